@@ -1,0 +1,20 @@
+// Each demcal subcommand lives in its own cmd_*.cpp and registers itself on the CLI11 app here.
+// A subcommand's callback throws demcal::UserError for bad input; main() prints it and exits 2.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <stdexcept>
+#include <string>
+
+namespace demcal {
+
+// Bad input from the user: the message names the field (or line/column) and the offending value.
+struct UserError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+void add_shear_commands(CLI::App& app);        // shear, status, resume            (cmd_shear.cpp)
+void add_silo_command(CLI::App& app);          // silo                              (cmd_silo.cpp)
+void add_discharge_commands(CLI::App& app);    // predict, diagnose                 (cmd_diagnose.cpp)
+void add_calibration_commands(CLI::App& app);  // sensitivity, calibrate, enlarge   (cmd_calibrate.cpp)
+
+}  // namespace demcal

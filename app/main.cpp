@@ -1,0 +1,25 @@
+#include "app/commands.hpp"
+
+#include <iostream>
+
+int main(int argc, char** argv) {
+    CLI::App app{"demcal: DEM calibration, YADE campaigns, discharge models and a native DEM kernel"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "demcal 0.1");
+    demcal::add_shear_commands(app);
+    demcal::add_silo_command(app);
+    demcal::add_discharge_commands(app);
+    demcal::add_calibration_commands(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const demcal::UserError& e) {
+        std::cerr << "demcal: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "demcal: failed: " << e.what() << "\n";
+        return 1;
+    }
+    return 0;
+}
