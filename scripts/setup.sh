@@ -5,7 +5,7 @@ set -euo pipefail
 PKGS=(
   build-essential cmake pkg-config ninja-build
   libeigen3-dev libgsl-dev libnlopt-dev libnlopt-cxx-dev nlohmann-json3-dev catch2 libsqlite3-dev sqlite3 libcli11-dev
-  libomp-dev gnuplot-nox
+  libssl-dev gnuplot-nox
   yade python3
   slurmctld slurmd slurm-client munge
 )
