@@ -1,0 +1,332 @@
+#include "orchestrator/campaign_store.hpp"
+
+#include <sqlite3.h>
+
+#include <chrono>
+#include <stdexcept>
+
+namespace demcal::orchestrator {
+
+double now_seconds() {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string to_string(RunState s) {
+    switch (s) {
+        case RunState::pending: return "pending";
+        case RunState::running: return "running";
+        case RunState::done: return "done";
+        case RunState::failed: return "failed";
+    }
+    return "?";
+}
+
+RunState run_state_from_string(const std::string& s) {
+    if (s == "pending") return RunState::pending;
+    if (s == "running") return RunState::running;
+    if (s == "done") return RunState::done;
+    if (s == "failed") return RunState::failed;
+    throw std::runtime_error("store: unknown run state '" + s + "'");
+}
+
+namespace {
+
+// A prepared statement that finalises itself; bind by 1-based position.
+class Statement {
+public:
+    Statement(sqlite3* db, const std::string& sql) : db_(db) {
+        if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) != SQLITE_OK)
+            throw std::runtime_error(std::string("store: ") + sqlite3_errmsg(db) + " in: " + sql);
+    }
+    ~Statement() { sqlite3_finalize(st_); }
+    Statement& bind(int i, const std::string& v) {
+        sqlite3_bind_text(st_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+        return *this;
+    }
+    Statement& bind(int i, const char* v) { return bind(i, std::string(v)); }
+    Statement& bind(int i, double v) {
+        sqlite3_bind_double(st_, i, v);
+        return *this;
+    }
+    Statement& bind(int i, std::int64_t v) {
+        sqlite3_bind_int64(st_, i, v);
+        return *this;
+    }
+    Statement& bind(int i, int v) { return bind(i, static_cast<std::int64_t>(v)); }
+    Statement& bind(int i, long v) { return bind(i, static_cast<std::int64_t>(v)); }
+    bool step() {
+        const int rc = sqlite3_step(st_);
+        if (rc == SQLITE_ROW) return true;
+        if (rc == SQLITE_DONE) return false;
+        throw std::runtime_error(std::string("store: ") + sqlite3_errmsg(db_));
+    }
+    std::string text(int c) const {
+        auto p = sqlite3_column_text(st_, c);
+        return p ? reinterpret_cast<const char*>(p) : "";
+    }
+    double real(int c) const { return sqlite3_column_double(st_, c); }
+    std::int64_t integer(int c) const { return sqlite3_column_int64(st_, c); }
+    bool is_null(int c) const { return sqlite3_column_type(st_, c) == SQLITE_NULL; }
+
+private:
+    sqlite3* db_;
+    sqlite3_stmt* st_ = nullptr;
+};
+
+// Runs a function inside one IMMEDIATE transaction; rolls back on exception.
+template <class F>
+void in_transaction(sqlite3* db, F&& f) {
+    char* err = nullptr;
+    if (sqlite3_exec(db, "BEGIN IMMEDIATE", nullptr, nullptr, &err) != SQLITE_OK) {
+        std::string m = err ? err : "?";
+        sqlite3_free(err);
+        throw std::runtime_error("store: cannot begin transaction: " + m);
+    }
+    try {
+        f();
+    } catch (...) {
+        sqlite3_exec(db, "ROLLBACK", nullptr, nullptr, nullptr);
+        throw;
+    }
+    if (sqlite3_exec(db, "COMMIT", nullptr, nullptr, &err) != SQLITE_OK) {
+        std::string m = err ? err : "?";
+        sqlite3_free(err);
+        throw std::runtime_error("store: cannot commit: " + m);
+    }
+}
+
+const char* kRunColumns =
+    "r.hash, r.params, r.state, r.attempts, r.result, r.cause, r.message, r.exit_code, r.wall_s, r.cpu_s, r.run_dir, "
+    "r.pgid, r.owner_pid";
+
+RunRecord read_run(const Statement& st, bool with_label) {
+    RunRecord r;
+    r.hash = st.text(0);
+    r.params = nlohmann::json::parse(st.text(1));
+    r.state = run_state_from_string(st.text(2));
+    r.attempts = static_cast<int>(st.integer(3));
+    if (!st.is_null(4)) r.result = nlohmann::json::parse(st.text(4));
+    r.cause = st.text(5);
+    r.message = st.text(6);
+    r.exit_code = static_cast<int>(st.integer(7));
+    r.wall_s = st.real(8);
+    r.cpu_s = st.real(9);
+    r.run_dir = st.text(10);
+    r.pgid = static_cast<long>(st.integer(11));
+    r.owner_pid = static_cast<long>(st.integer(12));
+    if (with_label) r.label = nlohmann::json::parse(st.text(13));
+    return r;
+}
+
+}  // namespace
+
+CampaignStore::CampaignStore(const std::filesystem::path& db_path) : path_(db_path) {
+    if (sqlite3_open_v2(db_path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
+        std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        sqlite3_close(db_);
+        throw std::runtime_error("store: cannot open " + db_path.string() + ": " + m);
+    }
+    sqlite3_busy_timeout(db_, 10000);
+    exec("PRAGMA journal_mode=WAL");
+    exec("PRAGMA synchronous=FULL");
+    exec("PRAGMA foreign_keys=ON");
+    exec(R"sql(
+CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);
+INSERT OR IGNORE INTO meta VALUES('schema_version', '1');
+CREATE TABLE IF NOT EXISTS campaigns(
+  id INTEGER PRIMARY KEY, name TEXT UNIQUE NOT NULL, kind TEXT NOT NULL, spec TEXT NOT NULL,
+  status TEXT NOT NULL DEFAULT 'open', created_at REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS runs(
+  hash TEXT PRIMARY KEY, params TEXT NOT NULL,
+  state TEXT NOT NULL CHECK(state IN ('pending','running','done','failed')),
+  attempts INTEGER NOT NULL DEFAULT 0, result TEXT, cause TEXT NOT NULL DEFAULT '', message TEXT NOT NULL DEFAULT '',
+  exit_code INTEGER NOT NULL DEFAULT 0, wall_s REAL NOT NULL DEFAULT 0, cpu_s REAL NOT NULL DEFAULT 0,
+  run_dir TEXT NOT NULL, pgid INTEGER NOT NULL DEFAULT 0, owner_pid INTEGER NOT NULL DEFAULT 0,
+  created_at REAL NOT NULL, updated_at REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS run_parameters(
+  hash TEXT NOT NULL REFERENCES runs(hash), name TEXT NOT NULL, value REAL NOT NULL, PRIMARY KEY(hash, name));
+CREATE TABLE IF NOT EXISTS campaign_runs(
+  campaign_id INTEGER NOT NULL REFERENCES campaigns(id), hash TEXT NOT NULL REFERENCES runs(hash),
+  label TEXT NOT NULL, position INTEGER NOT NULL, PRIMARY KEY(campaign_id, hash));
+CREATE TABLE IF NOT EXISTS attempts(
+  id INTEGER PRIMARY KEY, hash TEXT NOT NULL REFERENCES runs(hash), attempt INTEGER NOT NULL, executor TEXT NOT NULL,
+  started_at REAL NOT NULL, finished_at REAL, exit_code INTEGER, cause TEXT, message TEXT, wall_s REAL, cpu_s REAL);
+CREATE INDEX IF NOT EXISTS runs_by_state ON runs(state);
+)sql");
+}
+
+CampaignStore::~CampaignStore() { sqlite3_close(db_); }
+
+void CampaignStore::exec(const std::string& sql) {
+    char* err = nullptr;
+    if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+        std::string m = err ? err : "?";
+        sqlite3_free(err);
+        throw std::runtime_error("store " + path_.string() + ": " + m);
+    }
+}
+
+CampaignRecord CampaignStore::ensure_campaign(const std::string& name, const std::string& kind,
+                                              const nlohmann::json& spec) {
+    if (auto c = find_campaign(name)) return *c;
+    in_transaction(db_, [&] {
+        Statement(db_, "INSERT INTO campaigns(name, kind, spec, created_at) VALUES(?,?,?,?)")
+            .bind(1, name).bind(2, kind).bind(3, spec.dump()).bind(4, now_seconds()).step();
+    });
+    return *find_campaign(name);
+}
+
+namespace {
+CampaignRecord read_campaign(const Statement& st) {
+    CampaignRecord c;
+    c.id = st.integer(0);
+    c.name = st.text(1);
+    c.kind = st.text(2);
+    c.spec = nlohmann::json::parse(st.text(3));
+    c.status = st.text(4);
+    c.created_at = st.real(5);
+    return c;
+}
+}  // namespace
+
+std::optional<CampaignRecord> CampaignStore::find_campaign(const std::string& name) {
+    Statement st(db_, "SELECT id, name, kind, spec, status, created_at FROM campaigns WHERE name = ?");
+    st.bind(1, name);
+    if (st.step()) return read_campaign(st);
+    return std::nullopt;
+}
+
+std::vector<CampaignRecord> CampaignStore::campaigns() {
+    Statement st(db_, "SELECT id, name, kind, spec, status, created_at FROM campaigns ORDER BY id");
+    std::vector<CampaignRecord> out;
+    while (st.step()) out.push_back(read_campaign(st));
+    return out;
+}
+
+void CampaignStore::set_campaign_status(std::int64_t campaign_id, const std::string& status) {
+    in_transaction(db_, [&] {
+        Statement(db_, "UPDATE campaigns SET status = ? WHERE id = ?").bind(1, status).bind(2, campaign_id).step();
+    });
+}
+
+RunRecord CampaignStore::ensure_run(std::int64_t campaign_id, const std::string& hash, const nlohmann::json& params,
+                                    const std::filesystem::path& run_dir, const nlohmann::json& label) {
+    in_transaction(db_, [&] {
+        const double t = now_seconds();
+        Statement ins(db_,
+                      "INSERT OR IGNORE INTO runs(hash, params, state, run_dir, created_at, updated_at) "
+                      "VALUES(?,?,'pending',?,?,?)");
+        ins.bind(1, hash).bind(2, params.dump()).bind(3, run_dir.string()).bind(4, t).bind(5, t).step();
+        if (sqlite3_changes(db_) > 0) {
+            for (const auto& [k, v] : params.items())
+                if (v.is_number())
+                    Statement(db_, "INSERT INTO run_parameters VALUES(?,?,?)")
+                        .bind(1, hash).bind(2, k).bind(3, v.get<double>()).step();
+        }
+        Statement link(db_,
+                       "INSERT OR IGNORE INTO campaign_runs(campaign_id, hash, label, position) "
+                       "VALUES(?,?,?,(SELECT COUNT(*) FROM campaign_runs WHERE campaign_id = ?))");
+        link.bind(1, campaign_id).bind(2, hash).bind(3, label.dump()).bind(4, campaign_id).step();
+    });
+    return *run(hash);
+}
+
+std::optional<RunRecord> CampaignStore::run(const std::string& hash) {
+    Statement st(db_, std::string("SELECT ") + kRunColumns + " FROM runs r WHERE r.hash = ?");
+    st.bind(1, hash);
+    if (st.step()) return read_run(st, false);
+    return std::nullopt;
+}
+
+std::vector<RunRecord> CampaignStore::campaign_runs(std::int64_t campaign_id) {
+    Statement st(db_, std::string("SELECT ") + kRunColumns +
+                          ", c.label FROM campaign_runs c JOIN runs r ON r.hash = c.hash WHERE c.campaign_id = ? "
+                          "ORDER BY c.position");
+    st.bind(1, campaign_id);
+    std::vector<RunRecord> out;
+    while (st.step()) out.push_back(read_run(st, true));
+    return out;
+}
+
+std::vector<RunRecord> CampaignStore::runs_in_state(RunState s) {
+    Statement st(db_, std::string("SELECT ") + kRunColumns + " FROM runs r WHERE r.state = ?");
+    st.bind(1, to_string(s));
+    std::vector<RunRecord> out;
+    while (st.step()) out.push_back(read_run(st, false));
+    return out;
+}
+
+void CampaignStore::mark_running(const std::string& hash, long pgid, long owner_pid, const std::string& executor) {
+    in_transaction(db_, [&] {
+        const double t = now_seconds();
+        Statement(db_,
+                  "UPDATE runs SET state = 'running', attempts = attempts + 1, pgid = ?, owner_pid = ?, "
+                  "updated_at = ? WHERE hash = ?")
+            .bind(1, pgid).bind(2, owner_pid).bind(3, t).bind(4, hash).step();
+        Statement(db_,
+                  "INSERT INTO attempts(hash, attempt, executor, started_at) "
+                  "VALUES(?, (SELECT attempts FROM runs WHERE hash = ?), ?, ?)")
+            .bind(1, hash).bind(2, hash).bind(3, executor).bind(4, t).step();
+    });
+}
+
+namespace {
+void close_attempt(sqlite3* db, const std::string& hash, int exit_code, const std::string& cause,
+                   const std::string& message, double wall_s, double cpu_s) {
+    Statement(db,
+              "UPDATE attempts SET finished_at = ?, exit_code = ?, cause = ?, message = ?, wall_s = ?, cpu_s = ? "
+              "WHERE id = (SELECT MAX(id) FROM attempts WHERE hash = ?)")
+        .bind(1, now_seconds()).bind(2, exit_code).bind(3, cause).bind(4, message).bind(5, wall_s).bind(6, cpu_s)
+        .bind(7, hash).step();
+}
+}  // namespace
+
+void CampaignStore::mark_done(const std::string& hash, const nlohmann::json& result, int exit_code, double wall_s,
+                              double cpu_s) {
+    in_transaction(db_, [&] {
+        Statement(db_,
+                  "UPDATE runs SET state = 'done', result = ?, exit_code = ?, wall_s = ?, cpu_s = ?, cause = '', "
+                  "message = '', pgid = 0, updated_at = ? WHERE hash = ?")
+            .bind(1, result.dump()).bind(2, exit_code).bind(3, wall_s).bind(4, cpu_s).bind(5, now_seconds())
+            .bind(6, hash).step();
+        close_attempt(db_, hash, exit_code, "ok", "", wall_s, cpu_s);
+    });
+}
+
+void CampaignStore::mark_attempt_failed(const std::string& hash, const std::string& cause, const std::string& message,
+                                        int exit_code, double wall_s, double cpu_s, bool final) {
+    in_transaction(db_, [&] {
+        Statement(db_,
+                  "UPDATE runs SET state = ?, cause = ?, message = ?, exit_code = ?, wall_s = ?, cpu_s = ?, pgid = 0, "
+                  "updated_at = ? WHERE hash = ?")
+            .bind(1, final ? "failed" : "pending").bind(2, cause).bind(3, message).bind(4, exit_code).bind(5, wall_s)
+            .bind(6, cpu_s).bind(7, now_seconds()).bind(8, hash).step();
+        close_attempt(db_, hash, exit_code, cause, message, wall_s, cpu_s);
+    });
+}
+
+void CampaignStore::reset_to_pending(const std::string& hash, const std::string& why) {
+    in_transaction(db_, [&] {
+        Statement(db_, "UPDATE runs SET state = 'pending', result = NULL, pgid = 0, updated_at = ? WHERE hash = ?")
+            .bind(1, now_seconds()).bind(2, hash).step();
+        Statement(db_,
+                  "UPDATE attempts SET finished_at = ?, cause = 'interrupted', message = ? "
+                  "WHERE hash = ? AND finished_at IS NULL")
+            .bind(1, now_seconds()).bind(2, why).bind(3, hash).step();
+    });
+}
+
+std::vector<CampaignStore::Attempt> CampaignStore::attempts(const std::string& hash) {
+    Statement st(db_,
+                 "SELECT attempt, started_at, IFNULL(finished_at, 0), IFNULL(wall_s, 0), IFNULL(cpu_s, 0), "
+                 "IFNULL(exit_code, 0), IFNULL(cause, ''), IFNULL(message, ''), executor FROM attempts WHERE hash = ? "
+                 "ORDER BY id");
+    st.bind(1, hash);
+    std::vector<Attempt> out;
+    while (st.step())
+        out.push_back({static_cast<int>(st.integer(0)), st.real(1), st.real(2), st.real(3), st.real(4),
+                       static_cast<int>(st.integer(5)), st.text(6), st.text(7), st.text(8)});
+    return out;
+}
+
+}  // namespace demcal::orchestrator

@@ -1,0 +1,87 @@
+// The campaign store: one SQLite file in the campaign directory holding campaigns, runs (identity, parameters, state,
+// result, timings, error), every attempt of every run, and the numeric parameters in a queryable table.
+// Every state change is one transaction with synchronous=FULL, so a kill -9 at any moment leaves the store at the last
+// committed change: a finished run is either fully recorded (result included) or still pending/running.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+struct sqlite3;
+
+namespace demcal::orchestrator {
+
+enum class RunState { pending, running, done, failed };
+std::string to_string(RunState s);
+RunState run_state_from_string(const std::string& s);
+
+struct RunRecord {
+    std::string hash;
+    nlohmann::json params;
+    RunState state = RunState::pending;
+    int attempts = 0;
+    nlohmann::json result;           // null unless done
+    std::string cause, message;      // of the last failure
+    int exit_code = 0;
+    double wall_s = 0, cpu_s = 0;    // of the successful (or last) attempt
+    std::filesystem::path run_dir;
+    long pgid = 0, owner_pid = 0;    // while running: the process group and the orchestrator that owns it
+    nlohmann::json label;            // campaign-specific tags (normal stress, replicate), from campaign_runs
+};
+
+struct CampaignRecord {
+    std::int64_t id = 0;
+    std::string name, kind, status;
+    nlohmann::json spec;
+    double created_at = 0;
+};
+
+class CampaignStore {
+public:
+    explicit CampaignStore(const std::filesystem::path& db_path);
+    ~CampaignStore();
+    CampaignStore(const CampaignStore&) = delete;
+    CampaignStore& operator=(const CampaignStore&) = delete;
+
+    // Returns the campaign of that name, creating it with `spec` if new.
+    CampaignRecord ensure_campaign(const std::string& name, const std::string& kind, const nlohmann::json& spec);
+    std::optional<CampaignRecord> find_campaign(const std::string& name);
+    std::vector<CampaignRecord> campaigns();
+    void set_campaign_status(std::int64_t campaign_id, const std::string& status);
+
+    // Registers a run (new identity: pending) and links it to the campaign with its label. Returns the stored record.
+    RunRecord ensure_run(std::int64_t campaign_id, const std::string& hash, const nlohmann::json& params,
+                         const std::filesystem::path& run_dir, const nlohmann::json& label);
+    std::optional<RunRecord> run(const std::string& hash);
+    std::vector<RunRecord> campaign_runs(std::int64_t campaign_id);
+    std::vector<RunRecord> runs_in_state(RunState s);
+
+    void mark_running(const std::string& hash, long pgid, long owner_pid, const std::string& executor);
+    void mark_done(const std::string& hash, const nlohmann::json& result, int exit_code, double wall_s, double cpu_s);
+    // Records a failed attempt; `final` marks the run failed, otherwise it goes back to pending for a retry.
+    void mark_attempt_failed(const std::string& hash, const std::string& cause, const std::string& message,
+                             int exit_code, double wall_s, double cpu_s, bool final);
+    // Back to pending without counting a failure (interrupted by the user, or forced to recompute).
+    void reset_to_pending(const std::string& hash, const std::string& why);
+
+    struct Attempt {
+        int attempt;
+        double started_at, finished_at, wall_s, cpu_s;
+        int exit_code;
+        std::string cause, message, executor;
+    };
+    std::vector<Attempt> attempts(const std::string& hash);
+
+private:
+    void exec(const std::string& sql);
+    sqlite3* db_ = nullptr;
+    std::filesystem::path path_;
+};
+
+double now_seconds();  // wall clock, seconds since the epoch
+
+}  // namespace demcal::orchestrator
