@@ -53,7 +53,6 @@ public:
         return *this;
     }
     Statement& bind(int i, int v) { return bind(i, static_cast<std::int64_t>(v)); }
-    Statement& bind(int i, long v) { return bind(i, static_cast<std::int64_t>(v)); }
     bool step() {
         const int rc = sqlite3_step(st_);
         if (rc == SQLITE_ROW) return true;
