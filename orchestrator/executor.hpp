@@ -1,0 +1,76 @@
+// Executors run jobs (a command in a directory) and report how each ended. The campaign decides what a job is and
+// what to do with its outcome; an executor only runs processes: a local pool (LocalExecutor) or SLURM job arrays
+// (SlurmExecutor). Both pull jobs from a callback, so the campaign can re-queue a retry while others still run.
+#pragma once
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace demcal::orchestrator {
+
+struct Job {
+    std::string id;                   // the run's identity
+    std::filesystem::path dir;        // working directory; stdout.log and stderr.log are written there
+    std::vector<std::string> argv;    // command, run in `dir`
+    double timeout_s = 3600;          // wall-clock limit: terminate, then kill after the grace period
+};
+
+struct JobOutcome {
+    int exit_code = -1;               // -1 when killed by a signal
+    int term_signal = 0;
+    bool timed_out = false;
+    bool interrupted = false;         // stopped because the campaign was interrupted (Ctrl-C / SIGTERM)
+    double wall_s = 0, cpu_s = 0;
+    std::string failure_cause;        // from a `DEMCAL_FAILURE cause: message` line on stderr, if any
+    std::string message;              // that line's message, or the last line of stderr
+    bool succeeded() const { return exit_code == 0 && !timed_out && !interrupted; }
+};
+
+struct ExecutorEvents {
+    std::function<void(const Job&, long handle)> started;            // handle: process group or SLURM job id
+    std::function<void(const Job&, const JobOutcome&)> finished;
+};
+
+using JobSource = std::function<std::optional<Job>()>;  // next job to start, or none for now
+
+class Executor {
+public:
+    virtual ~Executor() = default;
+    virtual std::string name() const = 0;
+    // Runs jobs until the source is empty and nothing runs, or until interrupted(); then every running job is
+    // stopped and reported with interrupted = true.
+    virtual void run(const JobSource& next_job, const ExecutorEvents& events) = 0;
+};
+
+// Set by SIGINT/SIGTERM while an InterruptGuard lives; executors poll it.
+bool interrupted();
+void request_interrupt();
+class InterruptGuard {
+public:
+    InterruptGuard();   // installs the handlers and clears the flag
+    ~InterruptGuard();  // restores the previous handlers
+};
+
+// Reads the tail of a job's stderr.log for the failure cause and message.
+void read_failure_from_stderr(const std::filesystem::path& stderr_log, JobOutcome& out);
+
+class LocalExecutor : public Executor {
+public:
+    explicit LocalExecutor(int slots, double kill_grace_s = 5.0);
+    std::string name() const override { return "local"; }
+    void run(const JobSource& next_job, const ExecutorEvents& events) override;
+
+private:
+    int slots_;
+    double kill_grace_s_;
+};
+
+// True if a process group still has a member whose working directory is `dir` (a job left by a dead orchestrator).
+bool process_group_runs_in(long pgid, const std::filesystem::path& dir);
+// Kills such a left-over process group (SIGKILL) after checking it still belongs to `dir`.
+void kill_stale_process_group(long pgid, const std::filesystem::path& dir);
+
+}  // namespace demcal::orchestrator

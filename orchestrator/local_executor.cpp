@@ -1,0 +1,193 @@
+#include "orchestrator/executor.hpp"
+
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
+#include <fstream>
+#include <signal.h>
+#include <stdexcept>
+#include <sys/prctl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace demcal::orchestrator {
+
+namespace {
+std::atomic<bool> g_interrupted{false};
+struct sigaction g_old_int, g_old_term;
+extern "C" void on_interrupt_signal(int) { g_interrupted.store(true); }
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+bool interrupted() { return g_interrupted.load(); }
+void request_interrupt() { g_interrupted.store(true); }
+
+InterruptGuard::InterruptGuard() {
+    g_interrupted.store(false);
+    struct sigaction sa {};
+    sa.sa_handler = on_interrupt_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &g_old_int);
+    sigaction(SIGTERM, &sa, &g_old_term);
+}
+
+InterruptGuard::~InterruptGuard() {
+    sigaction(SIGINT, &g_old_int, nullptr);
+    sigaction(SIGTERM, &g_old_term, nullptr);
+}
+
+void read_failure_from_stderr(const std::filesystem::path& stderr_log, JobOutcome& out) {
+    std::ifstream f(stderr_log, std::ios::binary);
+    if (!f) return;
+    f.seekg(0, std::ios::end);
+    const std::streamoff size = f.tellg();
+    const std::streamoff from = size > 16384 ? size - 16384 : 0;
+    f.seekg(from);
+    std::string line, last;
+    while (std::getline(f, line)) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        const auto pos = line.find("DEMCAL_FAILURE ");
+        if (pos != std::string::npos) {
+            const std::string rest = line.substr(pos + 15);
+            const auto colon = rest.find(':');
+            out.failure_cause = rest.substr(0, colon);
+            out.message = colon == std::string::npos ? rest : rest.substr(colon + 1 + (rest.size() > colon + 1 && rest[colon + 1] == ' '));
+            return;
+        }
+        if (line.find_first_not_of(" \t") != std::string::npos) last = line;
+    }
+    out.message = last;
+}
+
+bool process_group_runs_in(long pgid, const std::filesystem::path& dir) {
+    if (pgid <= 0 || ::kill(-static_cast<pid_t>(pgid), 0) != 0) return false;
+    std::error_code ec;
+    // The group leader is the job's first process; its working directory tells whether it is still ours.
+    const auto cwd = std::filesystem::read_symlink("/proc/" + std::to_string(pgid) + "/cwd", ec);
+    return !ec && std::filesystem::equivalent(cwd, dir, ec);
+}
+
+void kill_stale_process_group(long pgid, const std::filesystem::path& dir) {
+    if (process_group_runs_in(pgid, dir)) ::kill(-static_cast<pid_t>(pgid), SIGKILL);
+}
+
+LocalExecutor::LocalExecutor(int slots, double kill_grace_s) : slots_(slots), kill_grace_s_(kill_grace_s) {
+    if (slots < 1) throw std::invalid_argument("jobs = " + std::to_string(slots) + " must be at least 1");
+}
+
+namespace {
+
+struct Running {
+    Job job;
+    pid_t pid;
+    std::chrono::steady_clock::time_point started;
+    bool terminating = false;
+    std::chrono::steady_clock::time_point term_sent;
+    bool timed_out = false;
+    bool interrupted = false;
+};
+
+pid_t spawn(const Job& job) {
+    std::filesystem::create_directories(job.dir);
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
+    if (pid == 0) {
+        ::setpgid(0, 0);  // own process group: Ctrl-C on the terminal reaches the orchestrator only, which decides
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // an orchestrator killed with -9 takes its jobs with it
+        if (::getppid() != parent) ::_exit(126);
+        sigset_t none;
+        sigemptyset(&none);
+        ::sigprocmask(SIG_SETMASK, &none, nullptr);
+        ::signal(SIGINT, SIG_DFL);
+        ::signal(SIGTERM, SIG_DFL);
+        if (::chdir(job.dir.c_str()) != 0) ::_exit(126);
+        const int out = ::open("stdout.log", O_WRONLY | O_CREAT | O_APPEND, 0644);
+        const int err = ::open("stderr.log", O_WRONLY | O_CREAT | O_APPEND, 0644);
+        if (out < 0 || err < 0) ::_exit(126);
+        ::dup2(out, 1);
+        ::dup2(err, 2);
+        const int devnull = ::open("/dev/null", O_RDONLY);
+        if (devnull >= 0) ::dup2(devnull, 0);
+        std::vector<char*> argv;
+        for (const auto& a : job.argv) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        ::execvp(argv[0], argv.data());
+        const std::string m = "DEMCAL_FAILURE exec: cannot start '" + job.argv[0] + "': " + std::strerror(errno) + "\n";
+        (void)!::write(2, m.data(), m.size());
+        ::_exit(127);
+    }
+    ::setpgid(pid, pid);  // also from the parent, so the group exists before we might signal it
+    return pid;
+}
+
+}  // namespace
+
+void LocalExecutor::run(const JobSource& next_job, const ExecutorEvents& events) {
+    std::vector<Running> running;
+    while (true) {
+        const bool stop = interrupted();
+        // Start jobs while there are free slots; the source is asked again each round since a finished job's
+        // callback may have queued a retry.
+        while (!stop && static_cast<int>(running.size()) < slots_) {
+            auto job = next_job();
+            if (!job) break;
+            Running r{*job, spawn(*job), std::chrono::steady_clock::now(), false, {}, false, false};
+            running.push_back(r);
+            if (events.started) events.started(r.job, r.pid);
+        }
+        if (running.empty()) return;
+        // Reap, time out, interrupt.
+        for (std::size_t i = 0; i < running.size();) {
+            Running& r = running[i];
+            int status = 0;
+            struct rusage ru {};
+            const pid_t w = ::wait4(r.pid, &status, WNOHANG, &ru);
+            if (w == r.pid) {
+                ::kill(-r.pid, SIGKILL);  // anything the job left behind in its group
+                JobOutcome o;
+                o.wall_s = seconds_since(r.started);
+                o.cpu_s = ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+                if (WIFEXITED(status)) o.exit_code = WEXITSTATUS(status);
+                if (WIFSIGNALED(status)) o.term_signal = WTERMSIG(status);
+                o.timed_out = r.timed_out;
+                o.interrupted = r.interrupted;
+                read_failure_from_stderr(r.job.dir / "stderr.log", o);
+                if (o.timed_out) {
+                    o.failure_cause = "timeout";
+                    o.message = "killed after the timeout of " + std::to_string(r.job.timeout_s) + " s";
+                } else if (o.interrupted) {
+                    o.failure_cause = "interrupted";
+                    o.message = "stopped by the user";
+                } else if (o.term_signal) {
+                    o.failure_cause = "signal";
+                    o.message = std::string("killed by signal ") + ::strsignal(o.term_signal);
+                }
+                Job finished_job = r.job;
+                running.erase(running.begin() + static_cast<long>(i));
+                if (events.finished) events.finished(finished_job, o);
+                continue;
+            }
+            const double age = seconds_since(r.started);
+            if (!r.terminating && (stop || age > r.job.timeout_s)) {
+                r.timed_out = !stop;
+                r.interrupted = stop;
+                r.terminating = true;
+                r.term_sent = std::chrono::steady_clock::now();
+                ::kill(-r.pid, SIGTERM);
+            } else if (r.terminating && seconds_since(r.term_sent) > kill_grace_s_) {
+                ::kill(-r.pid, SIGKILL);
+            }
+            ++i;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+}
+
+}  // namespace demcal::orchestrator
