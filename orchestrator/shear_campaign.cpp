@@ -1,0 +1,333 @@
+#include "orchestrator/shear_campaign.hpp"
+
+#include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_params.hpp"
+#include "orchestrator/slurm_executor.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <deque>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+namespace demcal::orchestrator {
+
+namespace fs = std::filesystem;
+
+nlohmann::json ShearCampaignSpec::to_json() const {
+    return {{"material", material},       {"normal_stresses", normal_stresses}, {"replicates", replicates},
+            {"base_seed", base_seed},     {"template", template_path.string()}, {"label", label}};
+}
+
+ShearCampaignSpec ShearCampaignSpec::from_json(const nlohmann::json& j) {
+    ShearCampaignSpec s;
+    s.material = j.at("material");
+    s.normal_stresses = j.at("normal_stresses").get<std::vector<double>>();
+    s.replicates = j.at("replicates").get<int>();
+    s.base_seed = j.at("base_seed").get<long>();
+    s.template_path = j.at("template").get<std::string>();
+    s.label = j.value("label", "");
+    return s;
+}
+
+fs::path default_shear_template() {
+    if (const char* d = std::getenv("DEMCAL_YADE_SCRIPTS")) return fs::path(d) / "shear_box.py";
+    return fs::path(DEMCAL_YADE_SCRIPTS_DIR) / "shear_box.py";
+}
+
+fs::path find_yade(const std::string& yade) {
+    if (yade.find('/') != std::string::npos) {
+        if (::access(yade.c_str(), X_OK) == 0) return yade;
+    } else if (const char* path = std::getenv("PATH")) {
+        std::string p = path;
+        for (std::size_t a = 0; a <= p.size();) {
+            std::size_t b = p.find(':', a);
+            if (b == std::string::npos) b = p.size();
+            const fs::path cand = fs::path(p.substr(a, b - a)) / yade;
+            if (::access(cand.c_str(), X_OK) == 0) return cand;
+            a = b + 1;
+        }
+    }
+    throw std::invalid_argument("yade = '" + yade +
+                                "' was not found on this machine (install the Debian package 'yade', e.g. with "
+                                "scripts/setup.sh, or pass --yade PATH)");
+}
+
+std::string campaign_name(const ShearCampaignSpec& spec) {
+    return "shear-" + sha256_hex(spec.to_json().dump()).substr(0, 12);
+}
+
+namespace {
+
+struct PlannedRun {
+    std::string hash;
+    nlohmann::json params;
+    nlohmann::json label;
+    fs::path dir;
+};
+
+ShearCampaignSpec resolved(const ShearCampaignSpec& spec) {
+    ShearCampaignSpec s = spec;
+    if (s.template_path.empty()) s.template_path = default_shear_template();
+    s.template_path = fs::absolute(s.template_path).lexically_normal();
+    s.material = validate_material(spec.material);
+    return s;
+}
+
+std::vector<PlannedRun> plan_runs(const ShearCampaignSpec& spec, const std::string& template_text,
+                                  const fs::path& campaign_dir) {
+    std::vector<PlannedRun> plan;
+    for (double sigma : spec.normal_stresses)
+        for (int rep = 0; rep < spec.replicates; ++rep) {
+            const long seed = spec.base_seed + rep;
+            PlannedRun r;
+            r.params = make_run_params(spec.material, sigma, seed);
+            r.hash = run_identity(template_text, r.params);
+            r.label = {{"normal_stress", sigma}, {"replicate", rep}, {"seed", seed}};
+            r.dir = campaign_dir / "runs" / r.hash.substr(0, 16);
+            plan.push_back(std::move(r));
+        }
+    return plan;
+}
+
+// The run directory holds everything needed to repeat the run by hand: `cd DIR && yade -n -x shear_box.py`.
+void write_run_directory(const PlannedRun& r, const std::string& template_text) {
+    fs::create_directories(r.dir);
+    const fs::path script = r.dir / "shear_box.py", params = r.dir / "params.json";
+    if (!fs::exists(script) || read_text_file(script) != template_text) write_text_file_atomically(script, template_text);
+    const std::string p = r.params.dump(2) + "\n";
+    if (!fs::exists(params) || read_text_file(params) != p) write_text_file_atomically(params, p);
+}
+
+// Physical failures and bad parameters are deterministic: a retry would fail the same way.
+bool retry_is_pointless(const std::string& cause) {
+    static const std::set<std::string> final_causes = {"nan", "kinetic_energy", "escaped", "normal_stress", "params",
+                                                       "exec", "no_result"};
+    return final_causes.count(cause) > 0;
+}
+
+std::unique_ptr<Executor> make_executor(const ExecutionOptions& o, const fs::path& campaign_dir) {
+    const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+    if (o.executor == "local") return std::make_unique<LocalExecutor>(jobs);
+    if (o.executor == "slurm") return std::make_unique<SlurmExecutor>(jobs, campaign_dir / "slurm", o.slurm_partition);
+    throw std::invalid_argument("executor = '" + o.executor + "' is not one of: local, slurm");
+}
+
+}  // namespace
+
+void validate_shear_spec(const ShearCampaignSpec& spec) {
+    if (spec.normal_stresses.empty()) throw std::invalid_argument("normal_stress: at least one normal stress is needed");
+    for (double s : spec.normal_stresses)
+        if (!(s > 0) || !std::isfinite(s))
+            throw std::invalid_argument("normal_stress = " + std::to_string(s) + " Pa must be positive");
+    if (spec.replicates < 1)
+        throw std::invalid_argument("replicates = " + std::to_string(spec.replicates) + " must be at least 1");
+    if (spec.base_seed < 0) throw std::invalid_argument("seed = " + std::to_string(spec.base_seed) + " must be >= 0");
+    const ShearCampaignSpec s = resolved(spec);
+    if (!fs::is_regular_file(s.template_path))
+        throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");
+}
+
+ShearCampaignRunner::ShearCampaignRunner(const fs::path& dir, ExecutionOptions options)
+    : dir_(fs::absolute(dir).lexically_normal()), options_(std::move(options)) {
+    fs::create_directories(dir_);
+    const fs::path lock = dir_ / ".lock";
+    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT, 0644);
+    if (lock_fd_ < 0) throw std::runtime_error("cannot open " + lock.string());
+    // flock is released by the kernel when the process dies, even by kill -9: no stale locks.
+    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+        ::close(lock_fd_);
+        throw std::runtime_error("campaign directory " + dir_.string() + " is in use by another demcal process");
+    }
+    store_ = std::make_unique<CampaignStore>(dir_ / "campaign.sqlite");
+    recover_stale_runs();
+}
+
+ShearCampaignRunner::~ShearCampaignRunner() {
+    store_.reset();
+    if (lock_fd_ >= 0) ::close(lock_fd_);
+}
+
+void ShearCampaignRunner::recover_stale_runs() {
+    // We hold the directory's lock, so any run still marked running belongs to a demcal that died.
+    for (const auto& r : store_->runs_in_state(RunState::running)) {
+        const auto attempts = store_->attempts(r.hash);
+        const std::string executor = attempts.empty() ? "local" : attempts.back().executor;
+        if (executor == "slurm")
+            cancel_stale_slurm_task(r.pgid);
+        else
+            kill_stale_process_group(r.pgid, r.run_dir);
+        store_->reset_to_pending(r.hash, "the orchestrator (pid " + std::to_string(r.owner_pid) +
+                                             ") stopped while the run was running");
+    }
+}
+
+ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, const ProgressCallback& progress) {
+    validate_shear_spec(spec_in);
+    const ShearCampaignSpec spec = resolved(spec_in);
+    find_yade(options_.yade);
+    const std::string template_text = read_text_file(spec.template_path);
+    const auto plan = plan_runs(spec, template_text, dir_);
+
+    ShearCampaignOutcome out;
+    out.campaign = store_->ensure_campaign(campaign_name(spec), "shear", spec.to_json());
+    std::deque<std::string> queue;
+    std::map<std::string, const PlannedRun*> by_hash;
+    std::set<std::string> seen;
+    for (const auto& r : plan) {
+        if (!seen.insert(r.hash).second) continue;  // the same run twice in a plan (repeated stress) runs once
+        by_hash[r.hash] = &r;
+        write_run_directory(r, template_text);
+        RunRecord rec = store_->ensure_run(out.campaign.id, r.hash, r.params, r.dir, r.label);
+        if (options_.force && rec.state != RunState::pending) {
+            store_->reset_to_pending(r.hash, "forced recomputation");
+            rec.state = RunState::pending;
+        }
+        if (rec.state == RunState::done) ++out.reused;
+        if (rec.state == RunState::pending) queue.push_back(r.hash);
+    }
+
+    CampaignProgress prog;
+    prog.total = static_cast<int>(by_hash.size());
+    prog.reused = out.reused;
+    prog.done = out.reused;
+    for (const auto& [h, _] : by_hash)
+        if (store_->run(h)->state == RunState::failed) ++prog.failed;
+    prog.pending = static_cast<int>(queue.size());
+    const auto t0 = std::chrono::steady_clock::now();
+    double finished_wall = 0;
+    int finished_here = 0;
+    auto executor = make_executor(options_, dir_);
+    const int slots = options_.jobs > 0 ? options_.jobs : std::max(1u, std::thread::hardware_concurrency());
+    auto report = [&](const std::string& event, const std::string& hash) {
+        if (!progress) return;
+        prog.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        prog.remaining_s = finished_here > 0 ? (finished_wall / finished_here) *
+                                                   (prog.pending + 0.5 * prog.running) / std::min(slots, std::max(1, prog.pending + prog.running))
+                                             : -1;
+        prog.event = event;
+        std::optional<RunRecord> rec = store_->run(hash);
+        if (rec) rec->label = by_hash.at(hash)->label;
+        prog.run = rec ? &*rec : nullptr;
+        progress(prog);
+        prog.run = nullptr;
+    };
+
+    ExecutorEvents events;
+    events.started = [&](const Job& job, long handle) {
+        store_->mark_running(job.id, handle, ::getpid(), executor->name());
+        --prog.pending;
+        ++prog.running;
+        report("started", job.id);
+    };
+    events.finished = [&](const Job& job, const JobOutcome& o) {
+        --prog.running;
+        if (o.interrupted) {
+            store_->reset_to_pending(job.id, "interrupted by the user");
+            ++prog.pending;
+            out.interrupted = true;
+            report("interrupted", job.id);
+            return;
+        }
+        finished_wall += o.wall_s;
+        ++finished_here;
+        std::string cause = o.failure_cause, message = o.message;
+        nlohmann::json result;
+        if (o.succeeded()) {
+            try {
+                result = nlohmann::json::parse(read_text_file(job.dir / "result.json"));
+                if (!result.contains("peak_shear_stress") || !result["peak_shear_stress"].is_number())
+                    throw std::runtime_error("no number 'peak_shear_stress'");
+            } catch (const std::exception& e) {
+                cause = "no_result";
+                message = std::string("exit code 0 but result.json is unusable: ") + e.what();
+            }
+        } else if (cause.empty()) {
+            cause = "exit_code";
+            message = "exit code " + std::to_string(o.exit_code) + (message.empty() ? "" : ": " + message);
+        }
+        if (cause.empty()) {
+            store_->mark_done(job.id, result, o.exit_code, o.wall_s, o.cpu_s);
+            ++out.executed;
+            ++prog.done;
+            report("done", job.id);
+            return;
+        }
+        const int attempts = store_->run(job.id)->attempts;
+        const bool final = retry_is_pointless(cause) || attempts > options_.retries;
+        store_->mark_attempt_failed(job.id, cause, message, o.exit_code, o.wall_s, o.cpu_s, final);
+        if (final) {
+            ++prog.failed;
+            report("failed", job.id);
+        } else {
+            queue.push_back(job.id);
+            ++prog.pending;
+            report("retry", job.id);
+        }
+    };
+    JobSource next = [&]() -> std::optional<Job> {
+        if (queue.empty()) return std::nullopt;
+        const std::string h = queue.front();
+        queue.pop_front();
+        const PlannedRun& r = *by_hash.at(h);
+        fs::remove(r.dir / "result.json");  // a result must come from this attempt
+        return Job{h, r.dir,
+                   {find_yade(options_.yade).string(), "-n", "-j1", "-x", "shear_box.py", "params.json", "result.json"},
+                   options_.timeout_s};
+    };
+
+    {
+        InterruptGuard guard;
+        if (!queue.empty()) executor->run(next, events);
+        if (interrupted()) out.interrupted = true;
+    }
+
+    out.runs.clear();
+    for (auto& rec : store_->campaign_runs(out.campaign.id)) {
+        if (rec.state == RunState::failed) ++out.failed;
+        if (rec.state == RunState::done) out.cpu_s += rec.cpu_s;
+        out.runs.push_back(std::move(rec));
+    }
+    const bool all_done = std::all_of(out.runs.begin(), out.runs.end(),
+                                      [](const RunRecord& r) { return r.state == RunState::done; });
+    store_->set_campaign_status(out.campaign.id, all_done ? "complete" : out.interrupted ? "interrupted"
+                                                         : out.failed ? "failed" : "open");
+    out.campaign = *store_->find_campaign(out.campaign.name);
+    return out;
+}
+
+std::vector<ShearCampaignOutcome> ShearCampaignRunner::resume(const ProgressCallback& progress) {
+    std::vector<ShearCampaignOutcome> outs;
+    for (const auto& c : store_->campaigns()) {
+        if (c.kind != "shear" || c.status == "complete") continue;
+        outs.push_back(run(ShearCampaignSpec::from_json(c.spec), progress));
+        if (outs.back().interrupted) break;
+    }
+    return outs;
+}
+
+std::vector<ShearCampaignOutcome> inspect_campaigns(const fs::path& dir) {
+    if (!fs::exists(dir / "campaign.sqlite"))
+        throw std::invalid_argument("campaign = '" + dir.string() + "' holds no campaign.sqlite");
+    CampaignStore store(dir / "campaign.sqlite");
+    std::vector<ShearCampaignOutcome> outs;
+    for (const auto& c : store.campaigns()) {
+        ShearCampaignOutcome o;
+        o.campaign = c;
+        o.runs = store.campaign_runs(c.id);
+        for (const auto& r : o.runs) {
+            if (r.state == RunState::failed) ++o.failed;
+            if (r.state == RunState::done) o.cpu_s += r.cpu_s;
+        }
+        outs.push_back(std::move(o));
+    }
+    return outs;
+}
+
+}  // namespace demcal::orchestrator

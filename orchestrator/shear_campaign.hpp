@@ -1,0 +1,97 @@
+// A shear campaign: one material sheared at several normal stresses (optionally replicated with other packing
+// seeds). It lives in a directory: DIR/campaign.sqlite (the store) and DIR/runs/<identity>/ (one generated run each:
+// shear_box.py, params.json, result.json, stdout.log, stderr.log). Runs are identified by their hash, so a run that
+// is already done in the store is reused, never computed twice (unless forced), and a campaign killed at any moment
+// resumes by running this again (or resume_shear_campaigns) on the same directory.
+#pragma once
+#include "orchestrator/campaign_store.hpp"
+#include "orchestrator/executor.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace demcal::orchestrator {
+
+struct ShearCampaignSpec {
+    nlohmann::json material;                 // as given; validated by plan_runs
+    std::vector<double> normal_stresses;     // [Pa]
+    int replicates = 1;                      // packings per normal stress, seeds base_seed, base_seed + 1, ...
+    long base_seed = 1;
+    std::filesystem::path template_path;     // empty: the installed yade_scripts/shear_box.py
+    std::string label;                       // optional human name, e.g. "sensitivity density level 2"
+
+    nlohmann::json to_json() const;
+    static ShearCampaignSpec from_json(const nlohmann::json& j);
+};
+
+struct ExecutionOptions {
+    int jobs = 0;                 // parallel runs; 0 = the number of cores
+    double timeout_s = 3600;      // per run
+    int retries = 1;              // further attempts after a crash or a timeout (not after a physical failure)
+    bool force = false;           // recompute runs already done
+    std::string executor = "local";  // "local" or "slurm"
+    std::string yade = "yade";    // the YADE launcher (path or name on PATH)
+    std::string slurm_partition;  // SLURM only; empty = the default partition
+};
+
+struct CampaignProgress {
+    int total = 0, done = 0, failed = 0, running = 0, pending = 0, reused = 0;
+    double elapsed_s = 0;
+    double remaining_s = -1;      // estimate from finished runs; < 0 when none finished yet
+    std::string event;            // "started", "done", "failed", "retry", "interrupted"
+    const RunRecord* run = nullptr;
+};
+using ProgressCallback = std::function<void(const CampaignProgress&)>;
+
+struct ShearCampaignOutcome {
+    CampaignRecord campaign;
+    std::vector<RunRecord> runs;  // in plan order, with their labels {"normal_stress", "replicate", "seed"}
+    int executed = 0;             // runs computed by this call
+    int reused = 0;               // runs found done in the store
+    int failed = 0;
+    double cpu_s = 0;             // CPU seconds of all the campaign's successful runs (also the reused ones)
+    bool interrupted = false;
+    bool complete() const { return !interrupted && failed == 0; }
+};
+
+std::filesystem::path default_shear_template();
+// Throws std::invalid_argument when the YADE launcher cannot be found (naming it and how to install it).
+std::filesystem::path find_yade(const std::string& yade);
+
+// Checks the spec (material, stresses, replicates, template, YADE) without writing anything.
+void validate_shear_spec(const ShearCampaignSpec& spec);
+
+class ShearCampaignRunner {
+public:
+    // Opens (creating if needed) the campaign directory and takes its lock; throws if another demcal holds it.
+    ShearCampaignRunner(const std::filesystem::path& dir, ExecutionOptions options);
+    ~ShearCampaignRunner();
+
+    // Plans the runs, reuses what is done, computes the rest. Blocks; Ctrl-C stops cleanly (outcome.interrupted).
+    ShearCampaignOutcome run(const ShearCampaignSpec& spec, const ProgressCallback& progress = {});
+    // Runs every campaign of the directory that is not complete.
+    std::vector<ShearCampaignOutcome> resume(const ProgressCallback& progress = {});
+
+    CampaignStore& store() { return *store_; }
+    const std::filesystem::path& dir() const { return dir_; }
+
+private:
+    std::filesystem::path dir_;
+    ExecutionOptions options_;
+    std::unique_ptr<CampaignStore> store_;
+    int lock_fd_ = -1;
+    void recover_stale_runs();
+};
+
+// Summary of a campaign directory without running anything (for `demcal status`): opens the store read-only-ish.
+std::vector<ShearCampaignOutcome> inspect_campaigns(const std::filesystem::path& dir);
+
+std::string campaign_name(const ShearCampaignSpec& spec);
+
+}  // namespace demcal::orchestrator

@@ -1,0 +1,189 @@
+#include "orchestrator/slurm_executor.hpp"
+
+#include "orchestrator/run_identity.hpp"
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace demcal::orchestrator {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string shell_quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+// Runs a command and returns its stdout; throws with the command's stderr on a non-zero exit.
+std::string capture(const std::string& cmd, int* exit_code = nullptr) {
+    std::array<char, 4096> buf{};
+    std::string out;
+    FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
+    if (!p) throw std::runtime_error("cannot run: " + cmd);
+    while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+    const int status = ::pclose(p);
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    if (exit_code) {
+        *exit_code = code;
+    } else if (code != 0) {
+        throw std::runtime_error("'" + cmd + "' failed (exit " + std::to_string(code) + "): " + out);
+    }
+    return out;
+}
+
+struct Task {
+    Job job;
+    long array_id;
+    int index;
+    std::chrono::steady_clock::time_point submitted;
+    bool cancel_sent = false;
+};
+
+// run.sh: the job's command with its logs, then one line: exit code, start and end (epoch s), CPU seconds.
+void write_task_script(const Job& job) {
+    std::ostringstream s;
+    s << "#!/bin/bash\n# Written by demcal's SLURM executor: runs this job, then records how it ended.\n"
+      << "cd " << shell_quote(job.dir.string()) << " || exit 1\nrm -f exit_status\nstart=$(date +%s.%N)\n";
+    for (const auto& a : job.argv) s << shell_quote(a) << ' ';
+    s << ">>stdout.log 2>>stderr.log </dev/null\ncode=$?\nend=$(date +%s.%N)\n"
+      << "cpu=$(times | tail -n 1 | awk '{split($1,u,/[ms]/); split($2,v,/[ms]/); print u[1]*60+u[2]+v[1]*60+v[2]}')\n"
+      << "echo \"$code $start $end $cpu\" > exit_status.tmp && mv exit_status.tmp exit_status\nexit $code\n";
+    write_text_file_atomically(job.dir / "run.sh", s.str());
+    fs::permissions(job.dir / "run.sh", fs::perms::owner_all | fs::perms::group_read | fs::perms::others_read);
+}
+
+// Task index -> SLURM state for an array job, from `squeue -r` (one line per task; finished tasks stay listed for
+// MinJobAge seconds).
+std::map<int, std::string> array_task_states(long array_id) {
+    int code = 0;
+    const std::string out =
+        capture("squeue -h -r -t all -j " + std::to_string(array_id) + " -o '%i %T'", &code);
+    std::map<int, std::string> states;
+    if (code != 0) return states;
+    std::istringstream in(out);
+    std::string id, state;
+    while (in >> id >> state) {
+        const auto us = id.find('_');
+        if (us == std::string::npos) continue;
+        try {
+            states[std::stoi(id.substr(us + 1))] = state;
+        } catch (...) {
+        }
+    }
+    return states;
+}
+
+bool is_terminal(const std::string& state) {
+    return state != "PENDING" && state != "RUNNING" && state != "CONFIGURING" && state != "COMPLETING" &&
+           state != "SUSPENDED" && state != "REQUEUED" && state != "RESIZING";
+}
+
+}  // namespace
+
+SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition)
+    : slots_(slots), work_dir_(std::move(work_dir)), partition_(std::move(partition)) {
+    if (slots < 1) throw std::invalid_argument("jobs = " + std::to_string(slots) + " must be at least 1");
+    int code = 0;
+    capture("command -v sbatch", &code);
+    if (code != 0)
+        throw std::invalid_argument("executor = 'slurm' but sbatch is not on PATH (install slurm-client and reach a "
+                                    "SLURM controller)");
+}
+
+void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events) {
+    fs::create_directories(work_dir_);
+    std::vector<Task> tasks;
+    auto submit_ready_jobs = [&] {
+        std::vector<Job> batch;
+        while (auto j = next_job()) batch.push_back(*j);
+        if (batch.empty()) return;
+        const std::string stem = "batch-" + std::to_string(::getpid()) + "-" + std::to_string(batches_++);
+        const fs::path list = work_dir_ / (stem + ".tasks"), script = work_dir_ / (stem + ".sbatch");
+        std::ostringstream l;
+        double longest = 0;
+        for (const auto& j : batch) {
+            write_task_script(j);
+            l << (j.dir / "run.sh").string() << "\n";
+            longest = std::max(longest, j.timeout_s);
+        }
+        write_text_file_atomically(list, l.str());
+        std::ostringstream s;
+        s << "#!/bin/bash\n#SBATCH --job-name=demcal\n#SBATCH --output=/dev/null\n#SBATCH --cpus-per-task=1\n"
+          << "#SBATCH --array=0-" << batch.size() - 1 << "%" << slots_ << "\n"
+          << "#SBATCH --time=" << static_cast<long>(std::ceil(longest / 60.0)) << "\n"
+          << (partition_.empty() ? "" : "#SBATCH --partition=" + partition_ + "\n")
+          << "exec bash \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" " << shell_quote(list.string()) << ")\"\n";
+        write_text_file_atomically(script, s.str());
+        const std::string out = capture("sbatch --parsable " + shell_quote(script.string()));
+        const long array_id = std::stol(out.substr(0, out.find_first_of(";\n")));
+        for (std::size_t i = 0; i < batch.size(); ++i) {
+            tasks.push_back({batch[i], array_id, static_cast<int>(i), std::chrono::steady_clock::now()});
+            if (events.started) events.started(batch[i], array_id * kTaskBase + static_cast<long>(i));
+        }
+    };
+
+    submit_ready_jobs();
+    while (!tasks.empty()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        const bool stop = interrupted();
+        std::map<long, std::map<int, std::string>> states;
+        for (std::size_t i = 0; i < tasks.size();) {
+            Task& t = tasks[i];
+            JobOutcome o;
+            bool ended = false;
+            std::ifstream st(t.job.dir / "exit_status");
+            double start = 0, end = 0, cpu = 0;
+            if (st >> o.exit_code >> start >> end >> cpu) {
+                ended = true;
+                o.wall_s = end - start;
+                o.cpu_s = cpu;
+                read_failure_from_stderr(t.job.dir / "stderr.log", o);
+            } else {
+                if (!states.count(t.array_id)) states[t.array_id] = array_task_states(t.array_id);
+                const auto& s = states[t.array_id];
+                const auto it = s.find(t.index);
+                if (it != s.end() && is_terminal(it->second)) {
+                    ended = true;
+                    o.exit_code = -1;
+                    o.timed_out = it->second == "TIMEOUT";
+                    o.interrupted = t.cancel_sent;
+                    o.failure_cause = o.timed_out ? "timeout" : o.interrupted ? "interrupted" : "slurm";
+                    o.message = "SLURM ended the task in state " + it->second;
+                    o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t.submitted).count();
+                }
+            }
+            if (!ended && stop && !t.cancel_sent) {
+                capture("scancel " + std::to_string(t.array_id) + "_" + std::to_string(t.index), &o.exit_code);
+                t.cancel_sent = true;
+            }
+            if (ended) {
+                if (t.cancel_sent) o.interrupted = true;
+                Job j = t.job;
+                tasks.erase(tasks.begin() + static_cast<long>(i));
+                if (events.finished) events.finished(j, o);
+                continue;
+            }
+            ++i;
+        }
+        if (!stop) submit_ready_jobs();  // retries queued by the finished callbacks
+    }
+}
+
+void cancel_stale_slurm_task(long handle) {
+    if (handle <= 0) return;
+    const long array_id = handle / SlurmExecutor::kTaskBase, task = handle % SlurmExecutor::kTaskBase;
+    int code = 0;
+    capture("scancel " + std::to_string(array_id) + "_" + std::to_string(task), &code);
+}
+
+}  // namespace demcal::orchestrator

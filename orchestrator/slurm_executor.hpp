@@ -1,0 +1,31 @@
+// Runs jobs as SLURM job arrays (for campaigns larger than one machine). Each batch of jobs that the campaign has
+// ready becomes one `sbatch --array=0-N%slots`; every array task runs its job's run.sh in the job's directory, which
+// leaves an `exit_status` file (exit code, start, end, CPU seconds). The executor polls those files and `squeue` for
+// tasks that SLURM ended without one (timeout, cancel, node failure). Needs sbatch/squeue/scancel on PATH.
+#pragma once
+#include "orchestrator/campaign_store.hpp"
+#include "orchestrator/executor.hpp"
+
+namespace demcal::orchestrator {
+
+class SlurmExecutor : public Executor {
+public:
+    // slots: array tasks running at once (the %N throttle); work_dir: where batch scripts and task lists go.
+    SlurmExecutor(int slots, std::filesystem::path work_dir, std::string partition = {});
+    std::string name() const override { return "slurm"; }
+    void run(const JobSource& next_job, const ExecutorEvents& events) override;
+
+    // The handle reported to `started` encodes the array job and task: job_id * kTaskBase + task.
+    static constexpr long kTaskBase = 100000;
+
+private:
+    int slots_;
+    std::filesystem::path work_dir_;
+    std::string partition_;
+    int batches_ = 0;
+};
+
+// On resume: cancels the SLURM array task (a handle reported to `started`) that a dead orchestrator left behind.
+void cancel_stale_slurm_task(long handle);
+
+}  // namespace demcal::orchestrator
