@@ -1,5 +1,306 @@
+// demcal shear / status / resume: YADE direct-shear campaigns and their failure lines.
 #include "app/commands.hpp"
+#include "app/gnuplot.hpp"
+#include "calibration/failure_line_evaluation.hpp"
+#include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_campaign.hpp"
+#include "orchestrator/shear_params.hpp"
+
+#include <map>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
 
 namespace demcal {
-void add_shear_commands(CLI::App&) {}  // placeholder until the subcommand lands
+
+namespace fs = std::filesystem;
+using namespace orchestrator;
+
+namespace {
+
+struct ShearCliOptions {
+    std::string material_file;
+    std::vector<double> normal_stresses;
+    int replicates = 1;
+    long seed = 1;
+    std::string campaign_dir;
+    std::string template_path;
+    std::string plot_format = "png";
+    ExecutionOptions exec;
+};
+
+std::string duration_text(double s) {
+    if (s < 0) return "?";
+    char buf[32];
+    const long t = std::lround(s);
+    if (t >= 3600)
+        std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
+    else if (t >= 60)
+        std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
+    else
+        std::snprintf(buf, sizeof buf, "%lds", t);
+    return buf;
+}
+
+nlohmann::json read_json_file(const std::string& path, const std::string& what) {
+    std::ifstream f(path);
+    if (!f) throw UserError(what + " = '" + path + "' cannot be read");
+    try {
+        return nlohmann::json::parse(f);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw UserError(what + " = '" + path + "' is not valid JSON: " + e.what());
+    }
+}
+
+void print_progress(const CampaignProgress& p) {
+    if (p.event == "started") return;  // one line per finished run keeps an overnight log readable
+    std::ostringstream line;
+    line << "[" << std::setw(6) << duration_text(p.elapsed_s) << "] " << std::left << std::setw(11) << p.event
+         << std::right;
+    if (p.run) {
+        line << " sigma=" << p.run->label.value("normal_stress", 0.0) << " Pa rep " << p.run->label.value("replicate", 0);
+        if (p.run->state == RunState::done)
+            line << "  peak " << std::setprecision(4) << p.run->result.value("peak_shear_stress", 0.0) << " Pa ("
+                 << duration_text(p.run->wall_s) << ")";
+        else if (!p.run->cause.empty())
+            line << "  " << p.run->cause << ": " << p.run->message;
+    }
+    line << "  | " << p.done << "/" << p.total << " done, " << p.running << " running, " << p.failed << " failed";
+    if (p.reused) line << " (" << p.reused << " reused)";
+    if (p.remaining_s >= 0 && p.pending + p.running > 0) line << ", ~" << duration_text(p.remaining_s) << " left";
+    std::cout << line.str() << std::endl;
+}
+
+void print_line(const char* title, const analytics::FailureLine& fl) {
+    std::cout << std::fixed << std::setprecision(4) << title << ": tau = " << fl.mu_b << " sigma + "
+              << std::setprecision(1) << fl.tau_c << " Pa\n"
+              << std::setprecision(4) << "  mu_b  = " << fl.mu_b << " +/- " << fl.se_mu_b << "  (95% CI "
+              << fl.mu_b_low << " .. " << fl.mu_b_high << "),  phi_b = " << std::setprecision(2) << fl.phi_b_deg
+              << " +/- " << fl.se_phi_b_deg << " deg\n"
+              << std::setprecision(1) << "  tau_c = " << fl.tau_c << " +/- " << fl.se_tau_c << " Pa  (95% CI "
+              << fl.tau_c_low << " .. " << fl.tau_c_high << "),  R^2 = " << std::setprecision(4) << fl.r_squared
+              << ", n = " << fl.n << "\n";
+    if (fl.lack_of_fit)
+        std::cout << "  lack of fit: F = " << std::setprecision(3) << fl.lack_of_fit->f_statistic << " ("
+                  << fl.lack_of_fit->df_lack_of_fit << ", " << fl.lack_of_fit->df_pure_error
+                  << " dof), p = " << fl.lack_of_fit->p_value
+                  << (fl.lack_of_fit->p_value < 0.05 ? "  -> the line does not fit the means" : "") << "\n";
+    std::cout.unsetf(std::ios::fixed);
+}
+
+// Failure line with its points and 95 % band, and the shear curves, for one campaign.
+void write_plots(const fs::path& dir, const std::string& stem, const calibration::FailureLineEvaluation& ev,
+                 const std::string& format) {
+    const fs::path points = dir / (stem + "_points.dat"), band = dir / (stem + "_band.dat");
+    {
+        std::ofstream p(points);
+        p << "# sigma_Pa peak_tau_Pa residual_tau_Pa\n";
+        for (const auto& r : ev.outcome.runs)
+            if (r.state == RunState::done)
+                p << r.label["normal_stress"].get<double>() << " " << r.result["peak_shear_stress"].get<double>() << " "
+                  << r.result.value("residual_shear_stress", 0.0) << "\n";
+        std::ofstream b(band);
+        b << "# sigma_Pa peak_fit peak_low peak_high residual_fit\n";
+        double smax = 0;
+        for (const auto& r : ev.outcome.runs) smax = std::max(smax, r.label["normal_stress"].get<double>());
+        for (int i = 0; i <= 50; ++i) {
+            const double s = 1.1 * smax * i / 50;
+            const double w = ev.peak->band_half_width(s);
+            b << s << " " << ev.peak->shear_stress(s) << " " << ev.peak->shear_stress(s) - w << " "
+              << ev.peak->shear_stress(s) + w << " " << ev.residual->shear_stress(s) << "\n";
+        }
+    }
+    std::ostringstream g;
+    g << "set title 'Failure line: mu_b = " << std::setprecision(3) << ev.peak->mu_b << " (phi_b = "
+      << std::setprecision(3) << ev.peak->phi_b_deg << " deg), tau_c = " << std::setprecision(3) << ev.peak->tau_c
+      << " Pa'\nset xlabel 'normal stress sigma [kPa]'\nset ylabel 'shear stress tau [kPa]'\nset key top left\n"
+      << "set grid\nset xrange [0:*]\nset yrange [0:*]\n"
+      << "plot " << gnuplot_quote(band) << " using ($1/1e3):($3/1e3):($4/1e3) with filledcurves lc rgb '#c6dbef' "
+      << "title '95% confidence band (peak)', \\\n  '' using ($1/1e3):($2/1e3) with lines lw 2 lc rgb '#08519c' "
+      << "title 'peak failure line', \\\n  '' using ($1/1e3):($5/1e3) with lines lw 2 dt 2 lc rgb '#a50f15' "
+      << "title 'residual failure line', \\\n  " << gnuplot_quote(points)
+      << " using ($1/1e3):($2/1e3) with points pt 7 ps 1.2 lc rgb '#08519c' title 'peak', \\\n  '' using "
+         "($1/1e3):($3/1e3) with points pt 5 ps 1 lc rgb '#a50f15' title 'residual'\n";
+    render_gnuplot(dir / (stem + "." + format), g.str());
+
+    std::ostringstream c;
+    c << "set title 'Shear stress against shear displacement'\nset xlabel 'shear displacement [mm]'\n"
+      << "set ylabel 'shear stress [kPa]'\nset key outside right\nset grid\nplot ";
+    bool first = true;
+    for (const auto& r : ev.outcome.runs) {
+        if (r.state != RunState::done || !r.result.contains("curve")) continue;
+        const fs::path curve = r.run_dir / "curve.dat";
+        std::ofstream f(curve);
+        const auto& cv = r.result["curve"];
+        for (std::size_t i = 0; i < cv["displacement"].size(); ++i)
+            f << cv["displacement"][i].get<double>() << " " << cv["shear_stress"][i].get<double>() << "\n";
+        c << (first ? "" : ", \\\n  ") << gnuplot_quote(curve) << " using ($1*1e3):($2/1e3) with lines title '"
+          << r.label["normal_stress"].get<double>() / 1e3 << " kPa #" << r.label["replicate"].get<int>() << "'";
+        first = false;
+    }
+    if (!first) render_gnuplot(dir / ("shear_curves_" + stem + "." + format), c.str(), 1000, 600);
+}
+
+// Prints, saves and plots one campaign's failure lines; returns the process exit code.
+int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, const std::string& plot_format) {
+    const auto ev = calibration::failure_lines_of(outcome);
+    std::cout << "\ncampaign " << outcome.campaign.name << " (" << dir.string() << "): " << outcome.runs.size()
+              << " runs, " << ev.simulations_run << " computed now, " << ev.simulations_reused << " reused, "
+              << ev.simulations_failed << " failed; CPU " << duration_text(ev.cpu_s) << "\n";
+    for (const auto& r : outcome.runs)
+        if (r.state == RunState::failed)
+            std::cout << "  FAILED sigma=" << r.label["normal_stress"] << " Pa rep " << r.label["replicate"] << ": "
+                      << r.cause << ": " << r.message << "  (" << r.run_dir.string() << "/stderr.log)\n";
+    nlohmann::json j = {{"campaign", outcome.campaign.name},
+                        {"spec", outcome.campaign.spec},
+                        {"runs", nlohmann::json::array()},
+                        {"simulations_run", ev.simulations_run},
+                        {"simulations_reused", ev.simulations_reused},
+                        {"simulations_failed", ev.simulations_failed},
+                        {"cpu_s", ev.cpu_s}};
+    for (const auto& r : outcome.runs) {
+        nlohmann::json rj = {{"hash", r.hash}, {"label", r.label}, {"state", to_string(r.state)},
+                             {"run_dir", r.run_dir.string()}, {"wall_s", r.wall_s}, {"cpu_s", r.cpu_s}};
+        if (r.state == RunState::done) {
+            for (const char* k : {"peak_shear_stress", "residual_shear_stress", "normal_stress_held", "porosity",
+                                  "particle_count"})
+                if (r.result.contains(k)) rj[k] = r.result[k];
+        } else if (r.state == RunState::failed) {
+            rj["cause"] = r.cause;
+            rj["message"] = r.message;
+        }
+        j["runs"].push_back(rj);
+    }
+    j["peak_failure_line"] = ev.peak ? ev.peak->to_json() : nlohmann::json(nullptr);
+    j["residual_failure_line"] = ev.residual ? ev.residual->to_json() : nlohmann::json(nullptr);
+    const std::string stem = "failure_line_" + outcome.campaign.name;
+    write_text_file_atomically(dir / (stem + ".json"), j.dump(2) + "\n");
+    if (ev.peak && ev.residual) {
+        std::cout << "\n";
+        print_line("Peak failure line", *ev.peak);
+        print_line("Residual failure line", *ev.residual);
+        try {
+            write_plots(dir, stem, ev, plot_format);
+            std::cout << "\nresults: " << (dir / (stem + ".json")).string() << "\nplots:   "
+                      << (dir / (stem + "." + plot_format)).string() << ", "
+                      << (dir / ("shear_curves_" + stem + "." + plot_format)).string() << "\n";
+        } catch (const std::exception& e) {
+            std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
+        }
+    } else {
+        std::cout << "no failure line: fewer than 3 finished runs on 2 normal stresses\n";
+    }
+    if (outcome.interrupted) return 130;
+    return outcome.failed > 0 ? 1 : 0;
+}
+
+void add_execution_options(CLI::App* cmd, ExecutionOptions& e) {
+    cmd->add_option("--jobs,-j", e.jobs, "runs in parallel (0 = one per core)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--timeout", e.timeout_s, "per-run wall-clock limit [s]")->check(CLI::PositiveNumber);
+    cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--executor", e.executor, "local (process pool) or slurm (job arrays)")
+        ->check(CLI::IsMember({"local", "slurm"}));
+    cmd->add_option("--partition", e.slurm_partition, "SLURM partition (slurm executor)");
+    cmd->add_option("--yade", e.yade, "YADE launcher to run");
+}
+
+}  // namespace
+
+void add_shear_commands(CLI::App& app) {
+    auto opt = std::make_shared<ShearCliOptions>();
+    auto* shear = app.add_subcommand("shear", "run a direct-shear campaign in YADE and fit the failure line");
+    shear->add_option("material", opt->material_file, "material JSON (micromechanical parameters)")->required();
+    shear->add_option("--normal-stress,-s", opt->normal_stresses, "normal stresses [Pa], e.g. 5e3,10e3,15e3")
+        ->required()
+        ->delimiter(',');
+    shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress (seeds seed, seed+1, ...)");
+    shear->add_option("--seed", opt->seed, "first packing seed");
+    shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<material name>)");
+    shear->add_option("--template", opt->template_path, "YADE template (default: yade_scripts/shear_box.py)");
+    shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    shear->add_flag("--force", opt->exec.force, "recompute runs already in the store");
+    add_execution_options(shear, opt->exec);
+    shear->callback([opt] {
+        ShearCampaignSpec spec;
+        spec.material = read_json_file(opt->material_file, "material");
+        try {
+            validate_material(spec.material, opt->material_file);
+        } catch (const std::invalid_argument& e) {
+            throw UserError(e.what());
+        }
+        spec.normal_stresses = opt->normal_stresses;
+        spec.replicates = opt->replicates;
+        spec.base_seed = opt->seed;
+        spec.template_path = opt->template_path;
+        try {
+            validate_shear_spec(spec);  // everything is checked before anything is written
+            find_yade(opt->exec.yade);
+        } catch (const std::invalid_argument& e) {
+            throw UserError(e.what());
+        }
+        const fs::path dir = opt->campaign_dir.empty()
+                                 ? fs::path("campaigns") / fs::path(opt->material_file).stem()
+                                 : fs::path(opt->campaign_dir);
+        ShearCampaignRunner runner(dir, opt->exec);
+        std::cout << "campaign directory " << runner.dir().string() << ": " << spec.normal_stresses.size()
+                  << " normal stresses x " << spec.replicates << " replicates, " << opt->exec.executor
+                  << " executor\n";
+        const auto outcome = runner.run(spec, print_progress);
+        const int code = report_campaign(runner.dir(), outcome, opt->plot_format);
+        if (code == 130) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";
+        if (code != 0) throw CLI::RuntimeError(code);
+    });
+
+    auto status_dir = std::make_shared<std::string>();
+    auto* status = app.add_subcommand("status", "summarise the campaigns of a directory");
+    status->add_option("dir", *status_dir, "campaign directory")->required();
+    status->callback([status_dir] {
+        std::vector<ShearCampaignOutcome> outs;
+        try {
+            outs = inspect_campaigns(*status_dir);
+        } catch (const std::invalid_argument& e) {
+            throw UserError(e.what());
+        }
+        for (const auto& o : outs) {
+            std::map<std::string, int> by_state;
+            double wall = 0;
+            for (const auto& r : o.runs) {
+                ++by_state[to_string(r.state)];
+                wall += r.wall_s;
+            }
+            std::cout << o.campaign.name << " [" << o.campaign.status << "] " << o.campaign.kind << ": "
+                      << o.runs.size() << " runs";
+            for (const auto& [s, n] : by_state) std::cout << ", " << n << " " << s;
+            std::cout << "; run time " << duration_text(wall) << ", CPU " << duration_text(o.cpu_s) << "\n";
+            for (const auto& r : o.runs)
+                if (r.state == RunState::failed)
+                    std::cout << "  failed: sigma=" << r.label["normal_stress"] << " rep " << r.label["replicate"]
+                              << " after " << r.attempts << " attempt(s): " << r.cause << ": " << r.message << "\n";
+            const auto ev = calibration::failure_lines_of(o);
+            if (ev.peak) print_line("  peak failure line", *ev.peak);
+        }
+        if (outs.empty()) std::cout << "no campaigns in " << *status_dir << "\n";
+    });
+
+    auto resume_opt = std::make_shared<ShearCliOptions>();
+    auto* resume = app.add_subcommand("resume", "continue the unfinished campaigns of a directory");
+    resume->add_option("dir", resume_opt->campaign_dir, "campaign directory")->required();
+    resume->add_option("--plot", resume_opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    add_execution_options(resume, resume_opt->exec);
+    resume->callback([resume_opt] {
+        if (!fs::exists(fs::path(resume_opt->campaign_dir) / "campaign.sqlite"))
+            throw UserError("campaign = '" + resume_opt->campaign_dir + "' holds no campaign.sqlite");
+        ShearCampaignRunner runner(resume_opt->campaign_dir, resume_opt->exec);
+        const auto outs = runner.resume(print_progress);
+        if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";
+        int code = 0;
+        for (const auto& o : outs) code = std::max(code, report_campaign(runner.dir(), o, resume_opt->plot_format));
+        if (code != 0) throw CLI::RuntimeError(code);
+    });
+}
+
 }  // namespace demcal

@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
     } catch (const demcal::UserError& e) {
         std::cerr << "demcal: error: " << e.what() << "\n";
         return 2;
+    } catch (const std::invalid_argument& e) {  // the libraries' word for bad input
+        std::cerr << "demcal: error: " << e.what() << "\n";
+        return 2;
     } catch (const std::exception& e) {
         std::cerr << "demcal: failed: " << e.what() << "\n";
         return 1;
