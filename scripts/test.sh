@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# README command 2 (and CI): installs what demcal needs, builds it, runs every test with ctest.
+# The YADE tests run real YADE; the SLURM test starts (and stops) a real single-node SLURM, so it needs root.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+bash scripts/build.sh
+cd build
+ctest --output-on-failure --timeout 1500 "$@"
