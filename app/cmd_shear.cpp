@@ -142,7 +142,7 @@ void write_plots(const fs::path& dir, const std::string& stem, const calibration
           << r.label["normal_stress"].get<double>() / 1e3 << " kPa #" << r.label["replicate"].get<int>() << "'";
         first = false;
     }
-    if (!first) render_gnuplot(dir / ("shear_curves_" + stem + "." + format), c.str(), 1000, 600);
+    if (!first) render_gnuplot(dir / ("shear_curves_" + ev.outcome.campaign.name + "." + format), c.str(), 1000, 600);
 }
 
 // Prints, saves and plots one campaign's failure lines; returns the process exit code.
@@ -187,7 +187,7 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
             write_plots(dir, stem, ev, plot_format);
             std::cout << "\nresults: " << (dir / (stem + ".json")).string() << "\nplots:   "
                       << (dir / (stem + "." + plot_format)).string() << ", "
-                      << (dir / ("shear_curves_" + stem + "." + plot_format)).string() << "\n";
+                      << (dir / ("shear_curves_" + outcome.campaign.name + "." + plot_format)).string() << "\n";
         } catch (const std::exception& e) {
             std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
         }

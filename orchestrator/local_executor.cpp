@@ -1,6 +1,7 @@
 #include "orchestrator/executor.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <csignal>
 #include <cstring>
 #include <fcntl.h>
@@ -161,7 +162,9 @@ void LocalExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
                 read_failure_from_stderr(r.job.dir / "stderr.log", o);
                 if (o.timed_out) {
                     o.failure_cause = "timeout";
-                    o.message = "killed after the timeout of " + std::to_string(r.job.timeout_s) + " s";
+                    char buf[64];
+                    std::snprintf(buf, sizeof buf, "killed after the timeout of %g s", r.job.timeout_s);
+                    o.message = buf;
                 } else if (o.interrupted) {
                     o.failure_cause = "interrupted";
                     o.message = "stopped by the user";
