@@ -27,7 +27,7 @@ const std::vector<ParamSpec>& shear_param_specs() {
          true},
         {"poisson_ratio", "-",
          "YADE's linear-law stiffness ratio ks/kn (CohFrictMat.poisson); it carries the name of a Poisson ratio",
-         std::nullopt, -1, 0.5, true, true},
+         std::nullopt, 0, 0.5, true, true},  // a Poisson ratio lies in (-1, 0.5); a stiffness ratio must be > 0
         {"friction_coefficient", "-", "inter-particle friction coefficient, tan of YADE's frictionAngle", std::nullopt,
          0, 10},
         {"bond_normal_strength", "Pa", "bond normal (tensile) strength, CohFrictMat.normalCohesion; 0 = no bonds",
