@@ -1,0 +1,323 @@
+#include "analytics/discharge_models.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+namespace demcal::analytics {
+
+namespace {
+constexpr double pi = std::numbers::pi;
+double rad(double deg) { return deg * pi / 180.0; }
+double deg(double rad) { return rad * 180.0 / pi; }
+
+std::string num(double v) {
+    std::ostringstream s;
+    s.precision(6);
+    s << v;
+    return s.str();
+}
+
+// Smallest outlet-to-particle ratio for which Beverloo-type correlations hold (Mankoc et al. 2007: d > 5-6 d_p).
+constexpr double min_outlet_particle_ratio = 6.0;
+// Silo-to-outlet ratio below which wall effects matter (the seed: D/d > 2.5 is conventional).
+constexpr double min_silo_outlet_ratio = 2.5;
+}  // namespace
+
+double beverloo_rate(double outlet, double particle_size, double bulk_density, double c, double k) {
+    const double effective = outlet - k * particle_size;
+    if (effective <= 0) return 0.0;
+    return c * bulk_density * std::sqrt(standard_gravity) * std::pow(effective, 2.5);
+}
+
+double beverloo_slot_rate(double slot_length, double slot_width, double particle_size, double bulk_density, double c,
+                          double k) {
+    const double length = slot_length - k * particle_size, width = slot_width - k * particle_size;
+    if (length <= 0 || width <= 0) return 0.0;
+    return c * bulk_density * std::sqrt(standard_gravity) * length * std::pow(width, 1.5);
+}
+
+// Johanson (1965): at the outlet of a mass-flow hopper the radial stress field gives an outlet velocity
+// v = sqrt(B g / (2 (1 + m) tan theta)) with B the outlet diameter (cone, m = 1) or width (wedge, m = 0).
+double johanson_conical_rate(double outlet, double half_angle_deg, double bulk_density) {
+    const double area = pi * outlet * outlet / 4.0;
+    return bulk_density * area * std::sqrt(outlet * standard_gravity / (4.0 * std::tan(rad(half_angle_deg))));
+}
+
+double johanson_wedge_rate(double slot_length, double slot_width, double half_angle_deg, double bulk_density) {
+    const double area = slot_length * slot_width;
+    return bulk_density * area * std::sqrt(slot_width * standard_gravity / (2.0 * std::tan(rad(half_angle_deg))));
+}
+
+// Oldal's arch model, derived here from the same assumptions as the seed's rectangular form (eqs. 3.3-3.6): below a
+// paraboloid arch f(r) = h (1 - (2r/d)^2) with apex h = delta d the grains fall freely, v(r) = sqrt(2 g f(r)).
+// Q = int_0^{d/2} sqrt(2 g delta d) sqrt(1 - (2r/d)^2) 2 pi r dr; with u = 2r/d:
+// Q = sqrt(2 g delta d) (pi d^2 / 2) int_0^1 u sqrt(1 - u^2) du = sqrt(2 g delta d) (pi d^2 / 2) / 3
+//   = (pi sqrt(2g) / 6) sqrt(delta) d^2.5, and with the effective outlet d - d_p, W = rho_b Q.
+// Checked: the same integral over a parabolic cylinder gives the seed's eq. 3.5, (pi/4) sqrt(2 g delta a) a b,
+// because int_{-1}^{1} sqrt(1 - u^2) du = pi/2; and the circular form is Beverloo with k = 1, C = 0.7405 sqrt(delta).
+// (Not checked against Oldal et al. 2012 itself, which we could not read.)
+double oldal_rate(double outlet, double particle_size, double bulk_density, double delta) {
+    const double effective = outlet - particle_size;
+    if (effective <= 0 || delta <= 0) return 0.0;
+    return pi * std::sqrt(2.0 * standard_gravity) / 6.0 * std::sqrt(delta) * bulk_density * std::pow(effective, 2.5);
+}
+
+double oldal_rectangular_rate(double depth, double outlet, double particle_size, double bulk_density, double delta) {
+    const double effective = outlet - particle_size;
+    if (effective <= 0 || delta <= 0) return 0.0;
+    return pi * std::sqrt(2.0 * standard_gravity) / 4.0 * std::sqrt(delta) * bulk_density * depth *
+           std::pow(effective, 1.5);
+}
+
+// Continuous at theta = 90 - phi_d (tan theta tan phi_d = 1); steeper hoppers (smaller theta) discharge faster.
+double rose_tanaka_factor(double half_angle_deg, double stagnant_angle_deg) {
+    if (half_angle_deg >= 90.0 - stagnant_angle_deg) return 1.0;
+    return std::pow(std::tan(rad(half_angle_deg)) * std::tan(rad(stagnant_angle_deg)), -0.35);
+}
+
+double jenike_mass_flow_limit_deg(double effective_friction_deg, double wall_friction_deg) {
+    if (!(effective_friction_deg > 0 && effective_friction_deg < 90))
+        throw std::invalid_argument("delta_e_deg=" + num(effective_friction_deg) + " not in (0, 90)");
+    if (!(wall_friction_deg >= 0 && wall_friction_deg < 90))
+        throw std::invalid_argument("phi_w_deg=" + num(wall_friction_deg) + " not in [0, 90)");
+    if (wall_friction_deg >= effective_friction_deg)
+        throw std::invalid_argument("phi_w_deg=" + num(wall_friction_deg) +
+                                    " is not below delta_e_deg=" + num(effective_friction_deg) +
+                                    ": the wall is rougher than the bulk, no mass flow is possible");
+    const double se = std::sin(rad(effective_friction_deg)), sw = std::sin(rad(wall_friction_deg));
+    const double beta = 0.5 * (wall_friction_deg + deg(std::asin(sw / se)));
+    return 90.0 - 0.5 * deg(std::acos((1.0 - se) / (2.0 * se))) - beta;
+}
+
+std::vector<std::string> oldal_rectangular_limit_violations(double depth, double width, double outlet) {
+    std::vector<std::string> out;
+    const double cb = width / depth, ac = outlet / width;
+    if (cb < 1.0 || cb > 4.0) out.push_back("c/b = " + num(cb) + " outside the validated range 1 <= c/b <= 4");
+    if (ac < 0.15 || ac > 0.7) out.push_back("a/c = " + num(ac) + " outside the validated range 0.15 <= a/c <= 0.7");
+    return out;
+}
+
+void validate(const SiloGeometry& g) {
+    auto positive = [](const char* field, double v) {
+        if (!(std::isfinite(v) && v > 0)) throw std::invalid_argument(std::string(field) + "=" + num(v) + " must be > 0");
+    };
+    positive("outlet_m", g.outlet);
+    positive("d_p_m", g.particle_size);
+    positive("rho_b_kg_m3", g.bulk_density);
+    if (!(g.half_angle_deg > 0 && g.half_angle_deg <= 90))
+        throw std::invalid_argument("theta_deg=" + num(g.half_angle_deg) + " not in (0, 90] (90 = flat bottom)");
+    if (g.outlet <= g.particle_size)
+        throw std::invalid_argument("outlet_m=" + num(g.outlet) + " is not larger than the particles (d_p_m=" +
+                                    num(g.particle_size) + ")");
+    if (g.shape == SiloShape::conical) {
+        positive("D_m", g.silo_diameter);
+        if (g.outlet >= g.silo_diameter)
+            throw std::invalid_argument("outlet_m=" + num(g.outlet) + " is not smaller than the silo, D_m=" +
+                                        num(g.silo_diameter));
+    } else {
+        positive("b_m", g.depth);
+        positive("c_m", g.width);
+        if (g.outlet >= g.width)
+            throw std::invalid_argument("outlet_m=" + num(g.outlet) + " is not smaller than the silo width, c_m=" +
+                                        num(g.width));
+    }
+    positive("beverloo_C", g.beverloo_c);
+    if (!(g.beverloo_k >= 0)) throw std::invalid_argument("beverloo_k=" + num(g.beverloo_k) + " must be >= 0");
+    positive("slot_C", g.slot_c);
+    positive("delta", g.arch_delta);
+    if (!(g.stagnant_angle_deg > 0 && g.stagnant_angle_deg < 90))
+        throw std::invalid_argument("phi_d_deg=" + num(g.stagnant_angle_deg) + " not in (0, 90)");
+    if (g.effective_friction_deg.has_value() != g.wall_friction_deg.has_value())
+        throw std::invalid_argument("delta_e_deg and phi_w_deg go together: give both or neither");
+    if (g.effective_friction_deg) jenike_mass_flow_limit_deg(*g.effective_friction_deg, *g.wall_friction_deg);
+}
+
+nlohmann::json DischargePrediction::to_json() const {
+    nlohmann::json j{{"model", model}, {"valid", valid}, {"warnings", warnings}};
+    j["W_kg_s"] = rate ? nlohmann::json(*rate) : nlohmann::json(nullptr);
+    return j;
+}
+
+std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
+    validate(g);
+    const bool conical = g.shape == SiloShape::conical;
+    const double theta = g.half_angle_deg;
+    // Flow pattern from Jenike's conical limit; for a wedge the plane-flow limit is wider, so the conical limit only
+    // proves mass flow there (theta below it), it cannot prove funnel flow.
+    std::optional<bool> mass_flow;
+    std::string pattern_note = "flow pattern unknown: give delta_e_deg and phi_w_deg to check it";
+    if (g.effective_friction_deg) {
+        const double limit = jenike_mass_flow_limit_deg(*g.effective_friction_deg, *g.wall_friction_deg);
+        if (theta < limit) {
+            mass_flow = true;
+            pattern_note = "mass flow (theta " + num(theta) + " < Jenike limit " + num(limit) + " deg)";
+        } else if (conical) {
+            mass_flow = false;
+            pattern_note = "funnel flow (theta " + num(theta) + " >= Jenike limit " + num(limit) + " deg)";
+        } else {
+            pattern_note = "theta " + num(theta) + " >= conical Jenike limit " + num(limit) +
+                           " deg; the plane-flow limit of a wedge is wider, flow pattern not decided";
+        }
+    }
+    auto funnel_flow_model = [&](DischargePrediction& p) {
+        if (mass_flow == true) {
+            p.valid = false;
+            p.warnings.push_back("a funnel-flow model used in " + pattern_note);
+        } else if (!mass_flow) {
+            p.warnings.push_back(pattern_note);
+        }
+    };
+    auto needs_outlet_ratio = [&](DischargePrediction& p, double outlet) {
+        if (outlet < min_outlet_particle_ratio * g.particle_size) {
+            p.valid = false;
+            p.warnings.push_back("outlet/d_p = " + num(outlet / g.particle_size) + " < " +
+                                 num(min_outlet_particle_ratio) + ": intermittent flow and clogging, correlation not valid");
+        }
+    };
+    auto wrong_shape = [&](DischargePrediction& p) {
+        p.valid = false;
+        p.warnings.push_back(std::string("applies to ") + (conical ? "rectangular" : "conical") + " silos only");
+    };
+
+    std::vector<DischargePrediction> out;
+    {
+        DischargePrediction p;
+        p.model = "beverloo";
+        if (!conical) wrong_shape(p);
+        else {
+            p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k);
+            needs_outlet_ratio(p, g.outlet);
+            if (g.silo_diameter < min_silo_outlet_ratio * g.outlet)
+                p.warnings.push_back("D/d = " + num(g.silo_diameter / g.outlet) + " < 2.5: wall effects likely");
+            if (rose_tanaka_factor(theta, g.stagnant_angle_deg) > 1.0)
+                p.warnings.push_back("hopper steeper than the stagnant zone (theta < 90 - phi_d): Beverloo "
+                                     "underestimates, see beverloo+rose-tanaka");
+        }
+        out.push_back(p);
+    }
+    {
+        DischargePrediction p;
+        p.model = "beverloo+rose-tanaka";
+        if (!conical) wrong_shape(p);
+        else {
+            p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k) *
+                     rose_tanaka_factor(theta, g.stagnant_angle_deg);
+            needs_outlet_ratio(p, g.outlet);
+        }
+        out.push_back(p);
+    }
+    {
+        DischargePrediction p;
+        p.model = "beverloo-slot";
+        if (conical) wrong_shape(p);
+        else {
+            p.rate = beverloo_slot_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.slot_c, g.beverloo_k);
+            needs_outlet_ratio(p, g.outlet);
+        }
+        out.push_back(p);
+    }
+    {
+        DischargePrediction p;
+        p.model = conical ? "johanson-conical" : "johanson-wedge";
+        if (theta >= 90.0) {
+            p.valid = false;
+            p.warnings.push_back("flat bottom (theta = 90): Johanson's hopper model does not apply");
+        } else {
+            p.rate = conical ? johanson_conical_rate(g.outlet, theta, g.bulk_density)
+                             : johanson_wedge_rate(g.depth, g.outlet, theta, g.bulk_density);
+            if (mass_flow == false) {
+                p.valid = false;
+                p.warnings.push_back("a mass-flow model used in " + pattern_note);
+            } else if (!mass_flow) {
+                p.warnings.push_back(pattern_note);
+            }
+        }
+        out.push_back(p);
+    }
+    {
+        DischargePrediction p;
+        p.model = "oldal";
+        if (!conical) wrong_shape(p);
+        else {
+            p.rate = oldal_rate(g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
+            funnel_flow_model(p);
+        }
+        out.push_back(p);
+    }
+    {
+        DischargePrediction p;
+        p.model = "oldal-rect";
+        if (conical) wrong_shape(p);
+        else {
+            p.rate = oldal_rectangular_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
+            for (auto& w : oldal_rectangular_limit_violations(g.depth, g.width, g.outlet)) {
+                p.valid = false;
+                p.warnings.push_back(w);
+            }
+            funnel_flow_model(p);
+        }
+        out.push_back(p);
+    }
+    return out;
+}
+
+SiloGeometry geometry_from_json(const nlohmann::json& j) {
+    if (!j.is_object()) throw std::invalid_argument("geometry: expected a JSON object, got " + j.dump());
+    SiloGeometry g;
+    auto number = [&](const std::string& key) -> std::optional<double> {
+        if (!j.contains(key)) return std::nullopt;
+        const auto& v = j.at(key);
+        if (!v.is_number()) throw std::invalid_argument("geometry: " + key + "=" + v.dump() + " is not a number");
+        return v.get<double>();
+    };
+    auto required = [&](const std::string& key) {
+        auto v = number(key);
+        if (!v) throw std::invalid_argument("geometry: missing key " + key);
+        return *v;
+    };
+    static const std::vector<std::string> known{"geometry", "D_m",        "b_m",        "c_m",        "outlet_m",
+                                                "theta_deg", "d_p_m",     "rho_b_kg_m3", "beverloo_C", "beverloo_k",
+                                                "slot_C",    "delta",     "phi_d_deg",   "delta_e_deg", "phi_w_deg"};
+    for (const auto& [key, value] : j.items())
+        if (std::find(known.begin(), known.end(), key) == known.end())
+            throw std::invalid_argument("geometry: unknown key " + key + "=" + value.dump());
+    if (!j.contains("geometry") || !j.at("geometry").is_string())
+        throw std::invalid_argument("geometry: key geometry must be \"conical\" or \"rectangular\"" +
+                                    (j.contains("geometry") ? ", got " + j.at("geometry").dump() : std::string()));
+    const auto shape = j.at("geometry").get<std::string>();
+    if (shape == "conical") {
+        g.shape = SiloShape::conical;
+        g.silo_diameter = required("D_m");
+        for (const char* k : {"b_m", "c_m"})
+            if (j.contains(k)) throw std::invalid_argument(std::string("geometry: ") + k + " is for rectangular silos");
+    } else if (shape == "rectangular") {
+        g.shape = SiloShape::rectangular;
+        g.depth = required("b_m");
+        g.width = required("c_m");
+        if (j.contains("D_m")) throw std::invalid_argument("geometry: D_m is for conical silos");
+    } else {
+        throw std::invalid_argument("geometry: geometry=\"" + shape + "\", expected conical or rectangular");
+    }
+    g.outlet = required("outlet_m");
+    g.half_angle_deg = required("theta_deg");
+    g.particle_size = required("d_p_m");
+    g.bulk_density = required("rho_b_kg_m3");
+    if (auto v = number("beverloo_C")) g.beverloo_c = *v;
+    if (auto v = number("beverloo_k")) g.beverloo_k = *v;
+    if (auto v = number("slot_C")) g.slot_c = *v;
+    if (auto v = number("delta")) g.arch_delta = *v;
+    if (auto v = number("phi_d_deg")) g.stagnant_angle_deg = *v;
+    g.effective_friction_deg = number("delta_e_deg");
+    g.wall_friction_deg = number("phi_w_deg");
+    try {
+        validate(g);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("geometry: ") + e.what());
+    }
+    return g;
+}
+
+}  // namespace demcal::analytics
