@@ -1,0 +1,264 @@
+#include "analytics/measured_data.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <istream>
+#include <limits>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+namespace demcal::analytics {
+
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+std::string trim(std::string_view s) {
+    const auto first = s.find_first_not_of(" \t\r");
+    if (first == std::string_view::npos) return {};
+    const auto last = s.find_last_not_of(" \t\r");
+    return std::string(s.substr(first, last - first + 1));
+}
+
+// Strict: the whole cell is one finite number (no "12 kg", no "1,5", no "nan"/"inf").
+std::optional<double> parse_number(const std::string& cell) {
+    if (cell.empty()) return std::nullopt;
+    const char* begin = cell.data();
+    if (*begin == '+') ++begin;
+    double v = 0;
+    const auto [end, ec] = std::from_chars(begin, cell.data() + cell.size(), v);
+    if (ec != std::errc() || end != cell.data() + cell.size() || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+std::vector<std::string> split_csv_line(const std::string& line, const std::string& source, int line_no) {
+    std::vector<std::string> fields;
+    std::string cur;
+    bool quoted = false, was_quoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char ch = line[i];
+        if (quoted) {
+            if (ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+                cur += '"';
+                ++i;
+            } else if (ch == '"') {
+                quoted = false;
+            } else {
+                cur += ch;
+            }
+        } else if (ch == '"' && trim(cur).empty()) {
+            quoted = was_quoted = true;
+            cur.clear();
+        } else if (ch == ',') {
+            fields.push_back(was_quoted ? cur : trim(cur));
+            cur.clear();
+            was_quoted = false;
+        } else {
+            cur += ch;
+        }
+    }
+    if (quoted) throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": unterminated quote");
+    fields.push_back(was_quoted ? cur : trim(cur));
+    return fields;
+}
+
+// Cells that may be empty: the geometry-specific sizes (they apply to one geometry only).
+bool may_be_empty(const std::string& column) { return column == "D_m" || column == "b_m" || column == "c_m"; }
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+std::string num(double v) {
+    std::ostringstream s;
+    s.precision(10);
+    s << v;
+    return s.str();
+}
+
+}  // namespace
+
+const DataColumn* MeasuredData::find(std::string_view name) const {
+    for (const auto& c : columns)
+        if (c.name == name) return &c;
+    return nullptr;
+}
+
+const DataColumn& MeasuredData::at(std::string_view name) const {
+    if (const auto* c = find(name)) return *c;
+    throw std::invalid_argument(source + ": no column " + std::string(name));
+}
+
+std::string MeasuredData::where(std::size_t row, std::string_view column) const {
+    return source + ": line " + std::to_string(lines.at(row)) + ", column " + std::string(column);
+}
+
+const std::vector<std::string>& reserved_columns(MeasuredKind kind) {
+    static const std::vector<std::string> discharge{"geometry", "D_m",   "b_m",         "c_m",   "outlet_m",
+                                                    "theta_deg", "d_p_m", "rho_b_kg_m3", "W_kg_s"};
+    static const std::vector<std::string> shear{"sigma_Pa", "tau_Pa"};
+    return kind == MeasuredKind::discharge ? discharge : shear;
+}
+
+MeasuredData parse_csv(std::istream& in, const std::string& source) {
+    MeasuredData data;
+    data.source = source;
+    std::string line;
+    int line_no = 0;
+    bool have_header = false;
+    while (std::getline(in, line)) {
+        ++line_no;
+        const std::string t = trim(line);
+        if (t.empty() || t[0] == '#') continue;  // blank lines and comments hold no data
+        auto fields = split_csv_line(line, source, line_no);
+        if (!have_header) {
+            for (auto& name : fields) {
+                if (name.empty())
+                    throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": empty column name");
+                for (const auto& c : data.columns)
+                    if (c.name == name)
+                        throw std::invalid_argument(source + ": line " + std::to_string(line_no) +
+                                                    ": duplicate column " + name);
+                data.columns.push_back(DataColumn{name, true, {}, {}});
+            }
+            have_header = true;
+            continue;
+        }
+        if (fields.size() != data.columns.size())
+            throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": " +
+                                        std::to_string(fields.size()) + " fields, the header has " +
+                                        std::to_string(data.columns.size()));
+        data.lines.push_back(line_no);
+        for (std::size_t c = 0; c < fields.size(); ++c) data.columns[c].text.push_back(fields[c]);
+    }
+    if (!have_header) throw std::invalid_argument(source + ": no header line");
+    if (data.rows() == 0) throw std::invalid_argument(source + ": header but no data rows");
+
+    for (auto& col : data.columns) {
+        std::size_t numbers = 0, texts = 0, first_text = 0;
+        for (std::size_t r = 0; r < data.rows(); ++r) {
+            const auto& cell = col.text[r];
+            if (cell.empty()) {
+                if (!may_be_empty(col.name)) throw std::invalid_argument(data.where(r, col.name) + ": missing value");
+                continue;
+            }
+            if (parse_number(cell)) {
+                ++numbers;
+            } else if (texts++ == 0) {
+                first_text = r;
+            }
+        }
+        // A column of mostly numbers with some text is a typo, not a category (e.g. "1,5" or "n/a").
+        col.numeric = texts == 0 || (numbers >= texts && col.name != "geometry");
+        if (col.numeric && texts > 0)
+            throw std::invalid_argument(data.where(first_text, col.name) + ": " + quote(col.text[first_text]) +
+                                        " is not a number");
+        if (col.numeric) {
+            col.values.reserve(data.rows());
+            for (const auto& cell : col.text) col.values.push_back(cell.empty() ? nan : *parse_number(cell));
+        }
+    }
+    return data;
+}
+
+void validate_measured(const MeasuredData& data, MeasuredKind kind) {
+    auto require_numeric = [&](const std::string& name) -> const DataColumn& {
+        const auto* col = data.find(name);
+        if (!col) throw std::invalid_argument(data.source + ": missing column " + name);
+        if (!col->numeric) {  // only possible when most cells are text: name the first
+            for (std::size_t r = 0; r < data.rows(); ++r)
+                if (!parse_number(col->text[r]) && !col->text[r].empty())
+                    throw std::invalid_argument(data.where(r, name) + ": " + quote(col->text[r]) + " is not a number");
+        }
+        return *col;
+    };
+    auto check = [&](std::size_t r, const DataColumn& col, bool ok, const std::string& what) {
+        if (!ok) throw std::invalid_argument(data.where(r, col.name) + ": " + num(col.values[r]) + " " + what);
+    };
+
+    if (kind == MeasuredKind::shear) {
+        const auto& sigma = require_numeric("sigma_Pa");
+        const auto& tau = require_numeric("tau_Pa");
+        for (std::size_t r = 0; r < data.rows(); ++r) {
+            check(r, sigma, sigma.values[r] >= 0, "is negative: normal stress must be >= 0");
+            check(r, tau, tau.values[r] >= 0, "is negative: shear strength must be >= 0");
+        }
+        return;
+    }
+
+    const auto* geometry = data.find("geometry");
+    if (!geometry) throw std::invalid_argument(data.source + ": missing column geometry");
+    bool any_conical = false, any_rectangular = false;
+    for (std::size_t r = 0; r < data.rows(); ++r) {
+        const auto& g = geometry->text[r];
+        if (g == "conical") any_conical = true;
+        else if (g == "rectangular") any_rectangular = true;
+        else
+            throw std::invalid_argument(data.where(r, "geometry") + ": " + quote(g) +
+                                        ", expected conical or rectangular");
+    }
+    const auto& outlet = require_numeric("outlet_m");
+    const auto& theta = require_numeric("theta_deg");
+    const auto& dp = require_numeric("d_p_m");
+    const auto& rho = require_numeric("rho_b_kg_m3");
+    const auto& rate = require_numeric("W_kg_s");
+    const DataColumn* silo_d = any_conical ? &require_numeric("D_m") : nullptr;
+    const DataColumn* depth = any_rectangular ? &require_numeric("b_m") : nullptr;
+    const DataColumn* width = any_rectangular ? &require_numeric("c_m") : nullptr;
+    for (const auto* col : {&outlet, &theta, &dp, &rho, &rate})
+        for (std::size_t r = 0; r < data.rows(); ++r)
+            if (std::isnan(col->values[r])) throw std::invalid_argument(data.where(r, col->name) + ": missing value");
+    for (std::size_t r = 0; r < data.rows(); ++r) {
+        check(r, dp, dp.values[r] > 0, "is not a positive particle size");
+        check(r, outlet, outlet.values[r] > 0, "is not a positive outlet size");
+        check(r, outlet, outlet.values[r] > dp.values[r],
+              "is not larger than the particles (d_p_m = " + num(dp.values[r]) + ")");
+        check(r, theta, theta.values[r] > 0 && theta.values[r] <= 90, "is not a half angle in (0, 90]");
+        check(r, rho, rho.values[r] > 0, "is not a positive bulk density");
+        check(r, rate, rate.values[r] > 0, "is not a positive discharge rate");
+        const bool conical = geometry->text[r] == "conical";
+        const auto& silo_size = conical ? *silo_d : *width;
+        const std::vector<const DataColumn*> sizes =
+            conical ? std::vector<const DataColumn*>{silo_d} : std::vector<const DataColumn*>{depth, width};
+        for (const auto* col : sizes) {
+            if (std::isnan(col->values[r]))
+                throw std::invalid_argument(data.where(r, col->name) + ": missing value (needed by a " +
+                                            geometry->text[r] + " silo)");
+            check(r, *col, col->values[r] > 0, "is not a positive silo size");
+        }
+        check(r, outlet, outlet.values[r] < silo_size.values[r],
+              "is not smaller than the silo (" + silo_size.name + " = " + num(silo_size.values[r]) + ")");
+    }
+}
+
+MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind) {
+    std::ifstream in(path);
+    if (!in) throw std::invalid_argument("cannot open data file " + path);
+    auto data = parse_csv(in, path);
+    validate_measured(data, kind);
+    return data;
+}
+
+std::string to_csv(const MeasuredData& data) {
+    std::ostringstream out;
+    for (std::size_t c = 0; c < data.columns.size(); ++c) out << (c ? "," : "") << data.columns[c].name;
+    out << "\n";
+    for (std::size_t r = 0; r < data.rows(); ++r) {
+        for (std::size_t c = 0; c < data.columns.size(); ++c) {
+            const auto& col = data.columns[c];
+            out << (c ? "," : "");
+            if (col.numeric && !col.values.empty())
+                out << (std::isnan(col.values[r]) ? std::string() : num(col.values[r]));
+            else if (col.text[r].find_first_of(",\"") != std::string::npos)
+                out << '"' << std::regex_replace(col.text[r], std::regex("\""), "\"\"") << '"';
+            else
+                out << col.text[r];
+        }
+        out << "\n";
+    }
+    return out.str();
+}
+
+}  // namespace demcal::analytics

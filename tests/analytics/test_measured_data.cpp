@@ -1,0 +1,62 @@
+#include "analytics/measured_data.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <sstream>
+
+using namespace demcal::analytics;
+
+namespace {
+MeasuredData load(const std::string& csv, MeasuredKind kind = MeasuredKind::discharge) {
+    std::istringstream in(csv);
+    auto data = parse_csv(in, "set.csv");
+    validate_measured(data, kind);
+    return data;
+}
+const std::string header = "geometry,D_m,b_m,c_m,outlet_m,theta_deg,d_p_m,rho_b_kg_m3,W_kg_s,operator,moisture_pct\n";
+}  // namespace
+
+TEST_CASE("discharge CSV loads every row with covariates", "[measured]") {
+    const auto data = load(header +
+                           "# a comment line\n"
+                           "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n"
+                           "\n"
+                           "rectangular,,0.05,0.1,0.03,60,0.0055,780,0.35,\"bob, jr\",13\n");
+    REQUIRE(data.rows() == 2);
+    CHECK(data.lines == std::vector<int>{3, 5});
+    CHECK(data.at("W_kg_s").values[1] == Approx(0.35));
+    CHECK(std::isnan(data.at("D_m").values[1]));
+    CHECK_FALSE(data.at("operator").numeric);
+    CHECK(data.at("operator").text[1] == "bob, jr");
+    CHECK(data.at("moisture_pct").numeric);
+    // Written back and read again it is the same table.
+    std::istringstream again(to_csv(data));
+    const auto round = parse_csv(again, "again.csv");
+    CHECK(round.at("operator").text[1] == "bob, jr");
+    CHECK(round.at("W_kg_s").values[0] == Approx(0.171));
+}
+
+TEST_CASE("bad discharge files name the line and the column", "[measured]") {
+    const std::string good = "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n";
+    auto fails_with = [&](const std::string& body, const std::string& expected) {
+        CHECK_THROWS_WITH(load(header + good + body), Catch::Contains(expected));
+    };
+    fails_with("conical,0.105,,,abc,30,0.0055,780,0.171,anna,12.5\n", "line 3, column outlet_m: 'abc' is not a number");
+    fails_with("conical,0.105,,,0.035,30,-0.0055,780,0.171,anna,12.5\n", "line 3, column d_p_m: -0.0055");
+    fails_with("conical,0.105,,,0.004,30,0.0055,780,0.171,anna,12.5\n",
+               "line 3, column outlet_m: 0.004 is not larger than the particles");
+    fails_with("conical,0.105,,,0.2,30,0.0055,780,0.171,anna,12.5\n", "line 3, column outlet_m: 0.2 is not smaller");
+    fails_with("conical,0.105,,,0.035,95,0.0055,780,0.171,anna,12.5\n", "line 3, column theta_deg: 95");
+    fails_with("conical,0.105,,,0.035,30,0.0055,780,,anna,12.5\n", "line 3, column W_kg_s: missing value");
+    fails_with("conical,,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column D_m: missing value");
+    fails_with("conical,0.105,,,0.035,30,0.0055,780,0.171,,12.5\n", "line 3, column operator: missing value");
+    fails_with("conical,0.105,,,0.035,30,0.0055,780,0.171,anna,1 2\n", "line 3, column moisture_pct: '1 2'");
+    fails_with("hexagonal,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column geometry: 'hexagonal'");
+    fails_with("conical,0.105,,,0.035,30,0.0055,780\n", "line 3: 8 fields, the header has 11");
+    CHECK_THROWS_WITH(load("geometry,outlet_m,theta_deg,d_p_m,W_kg_s\nconical,0.035,30,0.0055,0.17\n"),
+                      Catch::Contains("missing column rho_b_kg_m3"));
+    CHECK_THROWS_WITH(load("sigma_Pa,tau_Pa\n1000,800\n2000,-5\n", MeasuredKind::shear),
+                      Catch::Contains("line 3, column tau_Pa: -5"));
+    CHECK_THROWS_WITH(load("sigma_Pa,sigma_Pa\n1,2\n", MeasuredKind::shear), Catch::Contains("duplicate column"));
+}
