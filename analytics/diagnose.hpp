@@ -1,0 +1,96 @@
+// Residual diagnosis: fit a model to measured data, examine its residuals against every column, and add the effect the
+// model lacks when the evidence holds up on data the fit did not see.
+//
+// Statistics (chosen to hold up with a few dozen points, replicates and many candidate columns):
+//  * fits by GSL nonlinear least squares; discharge models on log W (the noise of a rate is relative), the failure line
+//    on tau (absolute);
+//  * lack of fit against pure error, where conditions are replicated (a condition = equal values in the model's
+//    condition columns: geometry, sizes, angle, density; sigma for shear data);
+//  * each candidate effect (a physical one from the library or a generic term in a column) is a nested extension of
+//    the current model: F test of the extra sum of squares, Holm's step-down correction over all candidates tried in
+//    that round (family-wise error rate `family_alpha`);
+//  * cross-validation with whole conditions left out (replicates never straddle folds, which would flatter the bigger
+//    model); a candidate is added only when it is significant after Holm AND cuts the cross-validated RMSE by at
+//    least `min_cv_improvement`; the best such candidate (lowest CV RMSE) is added and the search repeats.
+#pragma once
+#include "analytics/measured_data.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace demcal::analytics {
+
+struct DiagnoseOptions {
+    double family_alpha = 0.01;        // family-wise error rate of one round's candidate tests (Holm)
+    double min_cv_improvement = 0.05;  // least relative drop of the CV RMSE for an effect to be kept
+    int max_effects = 3;               // rounds of the search
+    int max_folds = 10;                // conditions are spread over at most this many CV folds
+};
+
+struct ParameterEstimate {
+    std::string name;
+    double value = 0;
+    double std_error = 0;  // from the fit's covariance; NaN when not identifiable from these data
+};
+
+struct ErrorSummary {
+    double rmse = 0;     // in the response's unit (kg/s or Pa)
+    double cv_rmse = 0;  // of predictions for conditions left out of the fit
+    double mape = 0;     // mean absolute relative error [%]
+};
+
+struct LackOfFitTest {
+    double f_statistic = 0;
+    int df_lack_of_fit = 0, df_pure_error = 0;
+    double p_value = 1;
+};
+
+// One candidate effect tried in one round.
+struct CandidateTest {
+    std::string variable;  // the column (or "row_order", the order of the rows in the file)
+    std::string form;      // the term, e.g. "W *= exp(beta*(x - x0))"
+    std::string kind;      // "physical", "nonlinearity" (a column the model uses), "missing variable", "drift"
+    int extra_params = 0;
+    double f_statistic = 0, p_value = 1, p_holm = 1;
+    double cv_rmse = 0;  // with this effect added
+    bool accepted = false;
+};
+
+struct AddedEffect {
+    std::string variable, form, kind;
+    std::vector<ParameterEstimate> params;
+    double f_statistic = 0, p_value = 1, p_holm = 1;
+    int candidates_tried = 0;
+    double cv_rmse_before = 0, cv_rmse_after = 0;
+};
+
+struct DiagnoseResult {
+    std::string model;
+    std::string response;        // W_kg_s or tau_Pa
+    std::string residual_scale;  // "relative" (fitted on log W) or "absolute"
+    int n = 0, conditions = 0, folds = 0;
+    std::vector<ParameterEstimate> params_before, params_after;
+    ErrorSummary before, after;
+    std::optional<LackOfFitTest> lack_of_fit_before, lack_of_fit_after;
+    std::vector<AddedEffect> effects;
+    std::vector<std::vector<CandidateTest>> rounds;  // every candidate of every round, for the evidence
+    std::vector<int> lines;                          // file line of each row
+    std::vector<double> observed, fitted_before, fitted_after;
+    std::vector<std::string> warnings;
+    // {"model", "n", "before": {...}, "effects": [...], "after": {...}} plus details (parameters, tests, rounds).
+    nlohmann::json to_json() const;
+};
+
+// Models diagnose knows: beverloo, johanson, oldal, oldal-rect, failure-line.
+const std::vector<std::string>& diagnose_models();
+// The kind of data a model needs (discharge or shear); throws std::invalid_argument for an unknown model.
+MeasuredKind data_kind_of(const std::string& model);
+
+// Runs the diagnosis. Throws std::invalid_argument naming the problem when the data do not suit the model
+// (e.g. rectangular rows for Beverloo, a flat bottom for Johanson, too few conditions to fit).
+DiagnoseResult diagnose(const MeasuredData& data, const std::string& model, const DiagnoseOptions& options = {});
+
+}  // namespace demcal::analytics

@@ -1,0 +1,170 @@
+#include "analytics/diagnose_synthetic.hpp"
+
+#include "analytics/discharge_models.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace demcal::analytics {
+
+namespace {
+
+std::string format(double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    return buf;
+}
+
+struct Table {
+    MeasuredData data;
+    DataColumn& column(const std::string& name, bool numeric) {
+        for (auto& c : data.columns)
+            if (c.name == name) return c;
+        data.columns.push_back(DataColumn{name, numeric, {}, {}});
+        return data.columns.back();
+    }
+    void number(const std::string& name, double v) {
+        auto& c = column(name, true);
+        c.values.push_back(v);
+        c.text.push_back(std::isnan(v) ? std::string() : format(v));
+    }
+    void text(const std::string& name, const std::string& v) { column(name, false).text.push_back(v); }
+};
+
+// One experimental condition (the silo set-up or the normal stress).
+struct Condition {
+    double outlet = 0, theta = 0, dp = 0, rho = 0, depth = 0, sigma = 0;
+};
+
+}  // namespace
+
+const std::vector<std::pair<std::string, std::string>>& synthetic_effects() {
+    static const std::vector<std::pair<std::string, std::string>> effects{
+        {"moisture", "moisture_pct"}, {"hopper_angle", "theta_deg"}, {"annulus", "d_p_m"},
+        {"drift", "run_order"},       {"operator", "operator"},      {"curved_locus", "sigma_Pa"}};
+    return effects;
+}
+
+MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
+    const bool shear = spec.model == "failure-line";
+    const bool rectangular = spec.model == "oldal-rect";
+    if (!shear && !rectangular && spec.model != "oldal" && spec.model != "beverloo" && spec.model != "johanson")
+        throw std::invalid_argument("synthetic set: unknown model " + spec.model);
+    const bool known = spec.effect == "none" || std::any_of(synthetic_effects().begin(), synthetic_effects().end(),
+                                                            [&](const auto& e) { return e.first == spec.effect; });
+    if (!known) throw std::invalid_argument("synthetic set: unknown effect " + spec.effect);
+    if ((spec.effect == "curved_locus") != shear && (spec.effect == "curved_locus" || spec.effect == "hopper_angle" ||
+                                                     spec.effect == "annulus"))
+        throw std::invalid_argument("synthetic set: effect " + spec.effect + " does not apply to " + spec.model);
+    if (spec.replicates < 1) throw std::invalid_argument("synthetic set: replicates must be >= 1");
+
+    // A factorial design of conditions, like a lab campaign.
+    std::vector<Condition> conditions;
+    if (shear) {
+        for (double sigma : {1e3, 2e3, 4e3, 6e3, 8e3, 10e3, 12e3, 15e3}) conditions.push_back({0, 0, 0, 0, 0, sigma});
+    } else {
+        const std::vector<double> outlets = rectangular ? std::vector<double>{0.02, 0.035, 0.05}
+                                                        : std::vector<double>{0.025, 0.035, 0.05};
+        const std::vector<double> angles = spec.model == "johanson" ? std::vector<double>{10, 20, 30}
+                                           : rectangular            ? std::vector<double>{20, 60}
+                                                                    : std::vector<double>{20, 40, 60};
+        const std::vector<double> depths = rectangular ? std::vector<double>{0.04, 0.07} : std::vector<double>{0};
+        for (double depth : depths)
+            for (double outlet : outlets)
+                for (double dp : {0.003, 0.005})
+                    for (double theta : angles)
+                        conditions.push_back({outlet, theta, dp, dp < 0.004 ? 820.0 : 780.0, depth, 0});
+    }
+    std::mt19937_64 rng(spec.seed);
+    std::vector<Condition> runs;
+    std::vector<int> replicate;
+    for (const auto& c : conditions)
+        for (int r = 1; r <= spec.replicates; ++r) {
+            runs.push_back(c);
+            replicate.push_back(r);
+        }
+    std::vector<std::size_t> order(runs.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::shuffle(order.begin(), order.end(), rng);  // randomised run order, rows written in run order
+
+    const double min_outlet = rectangular ? 0.02 : 0.025, max_dp = 0.005, min_theta = 20;
+    const double k0 = spec.model == "johanson" ? 0.0 : 1.0, exponent = rectangular ? 1.5 : 2.5;
+    // Annulus: k chosen so that the smallest outlet with the largest grains loses effect_size of its rate.
+    const double k_true =
+        (min_outlet - std::pow(1 - spec.effect_size, 1 / exponent) * (min_outlet - k0 * max_dp)) / max_dp;
+    // Rose-Tanaka: phi_d chosen so that the steepest hopper gains effect_size.
+    const double phi_d = std::atan(std::pow(1 + spec.effect_size, -1 / 0.35) /
+                                   std::tan(min_theta * M_PI / 180)) * 180 / M_PI;
+    const double mu_b = 0.55, tau_c = 400, sigma0 = 7e3;
+
+    std::normal_distribution<double> normal(0, 1);
+    std::uniform_real_distribution<double> moisture_dist(10, 16);
+    std::uniform_int_distribution<int> operator_dist(0, 2), vibration_dist(0, 2);
+    Table t;
+    t.data.source = "synthetic(" + spec.model + "," + spec.effect + ",seed " + std::to_string(spec.seed) + ")";
+    const std::size_t n = runs.size();
+    std::vector<double> clean(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto& c = runs[order[i]];
+        const double moisture = std::round(moisture_dist(rng) * 10) / 10, temperature = 20 + 2 * normal(rng);
+        const std::string op(1, static_cast<char>('A' + operator_dist(rng)));
+        const double vibration = 25.0 * vibration_dist(rng);
+        double y;
+        if (shear) {
+            const double n_exp = spec.effect == "curved_locus" ? 1 - spec.effect_size : 1.0;
+            y = tau_c + mu_b * sigma0 * std::pow(c.sigma / sigma0, n_exp);
+        } else if (spec.model == "beverloo") {
+            y = beverloo_rate(c.outlet, c.dp, c.rho, 0.58, 1.5);
+        } else if (spec.model == "johanson") {
+            y = johanson_conical_rate(c.outlet, c.theta, c.rho);
+        } else if (rectangular) {
+            y = oldal_rectangular_rate(c.depth, c.outlet, c.dp, c.rho, 0.45);
+        } else {
+            y = oldal_rate(c.outlet, c.dp, c.rho, 0.6);
+        }
+        if (spec.effect == "moisture") y *= 1 - spec.effect_size * (moisture - 13) / 6;
+        if (spec.effect == "drift") y *= 1 - spec.effect_size * i / (n - 1.0);
+        if (spec.effect == "operator" && op == "C") y *= 1 + spec.effect_size;
+        if (spec.effect == "hopper_angle") y *= rose_tanaka_factor(c.theta, phi_d);
+        if (spec.effect == "annulus")
+            y *= std::pow((c.outlet - k_true * c.dp) / (c.outlet - k0 * c.dp), exponent);
+        clean[i] = y;
+
+        if (shear) {
+            t.number("sigma_Pa", c.sigma);
+        } else {
+            t.text("geometry", rectangular ? "rectangular" : "conical");
+            if (rectangular) {
+                t.number("b_m", c.depth);
+                t.number("c_m", 0.1);
+            } else {
+                t.number("D_m", 0.105);
+            }
+            t.number("outlet_m", c.outlet);
+            t.number("theta_deg", c.theta);
+            t.number("d_p_m", c.dp);
+            t.number("rho_b_kg_m3", c.rho);
+        }
+        t.number(shear ? "tau_Pa" : "W_kg_s", 0);  // filled below, once the noise scale is known
+        t.number("replicate", replicate[order[i]]);
+        t.number("run_order", static_cast<double>(i + 1));
+        t.number("moisture_pct", moisture);
+        t.number("temperature_C", std::round(temperature * 10) / 10);
+        t.text("operator", op);
+        t.number("vibration_Hz", vibration);
+        t.data.lines.push_back(static_cast<int>(i + 2));
+    }
+    double mean = 0;
+    for (double v : clean) mean += v / n;
+    auto& response = t.column(shear ? "tau_Pa" : "W_kg_s", true);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double e = normal(rng);
+        response.values[i] = shear ? clean[i] + spec.noise * mean * e : clean[i] * std::exp(spec.noise * e);
+        response.text[i] = format(response.values[i]);
+    }
+    return t.data;
+}
+
+}  // namespace demcal::analytics
