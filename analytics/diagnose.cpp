@@ -599,6 +599,14 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
                 (best < 0 || tests[i].cv_rmse < tests[best].cv_rmse))
                 best = static_cast<int>(i);
         }
+        // A physical effect from the library is preferred to a generic term that predicts about as well (within
+        // min_cv_improvement): it names the mechanism, and the generic one is often its approximation.
+        if (best >= 0 && tests[best].kind != "physical")
+            for (std::size_t i = 0; i < tests.size(); ++i)
+                if (tests[i].kind == "physical" && tests[i].p_holm < options.family_alpha &&
+                    tests[i].cv_rmse < (1.0 - options.min_cv_improvement) * cv_now &&
+                    tests[i].cv_rmse <= (1.0 + options.min_cv_improvement) * tests[best].cv_rmse)
+                    best = static_cast<int>(i);
         if (best >= 0) tests[best].accepted = true;
         result.rounds.push_back(tests);
         if (best < 0) break;

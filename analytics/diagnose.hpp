@@ -11,7 +11,8 @@
 //    that round (family-wise error rate `family_alpha`);
 //  * cross-validation with whole conditions left out (replicates never straddle folds, which would flatter the bigger
 //    model); a candidate is added only when it is significant after Holm AND cuts the cross-validated RMSE by at
-//    least `min_cv_improvement`; the best such candidate (lowest CV RMSE) is added and the search repeats.
+//    least `min_cv_improvement`; the best such candidate (lowest CV RMSE) is added, except that a physical effect
+//    within `min_cv_improvement` of the best generic one is preferred (it names the mechanism); the search repeats.
 #pragma once
 #include "analytics/measured_data.hpp"
 

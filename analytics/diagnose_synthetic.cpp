@@ -77,7 +77,10 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
                     for (double theta : angles)
                         conditions.push_back({outlet, theta, dp, dp < 0.004 ? 820.0 : 780.0, depth, 0});
     }
-    std::mt19937_64 rng(spec.seed);
+    // The model and effect enter the seed so that one seed gives independent noise to different sets.
+    std::uint64_t mixed = 1469598103934665603ull;  // FNV-1a
+    for (char ch : spec.model + "/" + spec.effect) mixed = (mixed ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+    std::mt19937_64 rng(spec.seed ^ mixed);
     std::vector<Condition> runs;
     std::vector<int> replicate;
     for (const auto& c : conditions)

@@ -1,10 +1,16 @@
 // demcal predict GEOMETRY.json: every discharge model's rate with its validity.
+// demcal diagnose --model M --data F.csv: fit, residual diagnosis, the effect the model lacks, before/after errors.
+#include "analytics/diagnose.hpp"
 #include "analytics/discharge_models.hpp"
+#include "analytics/measured_data.hpp"
 #include "app/commands.hpp"
+#include "app/gnuplot.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -79,6 +85,167 @@ void run_predict(const std::string& geometry_path, const std::string& json_out) 
     }
 }
 
+
+constexpr const char* diagnose_help = R"(Data: CSV with a header of column names, SI units, angles in degrees.
+  discharge (beverloo, johanson, oldal, oldal-rect): geometry (conical|rectangular), D_m (conical) or b_m, c_m
+    (rectangular), outlet_m, theta_deg, d_p_m, rho_b_kg_m3, W_kg_s
+  shear (failure-line): sigma_Pa, tau_Pa
+  any other column is a covariate the model does not use (numeric, or categorical such as operator).
+Method: least-squares fit (GSL; discharge on log W), lack of fit against pure error of replicates, every column tried
+as a candidate effect (nested F test, Holm correction over the candidates of a round), cross-validation leaving whole
+conditions out; an effect is added when significant and it cuts the CV RMSE by at least --min-cv-gain; repeated until
+nothing more is. See examples/diagnose/README.md.)";
+
+std::string sci(double v) {
+    if (!std::isfinite(v)) return "n/a";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
+// Residual of row i: relative [%] for discharge rates, absolute for shear stresses.
+double residual_of(const analytics::DiagnoseResult& r, double fitted, std::size_t i) {
+    return r.residual_scale == "relative" ? 100.0 * (r.observed[i] - fitted) / fitted : r.observed[i] - fitted;
+}
+
+// Residuals against the fitted value and against the first added effect's column (or the file order): before/after.
+void plot_residuals(const analytics::DiagnoseResult& r, const analytics::MeasuredData& data,
+                    const std::filesystem::path& dat, const std::filesystem::path& before,
+                    const std::filesystem::path& after) {
+    std::string x_name = "row in file";
+    const analytics::DataColumn* x_col = nullptr;
+    for (const auto& e : r.effects)
+        if (const auto* c = data.find(e.variable); c && c->numeric) {
+            x_col = c;
+            x_name = e.variable;
+            break;
+        }
+    {
+        std::ofstream out(dat);
+        out << "# line observed fitted_before fitted_after residual_before residual_after x\n";
+        for (std::size_t i = 0; i < r.observed.size(); ++i)
+            out << r.lines[i] << " " << r.observed[i] << " " << r.fitted_before[i] << " " << r.fitted_after[i] << " "
+                << residual_of(r, r.fitted_before[i], i) << " " << residual_of(r, r.fitted_after[i], i) << " "
+                << (x_col ? x_col->values[i] : static_cast<double>(i + 1)) << "\n";
+        if (!out) throw UserError("cannot write " + dat.string());
+    }
+    const std::string unit = r.residual_scale == "relative" ? "residual [%]" : "residual [Pa]";
+    for (int which = 0; which < 2; ++which) {
+        const int col = which == 0 ? 5 : 6, fitted = which == 0 ? 3 : 4;
+        const std::string title = which == 0 ? "before" : "after";
+        std::ostringstream g;
+        g << "set multiplot layout 1,2 title '" << r.model << " residuals " << title
+          << (which == 1 ? " (" + std::to_string(r.effects.size()) + " effect(s) added)" : std::string()) << "'\n"
+          << "set grid\nset ylabel '" << unit << "'\nunset key\n"
+          << "set xlabel 'fitted " << r.response << "'\n"
+          << "plot " << gnuplot_quote(dat) << " using " << fitted << ":" << col << " with points pt 7 ps 0.8, 0 lt -1\n"
+          << "set xlabel '" << x_name << "'\n"
+          << "plot " << gnuplot_quote(dat) << " using 7:" << col << " with points pt 7 ps 0.8, 0 lt -1\n"
+          << "unset multiplot\n";
+        render_gnuplot(which == 0 ? before : after, g.str(), 1100, 450);
+    }
+}
+
+std::string markdown_report(const analytics::DiagnoseResult& r, const std::string& data_path,
+                            const std::string& plot_before, const std::string& plot_after) {
+    std::ostringstream md;
+    md << "# diagnose: " << r.model << " on " << data_path << "\n\n"
+       << r.n << " rows, " << r.conditions << " distinct conditions, " << r.folds
+       << "-fold cross-validation leaving whole conditions out; residuals " << r.residual_scale << ".\n\n"
+       << "| | RMSE | CV RMSE | MAPE [%] |\n|---|---|---|---|\n"
+       << "| before | " << sci(r.before.rmse) << " | " << sci(r.before.cv_rmse) << " | " << sci(r.before.mape) << " |\n"
+       << "| after | " << sci(r.after.rmse) << " | " << sci(r.after.cv_rmse) << " | " << sci(r.after.mape) << " |\n\n";
+    auto lof = [&](const char* when, const std::optional<analytics::LackOfFitTest>& t) {
+        if (t)
+            md << "Lack of fit " << when << ": F = " << sci(t->f_statistic) << " (" << t->df_lack_of_fit << ", "
+               << t->df_pure_error << " dof), p = " << sci(t->p_value) << "\n\n";
+        else
+            md << "Lack of fit " << when << ": not testable (no replicates or too few conditions)\n\n";
+    };
+    lof("before", r.lack_of_fit_before);
+    lof("after", r.lack_of_fit_after);
+    md << "## Effects added\n\n";
+    if (r.effects.empty()) md << "None: no candidate was significant after Holm's correction and improved the CV RMSE.\n\n";
+    for (const auto& e : r.effects) {
+        md << "- **" << e.variable << "** (" << e.kind << "): `" << e.form << "`; ";
+        for (const auto& p : e.params) md << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << "; ";
+        md << "F = " << sci(e.f_statistic) << ", p = " << sci(e.p_value) << ", Holm p = " << sci(e.p_holm) << " over "
+           << e.candidates_tried << " candidates; CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after)
+           << "\n";
+    }
+    md << "\n## Parameters\n\n| parameter | before | after |\n|---|---|---|\n";
+    for (std::size_t i = 0; i < r.params_after.size(); ++i) {
+        const auto& a = r.params_after[i];
+        md << "| " << a.name << " | "
+           << (i < r.params_before.size() ? sci(r.params_before[i].value) + " +/- " + sci(r.params_before[i].std_error)
+                                          : std::string("-"))
+           << " | " << sci(a.value) << " +/- " << sci(a.std_error) << " |\n";
+    }
+    md << "\n## Candidates examined\n\n";
+    for (std::size_t k = 0; k < r.rounds.size(); ++k) {
+        md << "Round " << k + 1 << "\n\n| column | kind | form | F | p | Holm p | CV RMSE | added |\n"
+           << "|---|---|---|---|---|---|---|---|\n";
+        for (const auto& c : r.rounds[k])
+            md << "| " << c.variable << " | " << c.kind << " | `" << c.form << "` | " << sci(c.f_statistic) << " | "
+               << sci(c.p_value) << " | " << sci(c.p_holm) << " | " << sci(c.cv_rmse) << " | "
+               << (c.accepted ? "yes" : "") << " |\n";
+        md << "\n";
+    }
+    if (!r.warnings.empty()) {
+        md << "## Warnings\n\n";
+        for (const auto& w : r.warnings) md << "- " << w << "\n";
+        md << "\n";
+    }
+    if (!plot_before.empty())
+        md << "## Residuals\n\n![before](" << plot_before << ")\n\n![after](" << plot_after << ")\n";
+    return md.str();
+}
+
+struct DiagnoseArgs {
+    std::string model, data, json_out, report_out;
+    analytics::DiagnoseOptions options;
+    bool no_plots = false;
+};
+
+void run_diagnose(const DiagnoseArgs& a) {
+    analytics::MeasuredData data;
+    analytics::DiagnoseResult r;
+    try {
+        const auto kind = analytics::data_kind_of(a.model);
+        data = analytics::read_measured_csv(a.data, kind);
+        r = analytics::diagnose(data, a.model, a.options);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+    std::cout << "model " << r.model << ": " << r.n << " rows, " << r.conditions << " conditions, " << r.folds
+              << " CV folds\n"
+              << "before: RMSE " << sci(r.before.rmse) << "  CV RMSE " << sci(r.before.cv_rmse) << "  MAPE "
+              << sci(r.before.mape) << " %\n";
+    for (const auto& e : r.effects) {
+        std::cout << "  + " << e.variable << " (" << e.kind << "): " << e.form << "\n    ";
+        for (const auto& p : e.params) std::cout << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << "  ";
+        std::cout << "p = " << sci(e.p_value) << " (Holm " << sci(e.p_holm) << ", " << e.candidates_tried
+                  << " candidates), CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after) << "\n";
+    }
+    if (r.effects.empty()) std::cout << "  no effect added: nothing significant and better out of sample\n";
+    std::cout << "after:  RMSE " << sci(r.after.rmse) << "  CV RMSE " << sci(r.after.cv_rmse) << "  MAPE "
+              << sci(r.after.mape) << " %\n";
+    for (const auto& w : r.warnings) std::cout << "warning: " << w << "\n";
+    if (!a.json_out.empty()) write_text(a.json_out, r.to_json().dump(2) + "\n");
+    if (!a.report_out.empty()) {
+        const std::filesystem::path report(a.report_out);
+        std::string before_name, after_name;
+        if (!a.no_plots) {
+            const std::string stem = report.stem().string();
+            before_name = stem + "_residuals_before.png";
+            after_name = stem + "_residuals_after.png";
+            const auto dir = report.parent_path();
+            plot_residuals(r, data, dir / (stem + "_residuals.dat"), dir / before_name, dir / after_name);
+        }
+        write_text(a.report_out, markdown_report(r, a.data, before_name, after_name));
+    }
+}
+
 }  // namespace
 
 void add_discharge_commands(CLI::App& app) {
@@ -89,6 +256,31 @@ void add_discharge_commands(CLI::App& app) {
     predict->add_option("--json", *predict_json, "also write the predictions as JSON to this file");
     predict->footer(geometry_keys_help);
     predict->callback([geometry, predict_json] { run_predict(*geometry, *predict_json); });
+
+    auto diagnose = app.add_subcommand("diagnose", "Fit a model to measured data, trace its residuals to the effect "
+                                                   "it lacks, report the error before and after");
+    auto args = std::make_shared<DiagnoseArgs>();
+    std::string models;
+    for (const auto& m : analytics::diagnose_models()) models += (models.empty() ? "" : ", ") + m;
+    diagnose->add_option("--model", args->model, "the model: " + models)->required();
+    diagnose->add_option("--data", args->data, "measured data, CSV (columns below)")->required();
+    diagnose->add_option("--json", args->json_out, "write the result as JSON to this file");
+    diagnose->add_option("--report", args->report_out,
+                         "write a Markdown report here, with residual plots (PNG) beside it");
+    diagnose->add_flag("--no-plots", args->no_plots, "report without the gnuplot residual plots");
+    diagnose->add_option("--alpha", args->options.family_alpha,
+                         "family-wise error rate of each round's candidate tests (Holm)")
+        ->capture_default_str()
+        ->check(CLI::Range(1e-6, 0.5));
+    diagnose->add_option("--min-cv-gain", args->options.min_cv_improvement,
+                         "least relative drop of the cross-validated RMSE for an effect to be added")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 0.9));
+    diagnose->add_option("--max-effects", args->options.max_effects, "most effects to add")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 10));
+    diagnose->footer(diagnose_help);
+    diagnose->callback([args] { run_diagnose(*args); });
 }
 
 }  // namespace demcal
