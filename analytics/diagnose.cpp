@@ -221,6 +221,12 @@ double sd_of(const std::vector<double>& v) {
     return std::sqrt(s / (v.size() > 1 ? v.size() - 1 : 1));
 }
 
+std::string short_number(double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
 bool drift_like(const std::string& name) {
     return name.find("order") != std::string::npos || name.find("time") != std::string::npos ||
            name.find("date") != std::string::npos;
@@ -322,7 +328,7 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
             const double x0 = mean_of(x), sd = sd_of(x);
             const bool positive = std::all_of(x.begin(), x.end(), [](double v) { return v > 0; });
             if (s.used.count(col.name) && positive && m.relative) {
-                Term t{col.name, y + " *= (x/x0)^beta, x0 = " + std::to_string(x0), "nonlinearity", {"beta"}, {1.0},
+                Term t{col.name, y + " *= (x/x0)^beta, x0 = " + short_number(x0), "nonlinearity", {"beta"}, {1.0},
                        {{0.0}}, nullptr, nullptr};
                 t.apply = [&x, x0](double w, std::size_t r, const double* tp, const double*) {
                     return w * std::pow(x[r] / x0, tp[0]);
@@ -331,8 +337,8 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
             } else if (!s.used.count(col.name)) {
                 // Fitted per standard deviation of x, reported per unit of x.
                 Term t{col.name,
-                       m.relative ? "W *= exp(beta*(x - x0)), x0 = " + std::to_string(x0)
-                                  : "tau += beta*(x - x0), x0 = " + std::to_string(x0),
+                       m.relative ? "W *= exp(beta*(x - x0)), x0 = " + short_number(x0)
+                                  : "tau += beta*(x - x0), x0 = " + short_number(x0),
                        drift_like(col.name) ? "drift" : "missing variable",
                        {"beta"},
                        {m.relative ? 1.0 / sd : s.scale / sd},
@@ -420,7 +426,7 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
     if (!m.relative && !done.count("sigma_Pa")) {
         const auto& sigma = d.at("sigma_Pa").values;
         const double s0 = mean_of(sigma);
-        Term t{"sigma_Pa", "tau = mu_b*s0*(sigma/s0)^n + tau_c, s0 = " + std::to_string(s0) + " (curved yield locus)",
+        Term t{"sigma_Pa", "tau = mu_b*s0*(sigma/s0)^n + tau_c, s0 = " + short_number(s0) + " (curved yield locus)",
                "physical", {"n"}, {1.0}, {{1.0}, {0.8}, {1.2}}, nullptr, nullptr};
         t.apply = [&sigma, s0](double w, std::size_t r, const double* tp, const double* bp) {
             if (!(tp[0] > 0)) return nan;
@@ -555,7 +561,14 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
     }
 
     LeastSquaresFit fit = fit_extended(s, m, m.start);
-    if (!fit.converged) result.warnings.push_back("the fit of " + model_name + " did not converge");
+    if (!fit.converged) {
+        // GSL also stops at its iteration limit when started at the optimum; only a restart that still improves the
+        // sum of squares means the fit had not converged.
+        const auto again = fit_rows(s, m, all_rows(s), fit.params);
+        if (again.sse < fit.sse * (1 - 1e-8))
+            result.warnings.push_back("the fit of " + model_name + " did not converge");
+        if (again.sse < fit.sse) fit = again;
+    }
     for (double se : fit.std_errors)
         if (!std::isfinite(se)) {
             result.warnings.push_back("some parameters of " + model_name +

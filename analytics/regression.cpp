@@ -68,9 +68,10 @@ LeastSquaresFit fit_least_squares(std::size_t n, const ResidualFunction& residua
         return fit;
     }
     int info = 0;
-    const int status = gsl_multifit_nlinear_driver(max_iterations, 1e-10, 1e-10, 0.0, nullptr, nullptr, &info,
+    const int status = gsl_multifit_nlinear_driver(max_iterations, 1e-10, 1e-10, 1e-14, nullptr, nullptr, &info,
                                                    work.get());
-    fit.converged = status == GSL_SUCCESS;
+    // No progress means no step lowers the sum of squares any more: a minimum (e.g. started at the optimum).
+    fit.converged = status == GSL_SUCCESS || status == GSL_ENOPROG;
     const gsl_vector* xs = gsl_multifit_nlinear_position(work.get());
     const gsl_vector* f = gsl_multifit_nlinear_residual(work.get());
     for (std::size_t i = 0; i < p; ++i) fit.params[i] = gsl_vector_get(xs, i);

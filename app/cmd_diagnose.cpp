@@ -136,10 +136,10 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
         std::ostringstream g;
         g << "set multiplot layout 1,2 title '" << r.model << " residuals " << title
           << (which == 1 ? " (" + std::to_string(r.effects.size()) + " effect(s) added)" : std::string()) << "'\n"
-          << "set grid\nset ylabel '" << unit << "'\nunset key\n"
-          << "set xlabel 'fitted " << r.response << "'\n"
+          << "set grid\nset ylabel '" << unit << "'\nunset key\nset title noenhanced\n"
+          << "set xlabel 'fitted " << r.response << "' noenhanced\n"
           << "plot " << gnuplot_quote(dat) << " using " << fitted << ":" << col << " with points pt 7 ps 0.8, 0 lt -1\n"
-          << "set xlabel '" << x_name << "'\n"
+          << "set xlabel '" << x_name << "' noenhanced\n"
           << "plot " << gnuplot_quote(dat) << " using 7:" << col << " with points pt 7 ps 0.8, 0 lt -1\n"
           << "unset multiplot\n";
         render_gnuplot(which == 0 ? before : after, g.str(), 1100, 450);
@@ -234,6 +234,7 @@ void run_diagnose(const DiagnoseArgs& a) {
     if (!a.json_out.empty()) write_text(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
         const std::filesystem::path report(a.report_out);
+        if (report.has_parent_path()) std::filesystem::create_directories(report.parent_path());
         std::string before_name, after_name;
         if (!a.no_plots) {
             const std::string stem = report.stem().string();

@@ -134,7 +134,7 @@ TEST_CASE("rates of false positives and of effect recovery", "[.][rates]") {
     };
     for (const std::string model : {"oldal", "beverloo", "oldal-rect", "johanson", "failure-line"})
         study(model, "none", "", 0, 0.03, 2);
-    for (double size : {0.05, 0.1, 0.2}) {
+    for (double size : {0.05, 0.1, 0.2, 0.3}) {
         study("oldal", "moisture", "moisture_pct", size, 0.03, 2);
         study("beverloo", "hopper_angle", "theta_deg", size, 0.03, 2);
         study("oldal-rect", "drift", "run_order", size, 0.03, 2);
