@@ -1,0 +1,133 @@
+#include "analytics/scaling_law.hpp"
+
+#include "analytics/regression.hpp"
+
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_fit.h>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace demcal::analytics {
+
+namespace {
+
+// Checks sizes and values; returns the weights (1 / sigma^2, or 1).
+std::vector<double> checked_weights(const char* law, std::span<const double> r, std::span<const double> y,
+                                    std::span<const double> sigma, double confidence, bool positive) {
+    const std::string where = std::string(law) + " law: ";
+    if (y.size() != r.size() || (!sigma.empty() && sigma.size() != r.size()))
+        throw std::invalid_argument(where + std::to_string(r.size()) + " radii but " + std::to_string(y.size()) +
+                                    " values and " + std::to_string(sigma.size()) + " uncertainties");
+    if (!(confidence > 0 && confidence < 1))
+        throw std::invalid_argument(where + "confidence = " + std::to_string(confidence) + " is not in (0, 1)");
+    std::set<double> distinct;
+    std::vector<double> w(r.size(), 1.0);
+    for (std::size_t i = 0; i < r.size(); ++i) {
+        if (!std::isfinite(r[i]) || !std::isfinite(y[i]) || (positive && (r[i] <= 0 || y[i] <= 0)))
+            throw std::invalid_argument(where + "point " + std::to_string(i) + " (r = " + std::to_string(r[i]) +
+                                        ", y = " + std::to_string(y[i]) + ") must be finite" +
+                                        (positive ? " and > 0" : ""));
+        if (!sigma.empty()) {
+            if (!(sigma[i] > 0) || !std::isfinite(sigma[i]))
+                throw std::invalid_argument(where + "uncertainty of point " + std::to_string(i) + " = " +
+                                            std::to_string(sigma[i]) + " must be finite and > 0");
+            w[i] = 1 / (sigma[i] * sigma[i]);
+        }
+        distinct.insert(r[i]);
+    }
+    if (r.size() < 3 || distinct.size() < 2)
+        throw std::invalid_argument(where + "needs at least 3 points on 2 distinct radii, got " +
+                                    std::to_string(r.size()) + " on " + std::to_string(distinct.size()));
+    return w;
+}
+
+double weighted_r_squared(std::span<const double> y, const std::vector<double>& w, double sse) {
+    double sw = 0, swy = 0;
+    for (std::size_t i = 0; i < y.size(); ++i) sw += w[i], swy += w[i] * y[i];
+    const double mean = swy / sw;
+    double sst = 0;
+    for (std::size_t i = 0; i < y.size(); ++i) sst += w[i] * (y[i] - mean) * (y[i] - mean);
+    return sst > 0 ? 1 - sse / sst : 1.0;
+}
+
+LawParameter parameter(const char* name, double value, double variance, double t) {
+    const double se = std::sqrt(std::max(variance, 0.0));
+    return {name, value, se, value - t * se, value + t * se};
+}
+
+}  // namespace
+
+double ScalingLawFit::operator()(double r) const {
+    if (law == "linear") return params[0].value * r + params[1].value;
+    return params[0].value * std::pow(r, -params[1].value);
+}
+
+std::string ScalingLawFit::formula() const {
+    std::ostringstream o;
+    o.precision(4);
+    if (law == "linear")
+        o << "y(r) = " << params[0].value << " r " << (params[1].value < 0 ? "- " : "+ ") << std::fabs(params[1].value);
+    else
+        o << "y(r) = " << params[0].value << " r^-" << params[1].value;
+    return o.str();
+}
+
+nlohmann::json ScalingLawFit::to_json() const {
+    nlohmann::json j = {{"law", law},   {"formula", formula()},       {"n", n},
+                        {"dof", dof},   {"confidence", confidence},   {"r_squared", r_squared},
+                        {"residual_sd", residual_sd}, {"converged", converged}, {"params", nlohmann::json::object()}};
+    for (const auto& p : params)
+        j["params"][p.name] = {{"value", p.value}, {"std_error", p.std_error}, {"low", p.low}, {"high", p.high}};
+    return j;
+}
+
+ScalingLawFit fit_linear_law(std::span<const double> r, std::span<const double> y, std::span<const double> sigma,
+                             double confidence) {
+    const auto w = checked_weights("linear", r, y, sigma, confidence, false);
+    double c0, c1, cov00, cov01, cov11, chisq;
+    gsl_fit_wlinear(r.data(), 1, w.data(), 1, y.data(), 1, r.size(), &c0, &c1, &cov00, &cov01, &cov11, &chisq);
+    ScalingLawFit fit;
+    fit.law = "linear";
+    fit.n = static_cast<int>(r.size());
+    fit.dof = fit.n - 2;
+    fit.confidence = confidence;
+    // gsl_fit_wlinear's covariance trusts the weights' scale; treat them as relative (scale from the residuals).
+    const double s2 = chisq / fit.dof;
+    const double t = gsl_cdf_tdist_Pinv(0.5 + confidence / 2, fit.dof);
+    fit.params = {parameter("A", c1, cov11 * s2, t), parameter("B", c0, cov00 * s2, t)};
+    fit.residual_sd = std::sqrt(s2);
+    fit.r_squared = weighted_r_squared(y, w, chisq);
+    return fit;
+}
+
+ScalingLawFit fit_power_law(std::span<const double> r, std::span<const double> y, std::span<const double> sigma,
+                            double confidence) {
+    const auto w = checked_weights("power", r, y, sigma, confidence, true);
+    // Start from the straight line log y = log C - D log r.
+    std::vector<double> lr(r.size()), ly(r.size());
+    for (std::size_t i = 0; i < r.size(); ++i) lr[i] = std::log(r[i]), ly[i] = std::log(y[i]);
+    double c0, c1, cov00, cov01, cov11, sse_log;
+    gsl_fit_linear(lr.data(), 1, ly.data(), 1, r.size(), &c0, &c1, &cov00, &cov01, &cov11, &sse_log);
+    const ResidualFunction residuals = [&](const double* p, double* f) {
+        for (std::size_t i = 0; i < r.size(); ++i) f[i] = (p[0] * std::pow(r[i], -p[1]) - y[i]) * std::sqrt(w[i]);
+    };
+    const auto ls = fit_least_squares(r.size(), residuals, {std::exp(c0), -c1});
+    ScalingLawFit fit;
+    fit.law = "power";
+    fit.n = static_cast<int>(r.size());
+    fit.dof = fit.n - 2;
+    fit.confidence = confidence;
+    fit.converged = ls.converged;
+    const double t = gsl_cdf_tdist_Pinv(0.5 + confidence / 2, fit.dof);
+    // fit_least_squares already scales the covariance by SSE / dof (relative weights).
+    fit.params = {parameter("C", ls.params[0], ls.covariance[0], t), parameter("D", ls.params[1], ls.covariance[3], t)};
+    fit.residual_sd = std::sqrt(ls.sse / fit.dof);
+    fit.r_squared = weighted_r_squared(y, w, ls.sse);
+    return fit;
+}
+
+}  // namespace demcal::analytics
