@@ -60,13 +60,13 @@ DOCUMENTATION_KEYS = ("name", "description")
 
 # --- numerical choices of the procedure (not inputs: they define the test, see README.md) ---
 CLOUD_SOLID_FRACTION = 0.25      # makeCloud's loose cloud (it cannot place spheres much above 0.3)
-GROWN_SOLID_FRACTION = 0.47      # after growing to full size, below random loose packing: growth itself never jams
-EXPECTED_SOLID_FRACTION = 0.55   # of the consolidated sample; sets the particle count so the lid ends near box_height
+GROWN_SOLID_FRACTION = 0.50      # after growing to full size, below random loose packing: growth itself never jams
+EXPECTED_SOLID_FRACTION = 0.555  # of the consolidated sample; sets the particle count so the lid ends near box_height
 GROWTH_SURFACE_SPEED = 0.05      # m/s, speed of a particle surface while radii grow in the (unjammed) cloud
 CONSOLIDATION_INERTIAL_NUMBER = 0.01  # lid speed limit while consolidating: I = (v / H) d sqrt(rho / sigma)
 SERVO_PERIOD = 10                # steps between lid velocity updates
 SERVO_GAIN = 1.0                 # fraction of the force error corrected per update, relative to the lid contact stiffness
-APPROACH_BELOW = 0.25            # while consolidating, a force error above this fraction of the target: fast approach
+APPROACH_BELOW = 0.10            # while consolidating, a force error above this fraction of the target: fast approach
 CONSOLIDATION_CHUNK = 200        # steps between quasi-static checks
 CONSOLIDATION_UNBALANCED = 0.02  # utils.unbalancedForce() below which the sample counts as quasi-static
 CONSOLIDATION_STRESS_TOL = 0.02  # relative lid stress error accepted at the end of consolidation
