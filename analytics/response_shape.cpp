@@ -110,17 +110,20 @@ PolynomialFit fit_polynomial(const std::vector<double>& u, std::span<const doubl
     return fit;
 }
 
-NestedFTest nested_f_test(const PolynomialFit& smaller, const PolynomialFit& larger) {
+// `negligible`: a sum of squares at the level of rounding errors (identical responses give 1e-30, not 0).
+NestedFTest nested_f_test(const PolynomialFit& smaller, const PolynomialFit& larger, double negligible) {
     NestedFTest t;
     t.df_num = larger.degree - smaller.degree;
     t.df_den = larger.dof;
     if (t.df_den <= 0) return t;
-    const double extra = std::max(0.0, smaller.chi_squared - larger.chi_squared) / t.df_num;
+    const double extra_ss = smaller.chi_squared - larger.chi_squared;
+    if (extra_ss <= negligible) return t;  // the extra term explains nothing
+    const double extra = extra_ss / t.df_num;
     const double residual = larger.chi_squared / t.df_den;
-    if (residual > 0) {
+    if (larger.chi_squared > negligible) {
         t.f_statistic = extra / residual;
         t.p_value = gsl_cdf_fdist_Q(t.f_statistic, t.df_num, t.df_den);
-    } else if (extra > 0) {  // the larger model is exact and the smaller is not
+    } else {  // the larger model is exact and the smaller is not
         t.f_statistic = inf;
         t.p_value = 0;
     }
@@ -183,8 +186,11 @@ ResponseShapeResult classify_response(std::span<const double> x, std::span<const
     r.n = static_cast<int>(n);
     const int max_degree = n >= 4 ? 2 : 1;  // a parabola through 3 points leaves nothing to test it with
     for (int d = 0; d <= max_degree; ++d) r.fits.push_back(fit_polynomial(u, y, w, d, scale));
-    r.linear_vs_constant = nested_f_test(r.fits[0], r.fits[1]);
-    if (max_degree == 2) r.parabolic_vs_linear = nested_f_test(r.fits[1], r.fits[2]);
+    double weighted_total = 0;
+    for (std::size_t i = 0; i < n; ++i) weighted_total += w[i] * y[i] * y[i];
+    const double negligible = 1e-13 * weighted_total;
+    r.linear_vs_constant = nested_f_test(r.fits[0], r.fits[1], negligible);
+    if (max_degree == 2) r.parabolic_vs_linear = nested_f_test(r.fits[1], r.fits[2], negligible);
 
     if (options.criterion == ShapeCriterion::f_test) {
         if (r.parabolic_vs_linear && r.parabolic_vs_linear->p_value < options.alpha)

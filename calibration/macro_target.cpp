@@ -1,0 +1,111 @@
+#include "calibration/macro_target.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace demcal::calibration {
+
+LineKind line_kind_from_string(const std::string& text) {
+    if (text == "peak") return LineKind::peak;
+    if (text == "residual") return LineKind::residual;
+    throw std::invalid_argument("line = '" + text + "' is not one of peak, residual");
+}
+
+std::string to_string(LineKind kind) { return kind == LineKind::peak ? "peak" : "residual"; }
+
+const analytics::FailureLine& line_of(const FailureLineEvaluation& ev, LineKind kind) {
+    const auto& line = kind == LineKind::peak ? ev.peak : ev.residual;
+    if (!line) {
+        std::ostringstream o;
+        o << "no " << to_string(kind) << " failure line for campaign '" << ev.outcome.campaign.name << "': "
+          << ev.simulations_failed << " of " << ev.outcome.runs.size() << " runs failed";
+        for (const auto& r : ev.outcome.runs)
+            if (r.state == orchestrator::RunState::failed) {
+                o << " (first: " << r.cause << ": " << r.message << ", " << r.run_dir.string() << "/stderr.log)";
+                break;
+            }
+        if (ev.outcome.interrupted) o << "; the campaign was interrupted";
+        throw std::runtime_error(o.str());
+    }
+    return *line;
+}
+
+const std::vector<std::string>& macro_quantities() {
+    static const std::vector<std::string> q{"mu_b", "tau_c"};
+    return q;
+}
+
+namespace {
+void check_quantity(const std::string& quantity) {
+    if (quantity != "mu_b" && quantity != "tau_c")
+        throw std::invalid_argument("target quantity '" + quantity + "' is not one of mu_b, tau_c");
+}
+}  // namespace
+
+double macro_value(const analytics::FailureLine& line, const std::string& quantity) {
+    check_quantity(quantity);
+    return quantity == "mu_b" ? line.mu_b : line.tau_c;
+}
+
+double macro_std_error(const analytics::FailureLine& line, const std::string& quantity) {
+    check_quantity(quantity);
+    return quantity == "mu_b" ? line.se_mu_b : line.se_tau_c;
+}
+
+double macro_half_width(const analytics::FailureLine& line, const std::string& quantity) {
+    check_quantity(quantity);
+    return quantity == "mu_b" ? 0.5 * (line.mu_b_high - line.mu_b_low) : 0.5 * (line.tau_c_high - line.tau_c_low);
+}
+
+double MacroTarget::acceptance(double tolerance) const {
+    return std::max(tolerance * std::fabs(value), half_width.value_or(0.0));
+}
+
+std::vector<MacroTarget> parse_targets(const std::string& text) {
+    std::vector<MacroTarget> targets;
+    std::stringstream items(text);
+    std::string item;
+    while (std::getline(items, item, ',')) {
+        const auto eq = item.find('=');
+        if (eq == std::string::npos)
+            throw std::invalid_argument("target item '" + item + "' is not of the form mu_b=VALUE or tau_c=VALUE");
+        MacroTarget t;
+        t.quantity = item.substr(0, eq);
+        check_quantity(t.quantity);
+        const std::string value = item.substr(eq + 1);
+        std::size_t used = 0;
+        try {
+            t.value = std::stod(value, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != value.size() || value.empty() || !std::isfinite(t.value))
+            throw std::invalid_argument("target " + t.quantity + " = '" + value + "' is not a number");
+        if (t.quantity == "mu_b" && !(t.value > 0))
+            throw std::invalid_argument("target mu_b = " + value + " must be > 0 (a friction coefficient)");
+        for (const auto& other : targets)
+            if (other.quantity == t.quantity) throw std::invalid_argument("target " + t.quantity + " is given twice");
+        targets.push_back(t);
+    }
+    if (targets.empty()) throw std::invalid_argument("target = '" + text + "' names no quantity (mu_b=..,tau_c=..)");
+    return targets;
+}
+
+std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigma, std::span<const double> tau,
+                                                    double confidence) {
+    const auto line = analytics::fit_failure_line(sigma, tau, confidence);
+    std::vector<MacroTarget> targets;
+    for (const auto& q : macro_quantities()) targets.push_back({q, macro_value(line, q), macro_half_width(line, q)});
+    return targets;
+}
+
+double round_significant(double value, int digits) {
+    if (value == 0 || !std::isfinite(value)) return value;
+    std::ostringstream o;
+    o.precision(digits);
+    o << value;
+    return std::stod(o.str());
+}
+
+}  // namespace demcal::calibration

@@ -1,0 +1,249 @@
+#include "calibration/sensitivity_study.hpp"
+
+#include "orchestrator/shear_params.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace demcal::calibration {
+
+const analytics::ResponseShapeResult& ParameterSensitivity::response(const std::string& quantity) const {
+    if (quantity == "mu_b") return mu_b;
+    if (quantity == "tau_c") return tau_c;
+    throw std::invalid_argument("quantity '" + quantity + "' is not one of mu_b, tau_c");
+}
+
+const ParameterSensitivity* SensitivityStudy::find(const std::string& name) const {
+    for (const auto& p : parameters)
+        if (p.name == name) return &p;
+    return nullptr;
+}
+
+namespace {
+
+std::string number_text(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+}
+
+// Inside the parameter's admissible range, with open ends kept strictly inside.
+bool admissible(const orchestrator::ParamSpec& s, double v) {
+    const bool above_min = s.min_exclusive ? v > s.min : v >= s.min;
+    const bool below_max = s.max_exclusive ? v < s.max : v <= s.max;
+    return std::isfinite(v) && above_min && below_max;
+}
+
+}  // namespace
+
+std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::string& name,
+                                       const SensitivityOptions& options) {
+    const auto& micro = orchestrator::micromechanical_param_names();
+    if (std::find(micro.begin(), micro.end(), name) == micro.end()) {
+        std::string list;
+        for (const auto& m : micro) list += (list.empty() ? "" : ", ") + m;
+        throw std::invalid_argument("params: '" + name + "' is not a micromechanical parameter (" + list + ")");
+    }
+    if (options.levels < 3)
+        throw std::invalid_argument("levels = " + std::to_string(options.levels) + " must be >= 3 to tell a shape");
+    if (!(options.relative_span > 0 && options.relative_span < 1))
+        throw std::invalid_argument("span = " + number_text(options.relative_span) + " must be in (0, 1)");
+    const auto& spec = *orchestrator::find_shear_param(name);
+    const double b = base.at(name).get<double>();
+    double lo, hi;
+    if (auto it = options.ranges.find(name); it != options.ranges.end()) {
+        std::tie(lo, hi) = it->second;
+        if (!(lo < hi))
+            throw std::invalid_argument("range of " + name + " = " + number_text(lo) + ":" + number_text(hi) +
+                                        " must have low < high");
+    } else {
+        if (b == 0)
+            throw std::invalid_argument("range of " + name + ": the base value is 0, so a relative span gives no range; "
+                                        "give one with --range " + name + "=LOW:HIGH");
+        const double half = std::fabs(b) * options.relative_span;
+        lo = b - half;
+        hi = b + half;
+        // Slide the window into the admissible range (e.g. particle_form >= 1: a sphere base goes 1 .. 1 + 2 span).
+        const double margin = 1e-3 * (hi - lo);
+        if (!admissible(spec, lo)) {
+            const double shift = spec.min + (spec.min_exclusive ? margin : 0) - lo;
+            lo += shift, hi += shift;
+        }
+        if (!admissible(spec, hi)) hi = spec.max - (spec.max_exclusive ? margin : 0);
+    }
+    if (!admissible(spec, lo) || !admissible(spec, hi))
+        throw std::invalid_argument("range of " + name + " = " + number_text(lo) + ":" + number_text(hi) +
+                                    " leaves its admissible range " + (spec.min_exclusive ? "(" : "[") +
+                                    number_text(spec.min) + ", " + number_text(spec.max) +
+                                    (spec.max_exclusive ? ")" : "]") + " " + spec.unit);
+    std::vector<double> values;
+    for (int i = 0; i < options.levels; ++i)
+        values.push_back(round_significant(lo + (hi - lo) * i / (options.levels - 1)));
+    // The base value itself, when inside, replaces the nearest level: its runs are shared by every parameter.
+    if (b > lo && b < hi) {
+        auto nearest = std::min_element(values.begin(), values.end(),
+                                        [b](double x, double y) { return std::fabs(x - b) < std::fabs(y - b); });
+        if (std::fabs(*nearest - b) < 0.25 * (hi - lo) / (options.levels - 1)) *nearest = b;
+    }
+    return values;
+}
+
+void fit_responses(ParameterSensitivity& p, const analytics::ResponseShapeOptions& shape) {
+    std::vector<double> x, mu, se_mu, tau, se_tau;
+    for (const auto& l : p.levels) {
+        x.push_back(l.value);
+        mu.push_back(l.mu_b);
+        tau.push_back(l.tau_c);
+        // A failure line through collinear points has a zero standard error; keep its weight finite.
+        se_mu.push_back(std::max(l.se_mu_b, 1e-9 * std::max(1.0, std::fabs(l.mu_b))));
+        se_tau.push_back(std::max(l.se_tau_c, 1e-9 * std::max(1.0, std::fabs(l.tau_c))));
+    }
+    p.mu_b = analytics::classify_response(x, mu, se_mu, p.base_value, shape);
+    p.tau_c = analytics::classify_response(x, tau, se_tau, p.base_value, shape);
+}
+
+SensitivityStudy run_sensitivity_study(const nlohmann::json& base, const FailureLineEvaluator& evaluate,
+                                       const SensitivityOptions& options, const SensitivityProgress& progress) {
+    SensitivityStudy study;
+    study.base_material = base;
+    study.options = options;
+    if (study.options.params.empty()) study.options.params = orchestrator::micromechanical_param_names();
+    // All levels are checked before the first simulation, so a bad range fails at once.
+    std::vector<std::vector<double>> all_levels;
+    for (const auto& name : study.options.params) all_levels.push_back(sensitivity_levels(base, name, study.options));
+    for (std::size_t k = 0; k < study.options.params.size(); ++k) {
+        ParameterSensitivity p;
+        p.name = study.options.params[k];
+        p.base_value = base.at(p.name).get<double>();
+        for (double v : all_levels[k]) {
+            nlohmann::json material = base;
+            material[p.name] = v;
+            const auto ev = evaluate(material);
+            const auto& line = line_of(ev, options.line);
+            SensitivityLevel l{v,
+                               line.mu_b,
+                               line.se_mu_b,
+                               macro_half_width(line, "mu_b"),
+                               line.tau_c,
+                               line.se_tau_c,
+                               macro_half_width(line, "tau_c"),
+                               ev.simulations_run,
+                               ev.simulations_reused,
+                               ev.cpu_s};
+            study.evaluations++;
+            study.simulations_run += ev.simulations_run;
+            study.simulations_reused += ev.simulations_reused;
+            study.cpu_s += ev.cpu_s;
+            p.levels.push_back(l);
+            if (progress) progress(p.name, l);
+        }
+        fit_responses(p, options.shape);
+        study.parameters.push_back(std::move(p));
+    }
+    return study;
+}
+
+nlohmann::json SensitivityStudy::to_json() const {
+    nlohmann::json j = {{"schema", "demcal.sensitivity/1"},
+                        {"base_material", base_material},
+                        {"levels", options.levels},
+                        {"relative_span", options.relative_span},
+                        {"line", to_string(options.line)},
+                        {"criterion", analytics::to_string(options.shape.criterion)},
+                        {"alpha", options.shape.alpha},
+                        {"evaluations", evaluations},
+                        {"simulations_run", simulations_run},
+                        {"simulations_reused", simulations_reused},
+                        {"cpu_s", cpu_s},
+                        {"parameters", nlohmann::json::array()}};
+    for (const auto& p : parameters) {
+        nlohmann::json pj = {{"name", p.name}, {"base_value", p.base_value}, {"levels", nlohmann::json::array()}};
+        for (const auto& l : p.levels)
+            pj["levels"].push_back({{"value", l.value},
+                                    {"mu_b", l.mu_b},
+                                    {"se_mu_b", l.se_mu_b},
+                                    {"mu_b_half_width", l.mu_b_half_width},
+                                    {"tau_c", l.tau_c},
+                                    {"se_tau_c", l.se_tau_c},
+                                    {"tau_c_half_width", l.tau_c_half_width},
+                                    {"simulations_run", l.simulations_run},
+                                    {"simulations_reused", l.simulations_reused},
+                                    {"cpu_s", l.cpu_s}});
+        pj["mu_b"] = p.mu_b.to_json();
+        pj["tau_c"] = p.tau_c.to_json();
+        j["parameters"].push_back(pj);
+    }
+    return j;
+}
+
+SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
+    if (j.value("schema", "") != "demcal.sensitivity/1")
+        throw std::invalid_argument("sensitivity file: schema = " + j.value("schema", std::string("<missing>")) +
+                                    " is not demcal.sensitivity/1");
+    SensitivityStudy s;
+    s.base_material = j.at("base_material");
+    s.options.levels = j.at("levels").get<int>();
+    s.options.relative_span = j.at("relative_span").get<double>();
+    s.options.line = line_kind_from_string(j.at("line").get<std::string>());
+    s.options.shape.criterion = analytics::shape_criterion_from_string(j.at("criterion").get<std::string>());
+    s.options.shape.alpha = j.at("alpha").get<double>();
+    s.evaluations = j.value("evaluations", 0);
+    s.simulations_run = j.value("simulations_run", 0);
+    s.simulations_reused = j.value("simulations_reused", 0);
+    s.cpu_s = j.value("cpu_s", 0.0);
+    for (const auto& pj : j.at("parameters")) {
+        ParameterSensitivity p;
+        p.name = pj.at("name").get<std::string>();
+        p.base_value = pj.at("base_value").get<double>();
+        s.options.params.push_back(p.name);
+        for (const auto& lj : pj.at("levels"))
+            p.levels.push_back({lj.at("value").get<double>(), lj.at("mu_b").get<double>(),
+                                lj.at("se_mu_b").get<double>(), lj.value("mu_b_half_width", 0.0),
+                                lj.at("tau_c").get<double>(), lj.at("se_tau_c").get<double>(),
+                                lj.value("tau_c_half_width", 0.0), lj.value("simulations_run", 0),
+                                lj.value("simulations_reused", 0), lj.value("cpu_s", 0.0)});
+        fit_responses(p, s.options.shape);
+        s.parameters.push_back(std::move(p));
+    }
+    return s;
+}
+
+namespace {
+// "linear (+1.2e-3 /unit, p = 0.001)" style cell of the table.
+std::string shape_cell(const analytics::ResponseShapeResult& r) {
+    std::ostringstream o;
+    o << std::setprecision(3);
+    o << analytics::to_string(r.shape);
+    const auto& f = r.selected();
+    if (f.degree >= 1)
+        o << " slope " << f.coefficients[1].value << " (p=" << std::setprecision(2) << f.coefficients[1].p_value << ")"
+          << std::setprecision(3);
+    if (f.degree >= 2)
+        o << " curv " << f.coefficients[2].value << " (p=" << std::setprecision(2) << f.coefficients[2].p_value << ")";
+    if (f.degree == 0) {
+        const auto& t = r.linear_vs_constant;
+        o << " (slope p=" << std::setprecision(2) << t.p_value << ")";
+    }
+    return o.str();
+}
+}  // namespace
+
+std::string SensitivityStudy::table() const {
+    std::ostringstream o;
+    o << "Sensitivity of the " << to_string(options.line) << " failure line (" << analytics::to_string(options.shape.criterion)
+      << ", alpha " << options.shape.alpha << "; slopes per unit of the parameter at its base value)\n";
+    o << std::left << std::setw(22) << "parameter" << std::setw(26) << "range" << std::setw(52) << "change of cohesion tau_c [Pa]"
+      << "change of internal friction mu_b [-]\n";
+    for (const auto& p : parameters) {
+        std::ostringstream range;
+        range << std::setprecision(4) << p.low() << " .. " << p.high();
+        o << std::left << std::setw(22) << p.name << std::setw(26) << range.str() << std::setw(52) << shape_cell(p.tau_c)
+          << shape_cell(p.mu_b) << "\n";
+    }
+    return o.str();
+}
+
+}  // namespace demcal::calibration

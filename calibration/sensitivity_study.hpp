@@ -1,0 +1,73 @@
+// Failure-line sensitivity study (seed section 3.1.1, Table 3.1): each micromechanical parameter is varied over a
+// range around the base material with the others fixed; the failure line at each level gives mu_b and tau_c, whose
+// responses are classified constant / linear / parabolic (analytics/response_shape) with the fitted coefficients and
+// their significance. The base material is one level of every parameter, so it is evaluated (and stored) once.
+#pragma once
+#include "analytics/response_shape.hpp"
+#include "calibration/macro_target.hpp"
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace demcal::calibration {
+
+struct SensitivityOptions {
+    std::vector<std::string> params;  // parameters to vary; empty = all micromechanical ones (orchestrator's list)
+    int levels = 5;                   // values per parameter, base included when odd (>= 3)
+    double relative_span = 0.5;       // default range base * (1 -+ span), moved inside the admissible range
+    std::map<std::string, std::pair<double, double>> ranges;  // explicit [low, high] per parameter
+    analytics::ResponseShapeOptions shape;
+    LineKind line = LineKind::peak;
+};
+
+struct SensitivityLevel {
+    double value = 0;         // of the varied parameter
+    double mu_b = 0, se_mu_b = 0, mu_b_half_width = 0;
+    double tau_c = 0, se_tau_c = 0, tau_c_half_width = 0;
+    int simulations_run = 0, simulations_reused = 0;
+    double cpu_s = 0;
+};
+
+struct ParameterSensitivity {
+    std::string name;
+    double base_value = 0;
+    std::vector<SensitivityLevel> levels;  // ascending values
+    analytics::ResponseShapeResult mu_b, tau_c;
+    const analytics::ResponseShapeResult& response(const std::string& quantity) const;
+    double low() const { return levels.front().value; }
+    double high() const { return levels.back().value; }
+};
+
+struct SensitivityStudy {
+    nlohmann::json base_material;
+    SensitivityOptions options;
+    std::vector<ParameterSensitivity> parameters;
+    int evaluations = 0;  // failure lines computed or reused
+    int simulations_run = 0, simulations_reused = 0;
+    double cpu_s = 0;
+    const ParameterSensitivity* find(const std::string& name) const;
+    nlohmann::json to_json() const;
+    // Reads a stored study (the level data) and refits its shapes with `shape` (the stored options when absent).
+    static SensitivityStudy from_json(const nlohmann::json& j);
+    // The seed's Table 3.1 for this material, as text: shape of each response with slope, curvature and p-values.
+    std::string table() const;
+};
+
+// The values a parameter takes in the study. Throws std::invalid_argument naming the parameter and the value when it
+// is not a micromechanical parameter, when its base is 0 with no explicit range, or when a range leaves its
+// admissible interval.
+std::vector<double> sensitivity_levels(const nlohmann::json& base_material, const std::string& name,
+                                       const SensitivityOptions& options);
+
+// Fits the two responses of one parameter from its levels.
+void fit_responses(ParameterSensitivity& p, const analytics::ResponseShapeOptions& shape);
+
+using SensitivityProgress = std::function<void(const std::string& param, const SensitivityLevel& level)>;
+
+// Runs the study: every level of every parameter through `evaluate`. The base material must be valid.
+SensitivityStudy run_sensitivity_study(const nlohmann::json& base_material, const FailureLineEvaluator& evaluate,
+                                       const SensitivityOptions& options, const SensitivityProgress& progress = {});
+
+}  // namespace demcal::calibration
