@@ -122,7 +122,7 @@ def read_params(path):
         below = value < lo if lo_incl else value <= lo
         above = value > hi if hi_incl else value >= hi
         if below or above:
-            fail(2, "params", "%s=%s outside %s%s, %s%s %s (%s)" % (key, json.dumps(raw[key]), "[" if lo_incl else "(",
+            fail(2, "params", "%s=%s outside %s%g, %g%s %s (%s)" % (key, json.dumps(raw[key]), "[" if lo_incl else "(",
                                                                     lo, hi, "]" if hi_incl else ")", unit, meaning))
         params[key] = value
     for key in PARAM_SPECS:
