@@ -1,5 +1,437 @@
+// demcal sensitivity / calibrate / enlarge: the failure-line sensitivity study (seed Table 3.1), the calibration loop
+// and the particle-enlargement laws (seed eqs. 3.1-3.2). Every simulation is a stored, cached, resumable campaign run.
+#include "analytics/scaling_law.hpp"
 #include "app/commands.hpp"
+#include "app/gnuplot.hpp"
+#include "calibration/calibration_loop.hpp"
+#include "calibration/campaign_evaluator.hpp"
+#include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_params.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
 
 namespace demcal {
-void add_calibration_commands(CLI::App&) {}  // placeholder until the subcommand lands
+
+namespace fs = std::filesystem;
+using namespace calibration;
+
+namespace {
+
+// Options shared by the commands that run campaigns.
+struct CampaignCli {
+    std::vector<double> normal_stresses{2e3, 4e3, 6e3};
+    int replicates = 1;
+    long seed = 1;
+    std::string campaign_dir = "campaigns/calibration";
+    std::string template_path;
+    std::string line = "peak";
+    std::string plot_format = "png";
+    orchestrator::ExecutionOptions exec;
+};
+
+void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
+    cmd->add_option("--normal-stress,-s", c.normal_stresses, "normal stresses of every failure line [Pa]")
+        ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(CLI::PositiveNumber);
+    cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)");
+    cmd->add_option("--campaign,-c", c.campaign_dir, "campaign directory (store, runs, results)")->capture_default_str();
+    cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
+    cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
+    cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    cmd->add_option("--jobs,-j", c.exec.jobs, "runs in parallel (0 = one per core)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--timeout", c.exec.timeout_s, "per-run wall-clock limit [s]")->check(CLI::PositiveNumber);
+    cmd->add_option("--executor", c.exec.executor, "local or slurm")->check(CLI::IsMember({"local", "slurm"}));
+    cmd->add_option("--yade", c.exec.yade, "YADE launcher to run");
+}
+
+nlohmann::json read_json(const std::string& path, const std::string& field) {
+    std::ifstream f(path);
+    if (!f) throw UserError(field + " = '" + path + "' cannot be read");
+    try {
+        return nlohmann::json::parse(f);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw UserError(field + " = '" + path + "' is not valid JSON: " + e.what());
+    }
+}
+
+// "name=low:high" items (repeatable option) -> map; throws naming the item.
+std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<std::string>& items,
+                                                              const std::string& option) {
+    std::map<std::string, std::pair<double, double>> out;
+    for (const auto& item : items) {
+        const auto eq = item.find('='), colon = item.find(':');
+        double lo = NAN, hi = NAN;
+        bool ok = eq != std::string::npos && colon != std::string::npos && colon > eq;
+        if (ok) {
+            try {
+                std::size_t a = 0, b = 0;
+                const std::string l = item.substr(eq + 1, colon - eq - 1), h = item.substr(colon + 1);
+                lo = std::stod(l, &a);
+                hi = std::stod(h, &b);
+                ok = a == l.size() && b == h.size();
+            } catch (const std::exception&) {
+                ok = false;
+            }
+        }
+        if (!ok) throw UserError(option + " '" + item + "' is not of the form NAME=LOW:HIGH");
+        const std::string name = item.substr(0, eq);
+        if (!orchestrator::find_shear_param(name)) throw UserError(option + " '" + item + "': unknown parameter '" + name + "'");
+        out[name] = {lo, hi};
+    }
+    return out;
+}
+
+void check_stresses(const CampaignCli& c) {
+    if (c.normal_stresses.size() < 2)
+        throw UserError("normal-stress: a failure line needs at least 2 normal stresses, got " +
+                        std::to_string(c.normal_stresses.size()));
+    for (double s : c.normal_stresses)
+        if (!(s > 0)) throw UserError("normal-stress = " + std::to_string(s) + " must be > 0 Pa");
+}
+
+std::string duration(double s) {
+    std::ostringstream o;
+    if (s >= 3600)
+        o << std::fixed << std::setprecision(1) << s / 3600 << " h";
+    else if (s >= 60)
+        o << std::fixed << std::setprecision(1) << s / 60 << " min";
+    else
+        o << std::fixed << std::setprecision(0) << s << " s";
+    return o.str();
+}
+
+// Runs in a campaign directory with one runner for all the evaluations of a command.
+struct CampaignSession {
+    std::unique_ptr<orchestrator::ShearCampaignRunner> runner;
+    FailureLineEvaluator evaluate;
+    CampaignSession(const CampaignCli& c, const std::string& label) {
+        check_stresses(c);
+        orchestrator::find_yade(c.exec.yade);
+        runner = std::make_unique<orchestrator::ShearCampaignRunner>(c.campaign_dir, c.exec);
+        CampaignSettings settings{c.normal_stresses, c.replicates, c.seed, c.template_path, label};
+        auto progress = [](const orchestrator::CampaignProgress& p) {
+            if (p.event != "failed" && p.event != "retry") return;  // the study prints one line per failure line
+            std::cout << "    run " << p.event << " (sigma = " << (p.run ? p.run->label.value("normal_stress", 0.0) : 0)
+                      << " Pa): " << (p.run ? p.run->cause + ": " + p.run->message : "") << std::endl;
+        };
+        evaluate = campaign_evaluator(*runner, settings, progress);
+    }
+};
+
+// ---- sensitivity ----
+
+struct SensitivityCli {
+    std::string base_file;
+    std::vector<std::string> params;
+    int levels = 5;
+    double span = 0.5;
+    std::vector<std::string> ranges;
+    std::string criterion = "f-test";
+    double alpha = 0.05;
+    CampaignCli campaign;
+};
+
+SensitivityOptions sensitivity_options(const SensitivityCli& o) {
+    SensitivityOptions s;
+    s.params = o.params;
+    s.levels = o.levels;
+    s.relative_span = o.span;
+    s.ranges = parse_ranges(o.ranges, "range");
+    s.shape.criterion = analytics::shape_criterion_from_string(o.criterion);
+    s.shape.alpha = o.alpha;
+    s.line = line_kind_from_string(o.campaign.line);
+    return s;
+}
+
+void print_level(const std::string& param, const SensitivityLevel& l) {
+    std::cout << "  " << std::left << std::setw(22) << param << std::right << " = " << std::setw(10) << l.value
+              << "  mu_b " << std::fixed << std::setprecision(4) << l.mu_b << " +/- " << l.se_mu_b << "  tau_c "
+              << std::setprecision(1) << l.tau_c << " +/- " << l.se_tau_c << " Pa  (" << l.simulations_run
+              << " run, " << l.simulations_reused << " reused)" << std::endl;
+    std::cout.unsetf(std::ios::fixed);
+}
+
+// One PNG per parameter: mu_b and tau_c against the parameter, with error bars and the selected fit.
+void plot_parameter(const fs::path& dir, const ParameterSensitivity& p, const std::string& format) {
+    const fs::path data = dir / ("sensitivity_" + p.name + ".dat"), fit = dir / ("sensitivity_" + p.name + "_fit.dat");
+    {
+        std::ofstream d(data), f(fit);
+        d << "# value mu_b se_mu_b tau_c se_tau_c\n";
+        for (const auto& l : p.levels) d << l.value << " " << l.mu_b << " " << l.se_mu_b << " " << l.tau_c << " " << l.se_tau_c << "\n";
+        f << "# value mu_b_fit tau_c_fit\n";
+        for (int i = 0; i <= 60; ++i) {
+            const double x = p.low() + (p.high() - p.low()) * i / 60;
+            f << x << " " << p.mu_b.value(x) << " " << p.tau_c.value(x) << "\n";
+        }
+    }
+    std::ostringstream g;
+    g << "set multiplot layout 1,2 title 'Sensitivity to " << p.name << " (error bars: 1 standard error)'\n"
+      << "set grid\nset xlabel '" << p.name << "'\nset key bottom right\n"
+      << "set ylabel 'mu_b [-]'\nset title 'internal friction: " << analytics::to_string(p.mu_b.shape) << "'\n"
+      << "plot " << gnuplot_quote(data) << " using 1:2:3 with yerrorbars pt 7 lc rgb '#08519c' title 'simulated', "
+      << gnuplot_quote(fit) << " using 1:2 with lines lw 2 lc rgb '#08519c' title 'fit'\n"
+      << "set ylabel 'tau_c [Pa]'\nset title 'cohesion: " << analytics::to_string(p.tau_c.shape) << "'\n"
+      << "plot " << gnuplot_quote(data) << " using 1:4:5 with yerrorbars pt 7 lc rgb '#a50f15' title 'simulated', "
+      << gnuplot_quote(fit) << " using 1:3 with lines lw 2 lc rgb '#a50f15' title 'fit'\n"
+      << "unset multiplot\n";
+    render_gnuplot(dir / ("sensitivity_" + p.name + "." + format), g.str(), 1200, 500);
+}
+
+void write_study(const fs::path& dir, const SensitivityStudy& study, const std::string& format) {
+    orchestrator::write_text_file_atomically(dir / "sensitivity.json", study.to_json().dump(2) + "\n");
+    orchestrator::write_text_file_atomically(dir / "sensitivity_table.txt", study.table());
+    for (const auto& p : study.parameters) {
+        try {
+            plot_parameter(dir, p, format);
+        } catch (const std::exception& e) {
+            std::cerr << "demcal: warning: plot for " << p.name << " not written: " << e.what() << "\n";
+        }
+    }
+}
+
+SensitivityStudy run_study(const nlohmann::json& base, const SensitivityCli& o, const FailureLineEvaluator& evaluate) {
+    const auto options = sensitivity_options(o);
+    // Check every level before the first run: a bad range must not cost simulations.
+    for (const auto& name : options.params.empty() ? orchestrator::micromechanical_param_names() : options.params)
+        sensitivity_levels(base, name, options);
+    std::cout << "sensitivity study: " << (options.params.empty() ? orchestrator::micromechanical_param_names().size()
+                                                                  : options.params.size())
+              << " parameters x " << options.levels << " levels, failure lines at " << o.campaign.normal_stresses.size()
+              << " normal stresses x " << o.campaign.replicates << " packings" << std::endl;
+    return run_sensitivity_study(base, evaluate, options, print_level);
+}
+
+void add_sensitivity(CLI::App& app) {
+    auto o = std::make_shared<SensitivityCli>();
+    auto* cmd = app.add_subcommand("sensitivity", "vary each micro parameter around a base material; classify the "
+                                                  "responses of mu_b and tau_c (seed Table 3.1)");
+    cmd->add_option("base", o->base_file, "base material JSON")->required();
+    cmd->add_option("--params", o->params, "parameters to vary (default: all micromechanical)")->delimiter(',');
+    cmd->add_option("--levels", o->levels, "values per parameter (>= 3; 5 lets a curvature be tested)")->capture_default_str();
+    cmd->add_option("--span", o->span, "default range: base * (1 -+ span)")->capture_default_str();
+    cmd->add_option("--range", o->ranges, "explicit range NAME=LOW:HIGH (repeatable)");
+    cmd->add_option("--criterion", o->criterion, "shape selection: f-test or aicc")->capture_default_str();
+    cmd->add_option("--alpha", o->alpha, "significance level of the F tests")->capture_default_str();
+    add_campaign_options(cmd, o->campaign);
+    cmd->callback([o] {
+        const auto base = orchestrator::validate_material(read_json(o->base_file, "base"), o->base_file);
+        sensitivity_options(*o);  // option errors before any campaign
+        CampaignSession session(o->campaign, "sensitivity");
+        const auto study = run_study(base, *o, session.evaluate);
+        write_study(o->campaign.campaign_dir, study, o->campaign.plot_format);
+        std::cout << "\n" << study.table() << "\n" << study.evaluations << " failure lines, " << study.simulations_run
+                  << " simulations run now, " << study.simulations_reused << " reused; CPU " << duration(study.cpu_s)
+                  << "\nresults: " << (fs::path(o->campaign.campaign_dir) / "sensitivity.json").string()
+                  << ", sensitivity_table.txt, sensitivity_<param>." << o->campaign.plot_format << std::endl;
+    });
+}
+
+// ---- calibrate ----
+
+struct CalibrateCli {
+    std::string target;
+    std::string measured;
+    std::string start_file;
+    double tol = 0.02;
+    std::string sensitivity_file;
+    std::vector<std::string> controls;
+    std::vector<std::string> bounds;
+    std::string method = "surrogate";
+    bool sequential = false;
+    bool strict = false;
+    int max_evaluations = 12;
+    int grid_points = 9;
+    std::string output;
+    SensitivityCli study;  // used when no --sensitivity file is given
+};
+
+std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
+    if (o.target.empty() == o.measured.empty()) throw UserError("give exactly one of --target and --measured");
+    if (!o.target.empty()) return parse_targets(o.target);
+    std::vector<double> sigma, tau;
+    std::stringstream items(o.measured);
+    std::string item;
+    while (std::getline(items, item, ',')) {
+        const auto colon = item.find(':');
+        try {
+            if (colon == std::string::npos) throw std::invalid_argument(item);
+            sigma.push_back(std::stod(item.substr(0, colon)));
+            tau.push_back(std::stod(item.substr(colon + 1)));
+        } catch (const std::exception&) {
+            throw UserError("measured point '" + item + "' is not of the form SIGMA:TAU (Pa)");
+        }
+    }
+    return targets_from_measured_line(sigma, tau);
+}
+
+void add_calibrate(CLI::App& app) {
+    auto o = std::make_shared<CalibrateCli>();
+    auto* cmd = app.add_subcommand("calibrate", "find micro parameters whose simulated failure line matches a target");
+    cmd->add_option("--target", o->target, "targets, e.g. mu_b=0.55,tau_c=800 (tau_c in Pa)");
+    cmd->add_option("--measured", o->measured, "measured failure line SIGMA:TAU,... [Pa] (targets with its intervals)");
+    cmd->add_option("--start", o->start_file, "starting material JSON")->required();
+    cmd->add_option("--tol", o->tol, "relative tolerance on each target")->capture_default_str();
+    cmd->add_option("--sensitivity", o->sensitivity_file, "stored sensitivity.json to reuse (default: run the study "
+                                                          "around the start, reusing stored runs)");
+    cmd->add_option("--controls", o->controls, "controlling parameters, one per target in order (default: chosen "
+                                               "from the study)")->delimiter(',');
+    cmd->add_option("--bounds", o->bounds, "search bounds NAME=LOW:HIGH (default: the studied range)");
+    cmd->add_option("--method", o->method, "surrogate (default), coordinate or grid (baselines)")
+        ->check(CLI::IsMember({"surrogate", "coordinate", "grid"}));
+    cmd->add_flag("--sequential", o->sequential, "slope first, then cohesion (the seed's order)");
+    cmd->add_flag("--strict", o->strict, "stop on the tolerance only, not when a target is inside the simulated interval");
+    cmd->add_option("--max-evaluations", o->max_evaluations, "failure lines at most (start included)")->capture_default_str();
+    cmd->add_option("--grid-points", o->grid_points, "points per parameter (grid method)")->capture_default_str();
+    cmd->add_option("--output,-o", o->output, "calibrated material JSON (default CAMPAIGN/calibrated_material.json)");
+    cmd->add_option("--params", o->study.params, "study: parameters to vary")->delimiter(',');
+    cmd->add_option("--levels", o->study.levels, "study: values per parameter")->capture_default_str();
+    cmd->add_option("--span", o->study.span, "study: base * (1 -+ span)")->capture_default_str();
+    cmd->add_option("--range", o->study.ranges, "study: explicit range NAME=LOW:HIGH");
+    add_campaign_options(cmd, o->study.campaign);
+    cmd->callback([o] {
+        const auto& camp = o->study.campaign;
+        const auto start = orchestrator::validate_material(read_json(o->start_file, "start"), o->start_file);
+        const auto targets = targets_of(*o);
+        const auto bounds = parse_ranges(o->bounds, "bounds");
+        CalibrationOptions options;
+        options.tolerance = o->tol;
+        options.method = search_method_from_string(o->method);
+        options.sequential = o->sequential;
+        options.accept_simulated_interval = !o->strict;
+        options.max_evaluations = o->max_evaluations;
+        options.grid_points = o->grid_points;
+        options.line = line_kind_from_string(camp.line);
+        if (!(o->tol > 0 && o->tol < 1)) throw UserError("tol = " + std::to_string(o->tol) + " must be in (0, 1)");
+        CampaignSession session(camp, "calibrate");
+        const fs::path dir = camp.campaign_dir;
+
+        SensitivityStudy study;
+        if (!o->sensitivity_file.empty()) {
+            study = SensitivityStudy::from_json(read_json(o->sensitivity_file, "sensitivity"));
+        } else {
+            if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
+            study = run_study(start, o->study, session.evaluate);
+            write_study(dir, study, camp.plot_format);
+            std::cout << "\n" << study.table() << std::endl;
+        }
+        std::vector<ControlParameter> controls;
+        if (o->controls.empty()) {
+            controls = choose_controls(study, targets, o->tol, {}, bounds);
+        } else {
+            if (o->controls.size() != targets.size())
+                throw UserError("controls: " + std::to_string(o->controls.size()) + " given for " +
+                                std::to_string(targets.size()) + " targets");
+            for (const auto& name : o->controls) {
+                const auto* p = study.find(name);
+                auto b = bounds.find(name);
+                if (!p && b == bounds.end())
+                    throw UserError("controls: '" + name + "' is neither in the study nor given --bounds");
+                controls.push_back({name, b != bounds.end() ? b->second.first : p->low(),
+                                    b != bounds.end() ? b->second.second : p->high()});
+            }
+        }
+        std::cout << "calibrating";
+        for (std::size_t i = 0; i < targets.size(); ++i)
+            std::cout << (i ? ", " : " ") << targets[i].quantity << " = " << targets[i].value << " +/- "
+                      << targets[i].acceptance(o->tol) << " with " << controls[i].name << " in [" << controls[i].low
+                      << ", " << controls[i].high << "]";
+        std::cout << " (" << o->method << (o->sequential ? ", slope first" : "") << ")" << std::endl;
+
+        const fs::path log_path = dir / ("calibration_log_" + o->method + ".jsonl");
+        std::ofstream log(log_path, std::ios::app);
+        const auto result = calibrate(start, targets, controls, &study, session.evaluate, options,
+                                      [&](const CalibrationIteration& it) {
+                                          std::cout << "  #" << std::setw(2) << it.evaluation << " " << std::left
+                                                    << std::setw(10) << it.phase << std::right;
+                                          for (const auto& [name, v] : it.values) std::cout << " " << name << "=" << v;
+                                          std::cout << std::fixed << std::setprecision(4) << "  mu_b " << it.mu_b
+                                                    << " +/- " << it.mu_b_half_width << std::setprecision(1)
+                                                    << "  tau_c " << it.tau_c << " +/- " << it.tau_c_half_width
+                                                    << " Pa" << std::setprecision(2) << "  miss " << it.mismatch
+                                                    << (it.accepted ? "  ACCEPTED (" + it.accepted_by + ")" : "")
+                                                    << "  [" << it.simulations_run << " run, "
+                                                    << it.simulations_reused << " reused]" << std::endl;
+                                          std::cout.unsetf(std::ios::fixed);
+                                          log << it.to_json().dump() << "\n" << std::flush;
+                                      });
+        auto summary = result.to_json();
+        summary["sensitivity"] = {{"evaluations", study.evaluations},
+                                  {"simulations_run", study.simulations_run},
+                                  {"simulations_reused", study.simulations_reused},
+                                  {"cpu_s", study.cpu_s}};
+        orchestrator::write_text_file_atomically(dir / ("calibration_" + o->method + ".json"), summary.dump(2) + "\n");
+        const fs::path out = o->output.empty() ? dir / "calibrated_material.json" : fs::path(o->output);
+        nlohmann::json material = result.material;
+        material["description"] = "calibrated by demcal calibrate (" + to_string(result.status) + "): " + result.message;
+        orchestrator::write_text_file_atomically(out, material.dump(1) + "\n");
+        const auto& best = result.iterations[result.best];
+        std::cout << "\n" << to_string(result.status) << ": " << result.message << "\n"
+                  << "final: mu_b = " << best.mu_b << " +/- " << best.mu_b_half_width << ", tau_c = " << best.tau_c
+                  << " +/- " << best.tau_c_half_width << " Pa (95 % intervals)\n"
+                  << "calibration: " << result.evaluations << " failure lines, " << result.simulations_run
+                  << " simulations run, " << result.simulations_reused << " reused, CPU " << duration(result.cpu_s)
+                  << "; sensitivity study: " << study.evaluations << " failure lines, " << study.simulations_run
+                  << " simulations run now\nmaterial: " << out.string() << "\n";
+        if (result.status == CalibrationStatus::unreachable) throw UserError("calibration stopped: " + result.message);
+        if (result.status != CalibrationStatus::converged) throw std::runtime_error(result.message);
+    });
+}
+
+// ---- enlarge ----
+
+struct EnlargeCli {
+    std::vector<std::string> materials;
+    std::string output = "enlargement.json";
+    std::string plot_format = "png";
+};
+
+void add_enlarge(CLI::App& app) {
+    auto o = std::make_shared<EnlargeCli>();
+    auto* cmd = app.add_subcommand("enlarge", "fit E(r_p) = A r_p + B and nu(r_p) = C r_p^-D (seed eqs. 3.1-3.2) to "
+                                              "materials calibrated at several particle radii");
+    cmd->add_option("materials", o->materials, "calibrated material JSONs (one per radius; from demcal calibrate)")
+        ->required();
+    cmd->add_option("--output,-o", o->output, "result JSON (a plot beside it)")->capture_default_str();
+    cmd->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    cmd->callback([o] {
+        std::vector<double> r, e, nu;
+        for (const auto& file : o->materials) {
+            const auto m = orchestrator::validate_material(read_json(file, "material"), file);
+            r.push_back(m.at("particle_radius").get<double>());
+            e.push_back(m.at("young_modulus").get<double>());
+            nu.push_back(m.at("poisson_ratio").get<double>());
+        }
+        if (r.size() < 3) throw UserError("materials: " + std::to_string(r.size()) + " given, need at least 3 radii");
+        const auto e_law = analytics::fit_linear_law(r, e);
+        const auto nu_law = analytics::fit_power_law(r, nu);
+        nlohmann::json j = {{"young_modulus", e_law.to_json()},
+                            {"poisson_ratio", nu_law.to_json()},
+                            {"note", "r in m; poisson_ratio is YADE's ks/kn stiffness ratio, so nu(r) is a law for it"},
+                            {"points", nlohmann::json::array()}};
+        for (std::size_t i = 0; i < r.size(); ++i)
+            j["points"].push_back({{"particle_radius", r[i]}, {"young_modulus", e[i]}, {"poisson_ratio", nu[i]}});
+        orchestrator::write_text_file_atomically(o->output, j.dump(2) + "\n");
+        std::cout << "E(r)  = A r + B:  A = " << e_law.params[0].value << " +/- " << e_law.params[0].std_error
+                  << " Pa/m, B = " << e_law.params[1].value << " +/- " << e_law.params[1].std_error << " Pa (R^2 "
+                  << e_law.r_squared << ")\n"
+                  << "nu(r) = C r^-D:   C = " << nu_law.params[0].value << " +/- " << nu_law.params[0].std_error
+                  << ", D = " << nu_law.params[1].value << " +/- " << nu_law.params[1].std_error << " (R^2 "
+                  << nu_law.r_squared << "; nu is YADE's ks/kn)\nresults: " << o->output << "\n";
+    });
+}
+
+}  // namespace
+
+void add_calibration_commands(CLI::App& app) {
+    add_sensitivity(app);
+    add_calibrate(app);
+    add_enlarge(app);
+}
+
 }  // namespace demcal

@@ -1,0 +1,27 @@
+// The calibration's evaluator over real YADE shear campaigns: each material becomes one campaign of the orchestrator
+// (stored, cached by run hash, resumable), always at the same normal stresses and packing seeds, so that every
+// material of a study or a calibration sees the same packings (common random numbers).
+#pragma once
+#include "calibration/macro_target.hpp"
+#include "orchestrator/shear_campaign.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace demcal::calibration {
+
+struct CampaignSettings {
+    std::vector<double> normal_stresses;   // [Pa], the same for every material
+    int replicates = 1;                    // packings per stress (seeds base_seed, base_seed + 1, ...)
+    long base_seed = 1;                    // fixed: common random numbers across materials
+    std::filesystem::path template_path;   // empty: the installed yade_scripts/shear_box.py
+    std::string label;                     // campaign label prefix, e.g. "sensitivity" or "calibrate"
+};
+
+// Evaluates materials through `runner` (which must outlive the evaluator). Throws std::runtime_error when the campaign
+// was interrupted (Ctrl-C: run the command again to resume) or when too few runs finished for a line.
+FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runner, CampaignSettings settings,
+                                        orchestrator::ProgressCallback progress = {});
+
+}  // namespace demcal::calibration
