@@ -394,18 +394,21 @@ def main():
             st = O.bodies[i].state
             v = st.vel
             kinetic += 0.5 * st.mass * v.squaredNorm()
+        # Order matters: an exploding integration also throws spheres out of the box; name the cause, not the symptom.
         for i in sphere_ids:
             pos = O.bodies[i].state.pos
             if not (math.isfinite(pos[0]) and math.isfinite(pos[1]) and math.isfinite(pos[2])):
                 raise RunFailure("nan", "sphere %d position %s during %s at step %d" % (i, pos, stage, O.iter))
-            if not (x_min <= pos[0] <= x_max and y_min <= pos[1] <= y_max and -t <= pos[2] <= z_max):
-                raise RunFailure("escaped", "sphere %d at (%.4g, %.4g, %.4g) m outside the box during %s at step %d" %
-                                 (i, pos[0], pos[1], pos[2], stage, O.iter))
         if not math.isfinite(kinetic):
             raise RunFailure("nan", "kinetic energy is %s during %s at step %d" % (kinetic, stage, O.iter))
         if kinetic > kinetic_energy_limit:
             raise RunFailure("kinetic_energy", "%.4g J > limit %.4g J (mass %.4g kg at %.3g m/s) during %s at step %d"
                              % (kinetic, kinetic_energy_limit, total_mass_full, speed_limit_kinetic, stage, O.iter))
+        for i in sphere_ids:
+            pos = O.bodies[i].state.pos
+            if not (x_min <= pos[0] <= x_max and y_min <= pos[1] <= y_max and -t <= pos[2] <= z_max):
+                raise RunFailure("escaped", "sphere %d at (%.4g, %.4g, %.4g) m outside the box during %s at step %d" %
+                                 (i, pos[0], pos[1], pos[2], stage, O.iter))
         return kinetic
 
     # --- 1: grow the radii to full size in place (no gas to ram, no stress wave), the lid servo already on
