@@ -195,11 +195,15 @@ void write_study(const fs::path& dir, const SensitivityStudy& study, const std::
     }
 }
 
-SensitivityStudy run_study(const nlohmann::json& base, const SensitivityCli& o, const FailureLineEvaluator& evaluate) {
+// Checks every level before anything is written or run: a bad range must not cost simulations.
+void check_study(const nlohmann::json& base, const SensitivityCli& o) {
     const auto options = sensitivity_options(o);
-    // Check every level before the first run: a bad range must not cost simulations.
     for (const auto& name : options.params.empty() ? orchestrator::micromechanical_param_names() : options.params)
         sensitivity_levels(base, name, options);
+}
+
+SensitivityStudy run_study(const nlohmann::json& base, const SensitivityCli& o, const FailureLineEvaluator& evaluate) {
+    const auto options = sensitivity_options(o);
     std::cout << "sensitivity study: " << (options.params.empty() ? orchestrator::micromechanical_param_names().size()
                                                                   : options.params.size())
               << " parameters x " << options.levels << " levels, failure lines at " << o.campaign.normal_stresses.size()
@@ -221,7 +225,7 @@ void add_sensitivity(CLI::App& app) {
     add_campaign_options(cmd, o->campaign);
     cmd->callback([o] {
         const auto base = orchestrator::validate_material(read_json(o->base_file, "base"), o->base_file);
-        sensitivity_options(*o);  // option errors before any campaign
+        check_study(base, *o);  // option errors before any campaign
         CampaignSession session(o->campaign, "sensitivity");
         const auto study = run_study(base, *o, session.evaluate);
         write_study(o->campaign.campaign_dir, study, o->campaign.plot_format);
@@ -308,6 +312,10 @@ void add_calibrate(CLI::App& app) {
         options.grid_points = o->grid_points;
         options.line = line_kind_from_string(camp.line);
         if (!(o->tol > 0 && o->tol < 1)) throw UserError("tol = " + std::to_string(o->tol) + " must be in (0, 1)");
+        if (o->sensitivity_file.empty()) {
+            if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
+            check_study(start, o->study);
+        }
         CampaignSession session(camp, "calibrate");
         const fs::path dir = camp.campaign_dir;
 
@@ -315,7 +323,6 @@ void add_calibrate(CLI::App& app) {
         if (!o->sensitivity_file.empty()) {
             study = SensitivityStudy::from_json(read_json(o->sensitivity_file, "sensitivity"));
         } else {
-            if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
             study = run_study(start, o->study, session.evaluate);
             write_study(dir, study, camp.plot_format);
             std::cout << "\n" << study.table() << std::endl;
