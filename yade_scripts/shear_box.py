@@ -66,6 +66,8 @@ GROWTH_SURFACE_SPEED = 0.05      # m/s, speed of a particle surface while radii 
 CONSOLIDATION_INERTIAL_NUMBER = 0.01  # lid speed limit while consolidating: I = (v / H) d sqrt(rho / sigma)
 SERVO_PERIOD = 10                # steps between lid velocity updates
 SERVO_GAIN = 1.0                 # fraction of the force error corrected per update, relative to the lid contact stiffness
+INTEGRAL_GAIN = 0.1              # integral part of the servo: this fraction of the proportional speed accumulates per update
+INTEGRAL_BAND = 0.25             # ...only while the force error is below this fraction of the target
 APPROACH_BELOW = 0.10            # while consolidating, a force error above this fraction of the target: fast approach
 CONSOLIDATION_CHUNK = 200        # steps between quasi-static checks
 CONSOLIDATION_UNBALANCED = 0.02  # utils.unbalancedForce() below which the sample counts as quasi-static
@@ -229,7 +231,10 @@ def main():
     cloud = pack.SpherePack()
     for attempt in range(6):  # makeCloud may not fit all: smaller seeds, deterministically
         cloud = pack.SpherePack()
-        placed = cloud.makeCloud(minCorner=Vector3(0, 0, 0), maxCorner=Vector3(L, W, cloud_height),
+        # Inset by what the largest particle will still grow, so that growing in place presses on no wall.
+        inset = form * r_mean * (1 + spread) * (1 - size_factor)
+        placed = cloud.makeCloud(minCorner=Vector3(inset, inset, inset),
+                                 maxCorner=Vector3(L - inset, W - inset, cloud_height - inset),
                                  rMean=r_mean * form * size_factor, rRelFuzz=spread, num=particle_count_target,
                                  seed=p["seed"])
         if placed >= particle_count_target:
@@ -322,7 +327,10 @@ def main():
     kinetic_energy_limit = 0.5 * total_mass_full * speed_limit_kinetic ** 2
 
     # State shared with the servo (PyRunner evaluates its command in this module's globals).
-    servo = {"vx": 0.0, "approach": True, "cap_down": 0.0, "cap_up": lid_speed_up,  # the lid waits while the radii grow
+    # While the radii grow the lid waits (no way down) but must rise as fast as a jammed column would expand.
+    growth_expansion_speed = cloud_height * GROWTH_SURFACE_SPEED / r_mean
+    servo = {"vx": 0.0, "approach": True, "cap_down": 0.0, "cap_up": max(lid_speed_up, 2 * growth_expansion_speed),
+             "v_integral": 0.0,
              "sum_fz": 0.0, "sum_fx": 0.0, "count": 0, "max_fz": 0.0}
     growth = {"remaining": 1.0 / size_factor, "per_call": 1.0}
 
@@ -359,8 +367,18 @@ def main():
         error = force_target - fz
         if stiffness > 0:
             vz = -SERVO_GAIN * error / (stiffness * O.dt * SERVO_PERIOD)
+            # Integral part: a sample that keeps creeping (consolidation) or dilating (shear) needs a steady lid
+            # speed, which a proportional servo only gets from a steady error; the integral supplies it. Only near
+            # the target, so that the long approach does not wind it up.
+            if abs(error) < INTEGRAL_BAND * force_target:
+                servo["v_integral"] += INTEGRAL_GAIN * vz
+                servo["v_integral"] = min(servo["cap_up"], max(-servo["cap_down"], servo["v_integral"]))
+            vz += servo["v_integral"]
         else:
             vz = -servo["cap_down"]
+        if growth["remaining"] > 1.0 and error < 0:
+            # A column jammed while its radii grow expands faster than the stiffness-based servo lets the lid rise.
+            vz = max(vz, growth_expansion_speed * min(1.0, -error / force_target))
         if servo["approach"] and error > APPROACH_BELOW * force_target:
             # Far below the target the packing compacts plastically, far softer than the lid contacts say: approach
             # at the quasi-static speed limit instead of creeping.
@@ -422,6 +440,8 @@ def main():
     dt = O.dt
     growth_steps = O.iter
     servo["cap_down"] = lid_speed_down
+    servo["cap_up"] = lid_speed_up
+    servo["v_integral"] = 0.0
     # Radii growing into the fixed lid give brief local force spikes on it; report them apart from consolidation.
     growth_peak_ratio = servo["max_fz"] / force_target
     take_average()
