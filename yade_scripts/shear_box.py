@@ -60,7 +60,7 @@ DOCUMENTATION_KEYS = ("name", "description")
 
 # --- numerical choices of the procedure (not inputs: they define the test, see README.md) ---
 CLOUD_SOLID_FRACTION = 0.25      # makeCloud's loose cloud (it cannot place spheres much above 0.3)
-GROWN_SOLID_FRACTION = 0.50      # after growing to full size, below random loose packing: growth itself never jams
+GROWN_SOLID_FRACTION = 0.50      # after growing to full size: below random loose packing in the bulk (walls may jam it)
 EXPECTED_SOLID_FRACTION = 0.555  # of the consolidated sample; sets the particle count so the lid ends near box_height
 GROWTH_SURFACE_SPEED = 0.05      # m/s, speed of a particle surface while radii grow in the (unjammed) cloud
 CONSOLIDATION_INERTIAL_NUMBER = 0.01  # lid speed limit while consolidating: I = (v / H) d sqrt(rho / sigma)
@@ -338,7 +338,8 @@ def main():
         return lid.state.pos[2] - 0.5 * t
 
     def servo_step():
-        """Lid servo: v_z = -gain * (F_target - F) / (K dt period), K = sum of normal stiffnesses at the lid.
+        """Lid servo, PI: v_P = -gain * (F_target - F) / (K dt period), K = sum of normal stiffnesses at the lid,
+        plus an integral part near the target (see README.md, Lid servo).
 
         Why not KinemCNLEngine: it drives YADE's simple-shear parallelogram box (rotating side walls, fixed wall ids)
         and holds the force it measured on its first step, not a prescribed stress; a split Jenike box needs its own
