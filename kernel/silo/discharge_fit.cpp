@@ -1,0 +1,56 @@
+#include "kernel/silo/discharge_fit.hpp"
+
+#include <cmath>
+
+namespace demcal::kernel::silo {
+
+DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, double reference_mass,
+                                double lower_fraction, double upper_fraction) {
+    DischargeFit f;
+    f.lower_fraction = lower_fraction;
+    f.upper_fraction = upper_fraction;
+    f.reference_mass = reference_mass;
+    const double lo = lower_fraction * reference_mass, hi = upper_fraction * reference_mass;
+    double st = 0, sm = 0;
+    int n = 0;
+    for (const auto& s : samples)
+        if (s.mass >= lo && s.mass <= hi) {
+            st += s.time;
+            sm += s.mass;
+            if (n == 0) f.t_begin = s.time;
+            f.t_end = s.time;
+            ++n;
+        }
+    f.n = n;
+    if (n < 3) {
+        f.message = "only " + std::to_string(n) + " samples between " + std::to_string(lower_fraction * 100) +
+                    " % and " + std::to_string(upper_fraction * 100) + " % of the filled mass";
+        return f;
+    }
+    const double tm = st / n, mm = sm / n;
+    double stt = 0, stm = 0, smm = 0;
+    for (const auto& s : samples)
+        if (s.mass >= lo && s.mass <= hi) {
+            stt += (s.time - tm) * (s.time - tm);
+            stm += (s.time - tm) * (s.mass - mm);
+            smm += (s.mass - mm) * (s.mass - mm);
+        }
+    if (!(stt > 0)) {
+        f.message = "the samples of the steady part all have the same time";
+        return f;
+    }
+    f.rate = stm / stt;
+    f.intercept = mm - f.rate * tm;
+    double sse = 0;
+    for (const auto& s : samples)
+        if (s.mass >= lo && s.mass <= hi) {
+            const double e = s.mass - (f.intercept + f.rate * s.time);
+            sse += e * e;
+        }
+    f.r_squared = smm > 0 ? 1 - sse / smm : 1.0;
+    f.rate_se = std::sqrt(sse / (n - 2) / stt);
+    f.ok = std::isfinite(f.rate);
+    return f;
+}
+
+}  // namespace demcal::kernel::silo

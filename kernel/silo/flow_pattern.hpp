@@ -1,0 +1,71 @@
+// The flow pattern (mass / mixed / funnel) from the velocity field in the hopper during the steady discharge.
+//
+// Measure (wall-to-axis velocity ratio): each grain whose centre lies in the hopper within `wall_layer` of the
+// hopper's slanted wall, and at least `edge_clearance` from the outlet edge measured along the wall, is a "wall
+// sample"; each grain within `axis_fraction` of the local half size from the axis (at least `axis_min` from it) is an
+// "axis sample". Samples are binned by height (bin = `bin_height`). The measure is the mean, over all wall samples, of
+// the wall grain's downward velocity divided by the mean downward velocity of the axis samples of its height bin
+// (bins whose axis grains are not moving down, mean below `min_axis_speed`, are left out). It is accumulated over
+// every sampled frame of the steady discharge.
+//
+// Thresholds (after the seed's figure 3.7, the mid-plane coloured by vertical velocity): in mass flow the whole
+// hopper content moves, the grains at the hopper wall as well as the core (for frictionless radial flow in a cone the
+// ratio is cos^3 theta, 0.96 at 10 deg); in funnel flow the grains along the hopper wall are stagnant (blue) while the
+// core runs: ratio near 0. Mass flow: ratio >= 0.3; funnel flow: ratio < 0.1 (wall grains at under a tenth of the
+// core's speed, "nearly stagnant"); mixed flow in between (moving wall layer in part of the hopper only).
+#pragma once
+#include "kernel/silo/silo_geometry.hpp"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace demcal::kernel::silo {
+
+enum class FlowPattern { undetermined, mass, mixed, funnel };
+std::string to_string(FlowPattern p);
+
+struct FlowPatternSettings {
+    double wall_layer = 0.0055;      // [m], default one grain length d_p
+    double edge_clearance = 0.011;   // [m] along the wall from the outlet edge, default 2 d_p
+    double axis_fraction = 0.3;      // of the local half size
+    double axis_min = 0.00275;       // [m], default d_p / 2
+    double bin_height = 0.0055;      // [m]
+    double min_axis_speed = 1e-3;    // [m/s]
+    double mass_threshold = 0.3;
+    double funnel_threshold = 0.1;
+};
+
+struct FlowPatternResult {
+    FlowPattern pattern = FlowPattern::undetermined;
+    double ratio = 0;              // the measure (wall / axis downward velocity)
+    double wall_speed = 0;         // mean downward velocity of the wall samples used [m/s]
+    double axis_speed = 0;         // mean downward velocity of the axis samples of the same bins [m/s]
+    long wall_samples = 0, axis_samples = 0, frames = 0;
+    std::string measure;           // the measure in words, with the thresholds
+    std::string message;           // why it is undetermined
+};
+
+class FlowPatternClassifier {
+public:
+    FlowPatternClassifier(const SiloGeometry& g, FlowPatternSettings s = {});
+    // One frame: centres of mass and velocities of the grains in the silo.
+    void add_frame(const std::vector<Eigen::Vector3d>& positions, const std::vector<Eigen::Vector3d>& velocities);
+    FlowPatternResult result() const;
+    const FlowPatternSettings& settings() const { return s_; }
+
+private:
+    struct Bin {
+        double wall_sum = 0, axis_sum = 0;
+        long wall_n = 0, axis_n = 0;
+    };
+    struct Frame {
+        std::vector<Bin> bins;
+    };
+    SiloGeometry g_;
+    FlowPatternSettings s_;
+    std::vector<Frame> frames_;  // per frame, so the ratio uses the axis speed of the same moment
+};
+
+}  // namespace demcal::kernel::silo

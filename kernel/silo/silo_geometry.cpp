@@ -1,0 +1,147 @@
+#include "kernel/silo/silo_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace demcal::kernel::silo {
+
+namespace {
+constexpr double pi = 3.14159265358979323846;
+double rad(double deg) { return deg * pi / 180.0; }
+
+std::string num(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+[[noreturn]] void bad(const std::string& field, double value, const std::string& why) {
+    throw std::invalid_argument(field + " = " + num(value) + ": " + why);
+}
+}  // namespace
+
+SiloGeometry SiloGeometry::conical(double theta_deg, double outlet_d, double diameter_D, double body_h) {
+    SiloGeometry g;
+    g.shape = SiloShape::conical;
+    g.half_angle_deg = theta_deg;
+    g.outlet = outlet_d;
+    g.diameter = diameter_D;
+    g.body_height = body_h;
+    return g;
+}
+
+SiloGeometry SiloGeometry::rectangular(double theta_deg, double a, double b, double c, double body_h) {
+    SiloGeometry g;
+    g.shape = SiloShape::rectangular;
+    g.half_angle_deg = theta_deg;
+    g.outlet = a;
+    g.depth = b;
+    g.width = c;
+    g.body_height = body_h;
+    return g;
+}
+
+double SiloGeometry::hopper_height() const { return (top_half() - outlet_half()) / std::tan(rad(half_angle_deg)); }
+
+double SiloGeometry::half_size_at(double z) const {
+    if (z <= 0) return outlet_half();
+    const double hh = hopper_height();
+    if (z >= hh) return top_half();
+    return outlet_half() + z * std::tan(rad(half_angle_deg));
+}
+
+double SiloGeometry::horizontal_area_at(double z) const {
+    const double h = half_size_at(z);
+    return shape == SiloShape::conical ? pi * h * h : 2 * h * depth;
+}
+
+double SiloGeometry::outlet_area() const {
+    return shape == SiloShape::conical ? pi * outlet_half() * outlet_half() : outlet * depth;
+}
+
+double SiloGeometry::volume_below(double z) const {
+    if (z <= 0) return 0;
+    const double hh = hopper_height(), t = std::tan(rad(half_angle_deg));
+    const double zh = std::min(z, hh);
+    const double r0 = outlet_half(), r1 = r0 + zh * t;
+    double v;
+    if (shape == SiloShape::conical)
+        v = pi * zh / 3 * (r0 * r0 + r0 * r1 + r1 * r1);
+    else
+        v = (r0 + r1) * zh * depth;  // trapezoid: (2 r0 + 2 r1)/2 * zh * b
+    if (z > hh) v += horizontal_area_at(hh + 1e-12) * (std::min(z, top()) - hh);
+    return v;
+}
+
+double SiloGeometry::volume() const { return volume_below(top()); }
+
+double SiloGeometry::transverse(const Eigen::Vector3d& p) const {
+    return shape == SiloShape::conical ? std::hypot(p.x(), p.y()) : std::abs(p.x());
+}
+
+double SiloGeometry::distance_to_side_wall(const Eigen::Vector3d& p) const {
+    const double s = transverse(p), z = p.z();
+    const double th = rad(half_angle_deg), hh = hopper_height();
+    double d;
+    if (z >= hh) {
+        d = top_half() - s;  // vertical body wall
+        // near the body-hopper edge the slanted wall can be closer (it cannot for points above it: convex corner)
+    } else {
+        // slanted wall: the line s = r0 + z tan(theta); perpendicular distance in the (s, z) half plane
+        d = (outlet_half() + z * std::tan(th) - s) * std::cos(th);
+        if (z < 0) d = outlet_half() - s;
+        d = std::min(d, top_half() - s);
+    }
+    if (shape == SiloShape::rectangular) d = std::min(d, 0.5 * depth - std::abs(p.y()));
+    return d;
+}
+
+bool SiloGeometry::contains(const Eigen::Vector3d& p, double r, double clearance) const {
+    if (p.z() - r < clearance || p.z() + r > top() - clearance) return false;
+    return distance_to_side_wall(p) >= r + clearance;
+}
+
+std::string SiloGeometry::describe() const {
+    std::ostringstream s;
+    if (shape == SiloShape::conical)
+        s << "conical hopper: D = " << diameter << " m, d = " << outlet << " m, theta = " << half_angle_deg
+          << " deg, hopper height " << hopper_height() << " m, body " << body_height << " m";
+    else
+        s << "rectangular hopper: a = " << outlet << " m, b = " << depth << " m, c = " << width
+          << " m, theta = " << half_angle_deg << " deg, hopper height " << hopper_height() << " m, body "
+          << body_height << " m";
+    return s.str();
+}
+
+void validate(const SiloGeometry& g, double particle_size, double min_outlet_particles) {
+    if (!(particle_size > 0)) bad("particle_size", particle_size, "must be positive");
+    if (!(g.half_angle_deg > 0 && g.half_angle_deg < 90))
+        bad("theta", g.half_angle_deg, "the hopper half angle must lie strictly between 0 and 90 deg");
+    if (!(g.body_height >= 0) || !std::isfinite(g.body_height)) bad("body_height", g.body_height, "must be >= 0 m");
+    const char* outlet_name = g.shape == SiloShape::conical ? "outlet" : "a (outlet width)";
+    if (!(g.outlet > 0) || !std::isfinite(g.outlet)) bad(outlet_name, g.outlet, "must be positive");
+    if (g.outlet < min_outlet_particles * particle_size)
+        bad(outlet_name, g.outlet,
+            "the outlet must be at least " + num(min_outlet_particles) + " particle sizes (" +
+                num(min_outlet_particles * particle_size) + " m for d_p = " + num(particle_size) +
+                " m), or the grains arch over it");
+    if (g.shape == SiloShape::conical) {
+        if (!(g.diameter > g.outlet) || !std::isfinite(g.diameter))
+            bad("diameter", g.diameter, "the silo diameter D must be larger than the outlet (" + num(g.outlet) + " m)");
+    } else {
+        if (!(g.width > g.outlet) || !std::isfinite(g.width))
+            bad("c (width)", g.width, "the silo width c must be larger than the outlet width a (" + num(g.outlet) + " m)");
+        if (!(g.depth > 0) || !std::isfinite(g.depth)) bad("b (depth)", g.depth, "must be positive");
+        if (g.depth < min_outlet_particles * particle_size)
+            bad("b (depth)", g.depth,
+                "the slot spans the depth b, which must be at least " + num(min_outlet_particles) +
+                    " particle sizes (" + num(min_outlet_particles * particle_size) + " m)");
+    }
+    const double size = g.shape == SiloShape::conical ? g.diameter : g.width;
+    if (g.hopper_height() > 20 * size)
+        bad("theta", g.half_angle_deg,
+            "the hopper would be " + num(g.hopper_height()) + " m tall (more than 20 silo sizes)");
+}
+
+}  // namespace demcal::kernel::silo
