@@ -1,0 +1,33 @@
+// What a contact law sees of one contact: geometry and kinematics, built by the kernel for sphere-sphere and
+// sphere-wall contacts alike. Sub-models (normal, tangential, rolling) are small structs with static inline
+// functions; a law composes them at compile time (contact_law.hpp), so the inner loop has no virtual calls.
+#pragma once
+#include "kernel/types.hpp"
+
+namespace demcal::kernel {
+
+struct ContactGeometry {
+  Vec3 n;          ///< unit normal, pointing from j (or the wall) towards i
+  double dn;       ///< overlap (> 0 in contact) [m]
+  double r_star;   ///< effective radius R* (1/R* = 1/R_i + 1/R_j; wall: R_i) [m]
+  double m_star;   ///< effective mass m* (1/m* = 1/m_i + 1/m_j; wall: m_i; clump member: whole clump's mass) [kg]
+  double radius_i; ///< radius of sphere i [m]
+  double radius_j; ///< radius of sphere j [m] (wall: 0)
+  double lever_i;  ///< distance from i's centre to the contact point (r_i - dn/2) [m]
+  double lever_j;  ///< distance from j's centre to the contact point (r_j - dn/2; wall: 0) [m]
+};
+
+struct ContactKinematics {
+  Vec3 v_rel;   ///< velocity of i's contact point relative to j's (or the wall's) [m/s]
+  Vec3 omega_i; ///< angular velocity of i (its body) [rad/s]
+  Vec3 omega_j; ///< angular velocity of j (zero for a wall) [rad/s]
+};
+
+/// What a law returns: force on i (j gets -force_i), torques about the two sphere centres.
+struct ContactResult {
+  Vec3 force_i = Vec3::Zero();
+  Vec3 torque_i = Vec3::Zero();
+  Vec3 torque_j = Vec3::Zero();
+};
+
+}  // namespace demcal::kernel

@@ -1,0 +1,52 @@
+// Linked-cell neighbour search with a Verlet skin, producing a half list (pairs i < j) in CSR form, with the
+// tangential history of each pair carried across rebuilds and a transposed index (pairs by their j) so that forces
+// can be gathered per sphere in a fixed order (deterministic for any thread count, no atomics).
+#pragma once
+#include <cstdint>
+#include <utility>
+#include <vector>
+#include "kernel/types.hpp"
+
+namespace demcal::kernel {
+
+class NeighborList {
+ public:
+  /// Rebuilds the list: pairs (i < j) with |x_i - x_j| < r_i + r_j + skin, excluding pairs of the same clump
+  /// (group[i] == group[j] >= 0). Histories of pairs present before are kept (matched by (i, j)); new pairs start
+  /// at zero. Uses `threads` OpenMP threads; the result does not depend on it.
+  void build(const std::vector<Vec3>& x, const std::vector<double>& r, const std::vector<std::int32_t>& group,
+             double skin, int threads);
+  /// True when some sphere moved more than skin/2 since the last build (or the list was never built / invalidated).
+  bool needs_rebuild(const std::vector<Vec3>& x, int threads) const;
+  /// Renumbers spheres after a removal or a permutation: old2new[old] = new index or -1 (removed). Pairs keep their
+  /// history (sign flipped where i and j swap order). The list must then be rebuilt before use (invalidated).
+  void renumber(const std::vector<std::int32_t>& old2new, std::size_t new_count);
+  void invalidate() { valid_ = false; }
+  bool valid() const { return valid_; }
+
+  std::size_t num_pairs() const { return nbr.size(); }
+  std::size_t num_builds() const { return builds_; }
+
+  // CSR half list: pairs of sphere i are p in [row[i], row[i+1]), partner nbr[p] > i, history hist[p].
+  std::vector<std::uint32_t> row;
+  std::vector<std::int32_t> nbr;
+  std::vector<Vec3> hist;
+  // transposed: pairs where sphere j is the partner: pair_of[q] for q in [trow[j], trow[j+1]), ascending i.
+  std::vector<std::uint32_t> trow;
+  std::vector<std::uint32_t> tpair;
+
+ private:
+  std::vector<Vec3> x_built_;
+  double skin_ = 0;
+  bool valid_ = false;
+  std::size_t builds_ = 0;
+  // cell grid scratch
+  std::vector<std::uint32_t> cell_start_, cell_items_, cell_of_;
+};
+
+/// All pairs (i < j, not in the same clump) whose spheres overlap (|x_i - x_j| < r_i + r_j), by brute force O(n^2).
+std::vector<std::pair<std::int32_t, std::int32_t>> brute_force_contacts(const std::vector<Vec3>& x,
+                                                                        const std::vector<double>& r,
+                                                                        const std::vector<std::int32_t>& group);
+
+}  // namespace demcal::kernel

@@ -1,0 +1,8 @@
+// The contact laws the kernel is compiled with. A new law: an alias in contact/ (or a new sub-model file) and one
+// line here.
+#include "kernel/simulation_impl.hpp"
+
+namespace demcal::kernel {
+template class BasicSimulation<HertzMindlinEdem>;
+template class BasicSimulation<HertzMindlin>;
+}  // namespace demcal::kernel

@@ -1,0 +1,206 @@
+// The native DEM simulation: spheres and rigid multi-sphere clumps, analytic walls, a contact law composed at
+// compile time (kernel/contact/contact_law.hpp), linked-cell + Verlet-skin neighbour list, velocity-Verlet
+// integration (clumps: angular momentum + Richardson quaternion update, as LAMMPS/LIGGGHTS fix rigid / multisphere),
+// OpenMP. Same input and thread count => bit-identical results (no atomics, fixed-order gathers and sums).
+//
+// Typical use:
+//   Simulation sim;
+//   int wheat = sim.add_material({.young = 2 * 3.58e8 * 1.4, .poisson = 0.4, .density = 1430});
+//   int steel = sim.add_material({.young = 2 * 8e8 * 1.3, .poisson = 0.3, .density = 7500});
+//   sim.set_pair(wheat, wheat, {.restitution = 0.5, .friction = 0.3, .rolling_friction = 0.01});
+//   sim.set_pair(wheat, steel, {.restitution = 0.6, .friction = 0.25, .rolling_friction = 0.01});
+//   int grain = sim.add_clump_template(wheat_clump_template());
+//   sim.add_wall(Wall::cylinder(0, 0, 0.0525, 0.0, 0.4, steel));
+//   sim.add_clump(grain, wheat, {0, 0, 0.1}, Quat::Identity());
+//   sim.set_timestep(0.3 * sim.rayleigh_timestep());
+//   sim.step(1000);
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "kernel/clump.hpp"
+#include "kernel/contact/contact_law.hpp"
+#include "kernel/material.hpp"
+#include "kernel/neighbor.hpp"
+#include "kernel/types.hpp"
+#include "kernel/walls.hpp"
+
+namespace demcal::kernel {
+
+/// A snapshot of one body (a single sphere or a clump), as returned by BasicSimulation::body().
+struct BodyState {
+  BodyId id = 0;                        ///< stable identity (assigned at insertion, never reused)
+  bool is_clump = false;                ///< false: a single sphere
+  int material = 0;                     ///< material id
+  int clump_template = -1;              ///< template id for clumps, -1 for spheres
+  double radius = 0;                    ///< sphere radius; for clumps the template's bounding radius [m]
+  double mass = 0;                      ///< [kg]
+  Vec3 position = Vec3::Zero();         ///< centre of mass [m]
+  Vec3 velocity = Vec3::Zero();         ///< velocity of the centre of mass [m/s]
+  Vec3 angular_velocity = Vec3::Zero(); ///< world frame [rad/s]
+  Quat orientation = Quat::Identity();  ///< template frame -> world (spheres: identity, not tracked)
+};
+
+/// A snapshot of one sphere (a single sphere or a clump member), for output/visualisation.
+struct SphereState {
+  Vec3 position = Vec3::Zero();  ///< [m]
+  Vec3 velocity = Vec3::Zero();  ///< velocity of the sphere's centre [m/s]
+  double radius = 0;             ///< [m]
+  int material = 0;
+  std::size_t body = 0;          ///< index of its body (valid until the next add/remove)
+};
+
+/// What remove_bodies_if removed.
+struct RemovalResult {
+  std::size_t count = 0;  ///< number of bodies removed
+  double mass = 0;        ///< their total mass [kg]
+};
+
+template <class Law>
+class BasicSimulation {
+ public:
+  BasicSimulation();
+
+  // ---------------------------------------------------------------- setup
+  /// Adds a material; returns its id (0, 1, ...). Validated: E > 0, -1 < nu < 0.5, density >= 0.
+  int add_material(const Material& m);
+  const Material& material(int id) const { return materials_.at(id); }
+  /// Sets the properties of the (unordered) material pair (a, b). Every pair of materials that can meet (particle-
+  /// particle, particle-wall) must be set before stepping, or step() throws naming the pair.
+  void set_pair(int a, int b, const PairProperties& p);
+  /// Gravity acceleration [m/s^2] (default (0, 0, -9.81)).
+  void set_gravity(const Vec3& g) { gravity_ = g; }
+  const Vec3& gravity() const { return gravity_; }
+  /// Time step [s] (> 0; no default: use e.g. 0.2-0.4 * rayleigh_timestep()).
+  void set_timestep(double dt);
+  double timestep() const { return dt_; }
+  /// Smallest Rayleigh time step over the spheres present (pi R sqrt(rho/G)/(0.1631 nu + 0.8766)) [s]; 0 if none.
+  double rayleigh_timestep() const;
+  /// Verlet skin [m] (default: 0.1 * the mean sphere radius at the first step if never set). The neighbour list is
+  /// rebuilt when a sphere has moved more than skin/2 since the last build.
+  void set_skin(double skin);
+  double skin() const { return skin_; }
+  /// Number of OpenMP threads (<= 0: omp_get_max_threads()). Results depend on nothing else but this... and not
+  /// even on it: every parallel loop writes disjoint data and every sum runs in a fixed order.
+  void set_threads(int n);
+  int threads() const { return threads_; }
+
+  /// Adds a wall; returns its id.
+  int add_wall(const Wall& w);
+  /// Enables/disables a wall (e.g. opens the outlet plate). A disabled wall exerts no force.
+  void set_wall_enabled(int id, bool enabled);
+  const Wall& wall(int id) const { return walls_.at(id); }
+  std::size_t num_walls() const { return walls_.size(); }
+  /// Total contact force exerted BY the particles ON wall `id` at the last force evaluation [N].
+  Vec3 wall_force(int id) const;
+
+  /// Registers a clump template (kernel/clump.hpp); returns its id. Its mass and inertia are used as they are
+  /// (make the template with the density of the material you will give the clumps).
+  int add_clump_template(const ClumpTemplate& t);
+  const ClumpTemplate& clump_template(int id) const { return templates_.at(id); }
+
+  /// Adds a single sphere; returns its id. position [m], radius [m] > 0, velocity [m/s], omega [rad/s].
+  BodyId add_sphere(const Vec3& position, double radius, int material, const Vec3& velocity = Vec3::Zero(),
+                    const Vec3& omega = Vec3::Zero());
+  /// Adds a rigid clump of template `tmpl`: its centre of mass at `com` [m], `orientation` rotating the template
+  /// frame into the world, velocity of the centre of mass [m/s], angular velocity omega [rad/s] (world frame).
+  BodyId add_clump(int tmpl, int material, const Vec3& com, const Quat& orientation = Quat::Identity(),
+                   const Vec3& velocity = Vec3::Zero(), const Vec3& omega = Vec3::Zero());
+
+  // ---------------------------------------------------------------- run
+  /// Advances n steps of the time step (velocity Verlet; forces at half-step velocities, as LAMMPS/LIGGGHTS).
+  void step(long n = 1);
+  double time() const { return time_; }           ///< simulated time [s]
+  long steps_done() const { return steps_; }      ///< steps taken so far
+
+  // ---------------------------------------------------------------- state
+  /// Bodies are indexed 0..num_bodies()-1 in insertion order; removal compacts (indices shift, ids stay).
+  std::size_t num_bodies() const { return body_ref_.size(); }
+  BodyState body(std::size_t i) const;
+  /// Sets the velocity [m/s] and angular velocity [rad/s, world] of body i.
+  void set_body_velocity(std::size_t i, const Vec3& velocity, const Vec3& omega);
+  /// Removes every body for which pred(state) is true; returns how many and their mass.
+  RemovalResult remove_bodies_if(const std::function<bool(const BodyState&)>& pred);
+
+  /// Spheres (single ones and clump members): 0..num_spheres()-1.
+  std::size_t num_spheres() const { return x_.size(); }
+  SphereState sphere(std::size_t k) const;
+  const std::vector<Vec3>& sphere_positions() const { return x_; }  ///< all sphere centres [m]
+  const std::vector<double>& sphere_radii() const { return r_; }    ///< all sphere radii [m]
+
+  /// Translational + rotational kinetic energy of all bodies [J].
+  double kinetic_energy() const;
+  double rotational_kinetic_energy() const;
+  /// Potential energy in gravity, -sum m g.x [J].
+  double potential_energy() const;
+  /// Total linear momentum [kg m/s] and angular momentum about `origin` [kg m^2/s].
+  Vec3 linear_momentum() const;
+  Vec3 angular_momentum(const Vec3& origin = Vec3::Zero()) const;
+  double total_mass() const;
+
+  // ---------------------------------------------------------------- diagnostics
+  /// Sphere pairs (i < j) overlapping now, found through the neighbour list (builds it if needed).
+  std::vector<std::pair<std::int32_t, std::int32_t>> contact_pairs();
+  /// The same by brute force (O(n^2); tests).
+  std::vector<std::pair<std::int32_t, std::int32_t>> contact_pairs_brute_force() const;
+  std::size_t neighbor_builds() const { return nl_.num_builds(); }
+  std::size_t neighbor_pairs() const { return nl_.num_pairs(); }
+  /// Approximate heap memory of the simulation's arrays [bytes].
+  std::size_t memory_bytes() const;
+
+ private:
+  void prepare();
+  void compute_forces();
+  void kick_drift();
+  void kick();
+  void update_members(std::size_t c, bool positions);
+  void rebuild_body_index();
+
+  // materials
+  std::vector<Material> materials_;
+  std::vector<PairProperties> pair_props_;  // nm * nm
+  std::vector<char> pair_set_;
+  std::vector<PairCoeffs> coeffs_;          // nm * nm (built in prepare)
+  int nm_coeffs_ = 0;
+  std::vector<Wall> walls_;
+  std::vector<Vec3> wall_force_;
+  std::vector<ClumpTemplate> templates_;
+
+  // per sphere (structure of arrays)
+  std::vector<Vec3> x_, v_, w_, f_, t_;
+  std::vector<double> r_, mass_, inv_mass_, inv_inertia_;  // mass_: body mass (m* of a clump member); inv_*: spheres
+  std::vector<std::int32_t> mat_, clump_;                  // clump_: clump index or -1
+  static constexpr int kWallSlots = 3;                      // wall contacts with history per sphere
+  std::vector<std::int32_t> wall_slot_id_;                  // kWallSlots per sphere, -1 empty
+  std::vector<Vec3> wall_slot_s_, wall_slot_f_;             // history, force on the sphere
+  std::vector<Vec3> pair_f_, pair_tj_;                      // per pair: force on i, torque on j
+
+  // per clump
+  std::vector<Vec3> cx_, cv_, cw_, cL_, cI_, cF_, cT_;
+  std::vector<Quat> cq_;  // principal frame -> world
+  std::vector<double> cm_;
+  std::vector<std::int32_t> ctmpl_, cmat_;
+  std::vector<std::uint32_t> cmem_start_, cmem_;  // member sphere indices (CSR)
+
+  // bodies
+  std::vector<std::int32_t> body_ref_;  // >= 0: sphere index; < 0: -(clump + 1)
+  std::vector<BodyId> body_id_;
+  std::vector<std::uint32_t> sphere_body_, clump_body_;  // inverse maps
+  BodyId next_id_ = 1;
+
+  NeighborList nl_;
+  Vec3 gravity_ = Vec3(0, 0, -9.81);
+  double dt_ = 0, time_ = 0, skin_ = -1;
+  long steps_ = 0;
+  int threads_ = 1;
+  bool forces_valid_ = false, prepared_ = false;
+};
+
+extern template class BasicSimulation<HertzMindlinEdem>;
+extern template class BasicSimulation<HertzMindlin>;
+
+/// The seed's model: Hertz-Mindlin (no slip) + EDEM constant directional torque rolling friction.
+using Simulation = BasicSimulation<HertzMindlinEdem>;
+
+}  // namespace demcal::kernel

@@ -1,0 +1,684 @@
+// Implementation of BasicSimulation<Law>; included only by the .cpp files that instantiate a law
+// (kernel/simulation.cpp). See simulation.hpp for the interface.
+#pragma once
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "kernel/simulation.hpp"
+
+namespace demcal::kernel {
+
+namespace detail {
+/// omega (world) from angular momentum L (world), orientation q (principal -> world) and principal moments I.
+inline Vec3 omega_from_L(const Quat& q, const Vec3& L, const Vec3& I) {
+  const Mat3 R = q.toRotationMatrix();
+  const Vec3 lb = R.transpose() * L;
+  return R * Vec3(I.x() > 0 ? lb.x() / I.x() : 0.0, I.y() > 0 ? lb.y() / I.y() : 0.0, I.z() > 0 ? lb.z() / I.z() : 0.0);
+}
+/// dq/dt = 1/2 (0, w) q
+inline Quat wq(const Vec3& w, const Quat& q) {
+  const Quat p = Quat(0.0, w.x(), w.y(), w.z()) * q;
+  return p;
+}
+inline Quat qadd(const Quat& a, double s, const Quat& b) {
+  return Quat(a.w() + s * b.w(), a.x() + s * b.x(), a.y() + s * b.y(), a.z() + s * b.z());
+}
+/// Richardson iteration for the quaternion over dt (LAMMPS MathExtra::richardson), with L fixed over the step.
+inline void richardson(Quat& q, const Vec3& L, Vec3& w, const Vec3& I, double dt) {
+  const double dtq = 0.5 * dt;
+  Quat wq0 = wq(w, q);
+  Quat qfull = qadd(q, dtq, wq0);
+  qfull.normalize();
+  Quat qhalf = qadd(q, 0.5 * dtq, wq0);
+  qhalf.normalize();
+  w = omega_from_L(qhalf, L, I);
+  Quat wq1 = wq(w, qhalf);
+  qhalf = qadd(qhalf, 0.5 * dtq, wq1);
+  qhalf.normalize();
+  q = Quat(2 * qhalf.w() - qfull.w(), 2 * qhalf.x() - qfull.x(), 2 * qhalf.y() - qfull.y(), 2 * qhalf.z() - qfull.z());
+  q.normalize();
+}
+}  // namespace detail
+
+template <class Law>
+BasicSimulation<Law>::BasicSimulation() {
+  threads_ = 1;
+}
+
+template <class Law>
+int BasicSimulation<Law>::add_material(const Material& m) {
+  if (!(m.young > 0)) throw std::invalid_argument("material young must be > 0, got " + std::to_string(m.young));
+  if (!(m.poisson > -1 && m.poisson < 0.5))
+    throw std::invalid_argument("material poisson must be in (-1, 0.5), got " + std::to_string(m.poisson));
+  if (!(m.density >= 0)) throw std::invalid_argument("material density must be >= 0, got " + std::to_string(m.density));
+  const int nm_old = int(materials_.size());
+  materials_.push_back(m);
+  const int nm = nm_old + 1;
+  std::vector<PairProperties> pp(nm * nm);
+  std::vector<char> ps(nm * nm, 0);
+  for (int a = 0; a < nm_old; ++a)
+    for (int b = 0; b < nm_old; ++b) {
+      pp[a * nm + b] = pair_props_[a * nm_old + b];
+      ps[a * nm + b] = pair_set_[a * nm_old + b];
+    }
+  pair_props_ = std::move(pp);
+  pair_set_ = std::move(ps);
+  prepared_ = false;
+  return nm - 1;
+}
+
+template <class Law>
+void BasicSimulation<Law>::set_pair(int a, int b, const PairProperties& p) {
+  const int nm = int(materials_.size());
+  if (a < 0 || b < 0 || a >= nm || b >= nm) throw std::invalid_argument("set_pair: unknown material id");
+  restitution_beta(p.restitution);  // validates
+  if (!(p.friction >= 0)) throw std::invalid_argument("set_pair: friction must be >= 0");
+  if (!(p.rolling_friction >= 0)) throw std::invalid_argument("set_pair: rolling_friction must be >= 0");
+  pair_props_[a * nm + b] = pair_props_[b * nm + a] = p;
+  pair_set_[a * nm + b] = pair_set_[b * nm + a] = 1;
+  prepared_ = false;
+}
+
+template <class Law>
+void BasicSimulation<Law>::set_timestep(double dt) {
+  if (!(dt > 0)) throw std::invalid_argument("set_timestep: dt must be > 0");
+  dt_ = dt;
+}
+
+template <class Law>
+double BasicSimulation<Law>::rayleigh_timestep() const {
+  double best = 0;
+  for (std::size_t k = 0; k < r_.size(); ++k) {
+    const Material& m = materials_[mat_[k]];
+    const double t = kernel::rayleigh_timestep(r_[k], m.density, m.shear_modulus(), m.poisson);
+    if (best == 0 || t < best) best = t;
+  }
+  return best;
+}
+
+template <class Law>
+void BasicSimulation<Law>::set_skin(double skin) {
+  if (!(skin > 0)) throw std::invalid_argument("set_skin: skin must be > 0");
+  skin_ = skin;
+  nl_.invalidate();
+}
+
+template <class Law>
+void BasicSimulation<Law>::set_threads(int n) {
+  threads_ = n > 0 ? n : omp_get_max_threads();
+}
+
+template <class Law>
+int BasicSimulation<Law>::add_wall(const Wall& w) {
+  if (w.material < 0 || w.material >= int(materials_.size())) throw std::invalid_argument("add_wall: unknown material");
+  walls_.push_back(w);
+  wall_force_.push_back(Vec3::Zero());
+  prepared_ = false;
+  forces_valid_ = false;
+  return int(walls_.size()) - 1;
+}
+
+template <class Law>
+void BasicSimulation<Law>::set_wall_enabled(int id, bool enabled) {
+  walls_.at(id).enabled = enabled;
+  forces_valid_ = false;
+}
+
+template <class Law>
+Vec3 BasicSimulation<Law>::wall_force(int id) const {
+  return wall_force_.at(id);
+}
+
+template <class Law>
+int BasicSimulation<Law>::add_clump_template(const ClumpTemplate& t) {
+  if (t.offsets.empty() || !(t.mass > 0)) throw std::invalid_argument("add_clump_template: use make_clump_template");
+  templates_.push_back(t);
+  return int(templates_.size()) - 1;
+}
+
+template <class Law>
+BodyId BasicSimulation<Law>::add_sphere(const Vec3& position, double radius, int material, const Vec3& velocity,
+                                        const Vec3& omega) {
+  if (material < 0 || material >= int(materials_.size())) throw std::invalid_argument("add_sphere: unknown material");
+  if (!(radius > 0)) throw std::invalid_argument("add_sphere: radius must be > 0");
+  const double rho = materials_[material].density;
+  if (!(rho > 0)) throw std::invalid_argument("add_sphere: the material's density must be > 0");
+  const double m = rho * 4.0 / 3.0 * M_PI * radius * radius * radius;
+  x_.push_back(position); v_.push_back(velocity); w_.push_back(omega);
+  f_.push_back(Vec3::Zero()); t_.push_back(Vec3::Zero());
+  r_.push_back(radius); mass_.push_back(m); inv_mass_.push_back(1.0 / m);
+  inv_inertia_.push_back(1.0 / (0.4 * m * radius * radius));
+  mat_.push_back(material); clump_.push_back(-1);
+  for (int s = 0; s < kWallSlots; ++s) { wall_slot_id_.push_back(-1); wall_slot_s_.push_back(Vec3::Zero()); wall_slot_f_.push_back(Vec3::Zero()); }
+  body_ref_.push_back(std::int32_t(x_.size() - 1));
+  body_id_.push_back(next_id_);
+  rebuild_body_index();
+  forces_valid_ = false;
+  nl_.invalidate();
+  return next_id_++;
+}
+
+template <class Law>
+BodyId BasicSimulation<Law>::add_clump(int tmpl, int material, const Vec3& com, const Quat& orientation,
+                                       const Vec3& velocity, const Vec3& omega) {
+  if (tmpl < 0 || tmpl >= int(templates_.size())) throw std::invalid_argument("add_clump: unknown template");
+  if (material < 0 || material >= int(materials_.size())) throw std::invalid_argument("add_clump: unknown material");
+  const ClumpTemplate& t = templates_[tmpl];
+  const std::size_t c = cx_.size();
+  const Quat q = (orientation.normalized() * t.principal).normalized();
+  cx_.push_back(com); cv_.push_back(velocity); cw_.push_back(omega);
+  cq_.push_back(q); cI_.push_back(t.inertia); cm_.push_back(t.mass);
+  // L = R I R^T omega
+  const Mat3 R = q.toRotationMatrix();
+  cL_.push_back(R * t.inertia.asDiagonal() * (R.transpose() * omega));
+  cF_.push_back(Vec3::Zero()); cT_.push_back(Vec3::Zero());
+  ctmpl_.push_back(tmpl); cmat_.push_back(material);
+  if (cmem_start_.empty()) cmem_start_.push_back(0);
+  for (std::size_t k = 0; k < t.offsets.size(); ++k) {
+    const Vec3 d = R * t.offsets[k];
+    cmem_.push_back(std::uint32_t(x_.size()));
+    x_.push_back(com + d); v_.push_back(velocity + omega.cross(d)); w_.push_back(omega);
+    f_.push_back(Vec3::Zero()); t_.push_back(Vec3::Zero());
+    r_.push_back(t.radii[k]); mass_.push_back(t.mass); inv_mass_.push_back(0.0); inv_inertia_.push_back(0.0);
+    mat_.push_back(material); clump_.push_back(std::int32_t(c));
+    for (int s = 0; s < kWallSlots; ++s) { wall_slot_id_.push_back(-1); wall_slot_s_.push_back(Vec3::Zero()); wall_slot_f_.push_back(Vec3::Zero()); }
+  }
+  cmem_start_.push_back(std::uint32_t(cmem_.size()));
+  body_ref_.push_back(-std::int32_t(c) - 1);
+  body_id_.push_back(next_id_);
+  rebuild_body_index();
+  forces_valid_ = false;
+  nl_.invalidate();
+  return next_id_++;
+}
+
+template <class Law>
+void BasicSimulation<Law>::rebuild_body_index() {
+  sphere_body_.assign(x_.size(), 0);
+  clump_body_.assign(cx_.size(), 0);
+  for (std::size_t b = 0; b < body_ref_.size(); ++b) {
+    const std::int32_t ref = body_ref_[b];
+    if (ref >= 0) {
+      sphere_body_[ref] = std::uint32_t(b);
+    } else {
+      const std::size_t c = std::size_t(-ref - 1);
+      clump_body_[c] = std::uint32_t(b);
+      for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) sphere_body_[cmem_[k]] = std::uint32_t(b);
+    }
+  }
+}
+
+template <class Law>
+void BasicSimulation<Law>::prepare() {
+  if (!(dt_ > 0)) throw std::logic_error("step: set_timestep() first");
+  const int nm = int(materials_.size());
+  if (!prepared_) {
+    std::vector<char> used(nm, 0), used_wall(nm, 0);
+    for (auto m : mat_) used[m] = 1;
+    for (const Wall& w : walls_) used_wall[w.material] = 1;
+    coeffs_.assign(nm * nm, PairCoeffs{});
+    for (int a = 0; a < nm; ++a)
+      for (int b = 0; b < nm; ++b) {
+        const bool needed = used[a] && (used[b] || used_wall[b]);
+        if (pair_set_[a * nm + b]) {
+          coeffs_[a * nm + b] = make_pair_coeffs(materials_[a], materials_[b], pair_props_[a * nm + b]);
+        } else if (needed) {
+          throw std::logic_error("step: material pair (" + std::to_string(a) + ", " + std::to_string(b) +
+                                 ") has no properties: call set_pair()");
+        }
+      }
+    nm_coeffs_ = nm;
+    prepared_ = true;
+  }
+  if (skin_ <= 0) {
+    double rs = 0;
+    for (double r : r_) rs += r;
+    skin_ = r_.empty() ? 1e-4 : 0.1 * rs / double(r_.size());
+  }
+}
+
+template <class Law>
+void BasicSimulation<Law>::update_members(std::size_t c, bool positions) {
+  const Mat3 R = cq_[c].toRotationMatrix();
+  const ClumpTemplate& t = templates_[ctmpl_[c]];
+  const Vec3 w = cw_[c];
+  for (std::uint32_t k = cmem_start_[c], m = 0; k < cmem_start_[c + 1]; ++k, ++m) {
+    const std::uint32_t s = cmem_[k];
+    const Vec3 d = R * t.offsets[m];
+    if (positions) x_[s] = cx_[c] + d;
+    v_[s] = cv_[c] + w.cross(d);
+    w_[s] = w;
+  }
+}
+
+template <class Law>
+void BasicSimulation<Law>::kick_drift() {
+  const double h = 0.5 * dt_, dt = dt_;
+  const Vec3 g = gravity_;
+  const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
+#pragma omp parallel num_threads(threads_)
+  {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (clump_[i] >= 0) continue;
+      v_[i] += h * (f_[i] * inv_mass_[i] + g);
+      w_[i] += (h * inv_inertia_[i]) * t_[i];
+      x_[i] += dt * v_[i];
+    }
+#pragma omp for schedule(static)
+    for (std::int64_t c = 0; c < nc; ++c) {
+      cv_[c] += h * (cF_[c] / cm_[c] + g);
+      cx_[c] += dt * cv_[c];
+      cL_[c] += h * cT_[c];
+      Vec3 w = detail::omega_from_L(cq_[c], cL_[c], cI_[c]);
+      detail::richardson(cq_[c], cL_[c], w, cI_[c], dt);
+      cw_[c] = detail::omega_from_L(cq_[c], cL_[c], cI_[c]);
+      update_members(std::size_t(c), true);
+    }
+  }
+}
+
+template <class Law>
+void BasicSimulation<Law>::kick() {
+  const double h = 0.5 * dt_;
+  const Vec3 g = gravity_;
+  const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
+#pragma omp parallel num_threads(threads_)
+  {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (clump_[i] >= 0) continue;
+      v_[i] += h * (f_[i] * inv_mass_[i] + g);
+      w_[i] += (h * inv_inertia_[i]) * t_[i];
+    }
+#pragma omp for schedule(static)
+    for (std::int64_t c = 0; c < nc; ++c) {
+      cv_[c] += h * (cF_[c] / cm_[c] + g);
+      cL_[c] += h * cT_[c];
+      cw_[c] = detail::omega_from_L(cq_[c], cL_[c], cI_[c]);
+      update_members(std::size_t(c), false);
+    }
+  }
+}
+
+template <class Law>
+void BasicSimulation<Law>::compute_forces() {
+  if (nl_.needs_rebuild(x_, threads_)) nl_.build(x_, r_, clump_, skin_, threads_);
+  const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
+  pair_f_.resize(nl_.num_pairs());
+  pair_tj_.resize(nl_.num_pairs());
+  const int nm = nm_coeffs_;
+  const double dt = dt_;
+  const int nw = int(walls_.size());
+  const std::uint32_t* row = nl_.row.data();
+  const std::int32_t* nbr = nl_.nbr.data();
+  Vec3* hist = nl_.hist.data();
+#pragma omp parallel num_threads(threads_)
+  {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {
+      Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
+      const Vec3 xi = x_[i], vi = v_[i], wi = w_[i];
+      const double ri = r_[i], mi = mass_[i];
+      const PairCoeffs* crow = coeffs_.data() + std::size_t(mat_[i]) * nm;
+      for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+        const std::int32_t j = nbr[p];
+        const Vec3 d = xi - x_[j];
+        const double rs = ri + r_[j];
+        const double d2 = d.squaredNorm();
+        if (d2 >= rs * rs) {
+          hist[p].setZero();
+          pair_f_[p].setZero();
+          pair_tj_[p].setZero();
+          continue;
+        }
+        const double dist = std::sqrt(d2);
+        ContactGeometry geo;
+        geo.n = d / dist;
+        geo.dn = rs - dist;
+        geo.radius_i = ri;
+        geo.radius_j = r_[j];
+        geo.r_star = ri * r_[j] / rs;
+        geo.m_star = mi * mass_[j] / (mi + mass_[j]);
+        geo.lever_i = ri - 0.5 * geo.dn;
+        geo.lever_j = r_[j] - 0.5 * geo.dn;
+        ContactKinematics kin;
+        kin.omega_i = wi;
+        kin.omega_j = w_[j];
+        kin.v_rel = (vi - geo.lever_i * wi.cross(geo.n)) - (v_[j] + geo.lever_j * w_[j].cross(geo.n));
+        const ContactResult res = Law::compute(crow[mat_[j]], geo, kin, hist[p], dt, false);
+        fi += res.force_i;
+        ti += res.torque_i;
+        pair_f_[p] = res.force_i;
+        pair_tj_[p] = res.torque_j;
+      }
+      // walls: up to kWallSlots simultaneous contacts keep a history
+      if (nw > 0) {
+        std::int32_t* sid = &wall_slot_id_[std::size_t(i) * kWallSlots];
+        Vec3* ss = &wall_slot_s_[std::size_t(i) * kWallSlots];
+        Vec3* sf = &wall_slot_f_[std::size_t(i) * kWallSlots];
+        std::int32_t nid[kWallSlots] = {-1, -1, -1};
+        Vec3 ns[kWallSlots], nf[kWallSlots];
+        int used = 0;
+        for (int wdx = 0; wdx < nw; ++wdx) {
+          const Wall& wall = walls_[wdx];
+          if (!wall.enabled) continue;
+          Vec3 nrm;
+          double dn, dist;
+          if (!wall.contact(xi, ri, nrm, dn, dist)) continue;
+          Vec3 s = Vec3::Zero();
+          for (int k = 0; k < kWallSlots; ++k)
+            if (sid[k] == wdx) s = ss[k];
+          ContactGeometry geo;
+          geo.n = nrm;
+          geo.dn = dn;
+          geo.radius_i = ri;
+          geo.radius_j = 0;
+          geo.r_star = ri;
+          geo.m_star = mi;
+          geo.lever_i = dist;
+          geo.lever_j = 0;
+          ContactKinematics kin;
+          kin.omega_i = wi;
+          kin.omega_j = Vec3::Zero();
+          kin.v_rel = vi - dist * wi.cross(nrm);
+          const ContactResult res = Law::compute(crow[wall.material], geo, kin, s, dt, true);
+          fi += res.force_i;
+          ti += res.torque_i;
+          if (used < kWallSlots) {
+            nid[used] = wdx;
+            ns[used] = s;
+            nf[used] = res.force_i;
+            ++used;
+          }
+        }
+        for (int k = 0; k < kWallSlots; ++k) {
+          sid[k] = nid[k];
+          ss[k] = k < used ? ns[k] : Vec3::Zero();
+          sf[k] = k < used ? nf[k] : Vec3::Zero();
+        }
+      }
+      f_[i] = fi;
+      t_[i] = ti;
+    }
+    // gather the j-side of each pair in a fixed order (ascending i)
+    const std::uint32_t* trow = nl_.trow.data();
+    const std::uint32_t* tpair = nl_.tpair.data();
+#pragma omp for schedule(static)
+    for (std::int64_t j = 0; j < n; ++j) {
+      Vec3 fj = Vec3::Zero(), tj = Vec3::Zero();
+      for (std::uint32_t q = trow[j]; q < trow[j + 1]; ++q) {
+        const std::uint32_t p = tpair[q];
+        fj -= pair_f_[p];
+        tj += pair_tj_[p];
+      }
+      f_[j] += fj;
+      t_[j] += tj;
+    }
+    // clumps: total force and torque about the centre of mass (members in a fixed order)
+#pragma omp for schedule(static)
+    for (std::int64_t c = 0; c < nc; ++c) {
+      Vec3 F = Vec3::Zero(), T = Vec3::Zero();
+      for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) {
+        const std::uint32_t s = cmem_[k];
+        F += f_[s];
+        T += t_[s] + (x_[s] - cx_[c]).cross(f_[s]);
+      }
+      cF_[c] = F;
+      cT_[c] = T;
+    }
+  }
+  // wall forces (serial, fixed order)
+  for (int wdx = 0; wdx < nw; ++wdx) wall_force_[wdx].setZero();
+  if (nw > 0)
+    for (std::int64_t i = 0; i < n; ++i)
+      for (int k = 0; k < kWallSlots; ++k) {
+        const std::int32_t id = wall_slot_id_[std::size_t(i) * kWallSlots + k];
+        if (id >= 0) wall_force_[id] -= wall_slot_f_[std::size_t(i) * kWallSlots + k];
+      }
+}
+
+template <class Law>
+void BasicSimulation<Law>::step(long nsteps) {
+  prepare();
+  if (!forces_valid_) {
+    compute_forces();
+    forces_valid_ = true;
+  }
+  for (long s = 0; s < nsteps; ++s) {
+    kick_drift();
+    compute_forces();
+    kick();
+    time_ += dt_;
+    ++steps_;
+  }
+}
+
+template <class Law>
+BodyState BasicSimulation<Law>::body(std::size_t b) const {
+  BodyState s;
+  const std::int32_t ref = body_ref_.at(b);
+  s.id = body_id_[b];
+  if (ref >= 0) {
+    s.is_clump = false;
+    s.material = mat_[ref];
+    s.radius = r_[ref];
+    s.mass = mass_[ref];
+    s.position = x_[ref];
+    s.velocity = v_[ref];
+    s.angular_velocity = w_[ref];
+  } else {
+    const std::size_t c = std::size_t(-ref - 1);
+    const ClumpTemplate& t = templates_[ctmpl_[c]];
+    s.is_clump = true;
+    s.material = cmat_[c];
+    s.clump_template = ctmpl_[c];
+    s.radius = t.bounding_radius;
+    s.mass = cm_[c];
+    s.position = cx_[c];
+    s.velocity = cv_[c];
+    s.angular_velocity = cw_[c];
+    s.orientation = (cq_[c] * t.principal.conjugate()).normalized();
+  }
+  return s;
+}
+
+template <class Law>
+void BasicSimulation<Law>::set_body_velocity(std::size_t b, const Vec3& velocity, const Vec3& omega) {
+  const std::int32_t ref = body_ref_.at(b);
+  if (ref >= 0) {
+    v_[ref] = velocity;
+    w_[ref] = omega;
+  } else {
+    const std::size_t c = std::size_t(-ref - 1);
+    cv_[c] = velocity;
+    cw_[c] = omega;
+    const Mat3 R = cq_[c].toRotationMatrix();
+    cL_[c] = R * cI_[c].asDiagonal() * (R.transpose() * omega);
+    update_members(c, false);
+  }
+  forces_valid_ = false;
+}
+
+template <class Law>
+RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(const BodyState&)>& pred) {
+  RemovalResult res;
+  std::vector<char> drop_body(body_ref_.size(), 0);
+  for (std::size_t b = 0; b < body_ref_.size(); ++b) {
+    const BodyState s = body(b);
+    if (pred(s)) {
+      drop_body[b] = 1;
+      ++res.count;
+      res.mass += s.mass;
+    }
+  }
+  if (res.count == 0) return res;
+  const std::size_t n = x_.size(), nc = cx_.size();
+  std::vector<char> drop_sphere(n, 0), drop_clump(nc, 0);
+  for (std::size_t b = 0; b < body_ref_.size(); ++b) {
+    if (!drop_body[b]) continue;
+    const std::int32_t ref = body_ref_[b];
+    if (ref >= 0) {
+      drop_sphere[ref] = 1;
+    } else {
+      const std::size_t c = std::size_t(-ref - 1);
+      drop_clump[c] = 1;
+      for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) drop_sphere[cmem_[k]] = 1;
+    }
+  }
+  std::vector<std::int32_t> s_old2new(n, -1), c_old2new(nc, -1);
+  std::size_t ns = 0, ncn = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!drop_sphere[i]) s_old2new[i] = std::int32_t(ns++);
+  for (std::size_t c = 0; c < nc; ++c)
+    if (!drop_clump[c]) c_old2new[c] = std::int32_t(ncn++);
+  // compact per-sphere arrays
+  auto compact = [&](auto& vec, std::size_t per) {
+    std::size_t o = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (drop_sphere[i]) continue;
+      for (std::size_t k = 0; k < per; ++k) vec[o * per + k] = vec[i * per + k];
+      ++o;
+    }
+    vec.resize(o * per);
+  };
+  compact(x_, 1); compact(v_, 1); compact(w_, 1); compact(f_, 1); compact(t_, 1);
+  compact(r_, 1); compact(mass_, 1); compact(inv_mass_, 1); compact(inv_inertia_, 1); compact(mat_, 1);
+  compact(clump_, 1);
+  compact(wall_slot_id_, kWallSlots); compact(wall_slot_s_, kWallSlots); compact(wall_slot_f_, kWallSlots);
+  for (auto& c : clump_)
+    if (c >= 0) c = c_old2new[c];
+  // compact per-clump arrays
+  auto ccompact = [&](auto& vec) {
+    std::size_t o = 0;
+    for (std::size_t c = 0; c < nc; ++c)
+      if (!drop_clump[c]) vec[o++] = vec[c];
+    vec.resize(o);
+  };
+  std::vector<std::uint32_t> mem_start{0}, mem;
+  for (std::size_t c = 0; c < nc; ++c) {
+    if (drop_clump[c]) continue;
+    for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) mem.push_back(std::uint32_t(s_old2new[cmem_[k]]));
+    mem_start.push_back(std::uint32_t(mem.size()));
+  }
+  cmem_start_ = std::move(mem_start);
+  cmem_ = std::move(mem);
+  ccompact(cx_); ccompact(cv_); ccompact(cw_); ccompact(cL_); ccompact(cI_); ccompact(cF_); ccompact(cT_);
+  ccompact(cq_); ccompact(cm_); ccompact(ctmpl_); ccompact(cmat_);
+  // bodies
+  std::vector<std::int32_t> refs;
+  std::vector<BodyId> ids;
+  for (std::size_t b = 0; b < body_ref_.size(); ++b) {
+    if (drop_body[b]) continue;
+    const std::int32_t ref = body_ref_[b];
+    refs.push_back(ref >= 0 ? s_old2new[ref] : -c_old2new[std::size_t(-ref - 1)] - 1);
+    ids.push_back(body_id_[b]);
+  }
+  body_ref_ = std::move(refs);
+  body_id_ = std::move(ids);
+  rebuild_body_index();
+  nl_.renumber(s_old2new, ns);
+  // forces of the remaining spheres are still valid except for the contacts with removed ones; recompute
+  forces_valid_ = false;
+  return res;
+}
+
+template <class Law>
+SphereState BasicSimulation<Law>::sphere(std::size_t k) const {
+  SphereState s;
+  s.position = x_.at(k);
+  s.velocity = v_[k];
+  s.radius = r_[k];
+  s.material = mat_[k];
+  s.body = sphere_body_[k];
+  return s;
+}
+
+template <class Law>
+double BasicSimulation<Law>::rotational_kinetic_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    if (clump_[i] < 0) e += 0.5 * w_[i].squaredNorm() / inv_inertia_[i];
+  for (std::size_t c = 0; c < cx_.size(); ++c) e += 0.5 * cL_[c].dot(cw_[c]);
+  return e;
+}
+
+template <class Law>
+double BasicSimulation<Law>::kinetic_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    if (clump_[i] < 0) e += 0.5 * mass_[i] * v_[i].squaredNorm();
+  for (std::size_t c = 0; c < cx_.size(); ++c) e += 0.5 * cm_[c] * cv_[c].squaredNorm();
+  return e + rotational_kinetic_energy();
+}
+
+template <class Law>
+double BasicSimulation<Law>::potential_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    if (clump_[i] < 0) e -= mass_[i] * gravity_.dot(x_[i]);
+  for (std::size_t c = 0; c < cx_.size(); ++c) e -= cm_[c] * gravity_.dot(cx_[c]);
+  return e;
+}
+
+template <class Law>
+Vec3 BasicSimulation<Law>::linear_momentum() const {
+  Vec3 p = Vec3::Zero();
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    if (clump_[i] < 0) p += mass_[i] * v_[i];
+  for (std::size_t c = 0; c < cx_.size(); ++c) p += cm_[c] * cv_[c];
+  return p;
+}
+
+template <class Law>
+Vec3 BasicSimulation<Law>::angular_momentum(const Vec3& o) const {
+  Vec3 L = Vec3::Zero();
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    if (clump_[i] < 0) L += mass_[i] * (x_[i] - o).cross(v_[i]) + w_[i] / inv_inertia_[i];
+  for (std::size_t c = 0; c < cx_.size(); ++c) L += cm_[c] * (cx_[c] - o).cross(cv_[c]) + cL_[c];
+  return L;
+}
+
+template <class Law>
+double BasicSimulation<Law>::total_mass() const {
+  double m = 0;
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    if (clump_[i] < 0) m += mass_[i];
+  for (double cm : cm_) m += cm;
+  return m;
+}
+
+template <class Law>
+std::vector<std::pair<std::int32_t, std::int32_t>> BasicSimulation<Law>::contact_pairs() {
+  prepare();
+  if (nl_.needs_rebuild(x_, threads_)) nl_.build(x_, r_, clump_, skin_, threads_);
+  std::vector<std::pair<std::int32_t, std::int32_t>> out;
+  for (std::size_t i = 0; i + 1 < nl_.row.size(); ++i)
+    for (std::uint32_t p = nl_.row[i]; p < nl_.row[i + 1]; ++p) {
+      const std::int32_t j = nl_.nbr[p];
+      const double c = r_[i] + r_[j];
+      if ((x_[i] - x_[j]).squaredNorm() < c * c) out.emplace_back(std::int32_t(i), j);
+    }
+  return out;
+}
+
+template <class Law>
+std::vector<std::pair<std::int32_t, std::int32_t>> BasicSimulation<Law>::contact_pairs_brute_force() const {
+  return brute_force_contacts(x_, r_, clump_);
+}
+
+template <class Law>
+std::size_t BasicSimulation<Law>::memory_bytes() const {
+  const std::size_t n = x_.size();
+  std::size_t b = n * (5 * sizeof(Vec3) + 4 * sizeof(double) + 2 * sizeof(std::int32_t) +
+                       kWallSlots * (sizeof(std::int32_t) + 2 * sizeof(Vec3)) + sizeof(std::uint32_t));
+  b += nl_.num_pairs() * (sizeof(std::int32_t) + 3 * sizeof(Vec3) + sizeof(std::uint32_t)) + 2 * (n + 1) * 4;
+  b += cx_.size() * (7 * sizeof(Vec3) + sizeof(Quat) + sizeof(double) + 3 * 4);
+  return b;
+}
+
+}  // namespace demcal::kernel
