@@ -67,6 +67,7 @@ CONSOLIDATION_INERTIAL_NUMBER = 0.01  # lid speed limit while consolidating: I =
 SERVO_PERIOD = 10                # steps between lid velocity updates
 SERVO_GAIN = 1.0                 # fraction of the force error corrected per update, relative to the lid contact stiffness
 INTEGRAL_GAIN = 0.1              # integral part of the servo: this fraction of the proportional speed accumulates per update
+STIFFNESS_SMOOTHING = 0.1        # weight of the newest lid stiffness in its running mean (see servo_step)
 INTEGRAL_BAND = 0.25             # ...only while the force error is below this fraction of the target
 APPROACH_BELOW = 0.10            # while consolidating, a force error above this fraction of the target: fast approach
 CONSOLIDATION_CHUNK = 200        # steps between quasi-static checks
@@ -330,7 +331,7 @@ def main():
     # While the radii grow the lid waits (no way down) but must rise as fast as a jammed column would expand.
     growth_expansion_speed = cloud_height * GROWTH_SURFACE_SPEED / r_mean
     servo = {"vx": 0.0, "approach": True, "cap_down": 0.0, "cap_up": max(lid_speed_up, 2 * growth_expansion_speed),
-             "v_integral": 0.0,
+             "v_integral": 0.0, "k_mean": 0.0,
              "sum_fz": 0.0, "sum_fx": 0.0, "count": 0, "max_fz": 0.0}
     growth = {"remaining": 1.0 / size_factor, "per_call": 1.0}
 
@@ -365,6 +366,13 @@ def main():
         for inter in O.interactions.withBody(lid_id):
             if inter.isReal:
                 stiffness += inter.phys.kn
+        # The lid's contact stiffness rises and falls with its force; dividing the error by the instantaneous value
+        # rectifies a vibrating sample into a steady drift (low force, few contacts: fast down; high force: slow up),
+        # which held the tiny box 20 % above target (measured). A running mean over about 10 updates removes that bias.
+        if stiffness > 0:
+            k = servo["k_mean"]
+            servo["k_mean"] = stiffness if k <= 0 else k + STIFFNESS_SMOOTHING * (stiffness - k)
+        stiffness = servo["k_mean"]
         error = force_target - fz
         if stiffness > 0:
             vz = -SERVO_GAIN * error / (stiffness * O.dt * SERVO_PERIOD)

@@ -64,8 +64,8 @@ TEST_CASE("a tiny YADE shear campaign gives positive peaks and a failure line, a
     fs::remove_all(dir);
 }
 
-TEST_CASE("a run whose script raises is recorded as failed and a hanging run is killed at its timeout; the others "
-          "finish", "[yade]") {
+TEST_CASE("a run whose script raises is recorded as failed and a hanging run is killed at its timeout while the "
+          "others finish", "[yade]") {
     const fs::path dir = test::fresh_test_dir("failing-campaign");
     // A template that is the real shear box, preceded by two deliberate faults chosen by the normal stress.
     const std::string faults =
