@@ -2,6 +2,7 @@
 // and the particle-enlargement laws (seed eqs. 3.1-3.2). Every simulation is a stored, cached, resumable campaign run.
 #include "analytics/scaling_law.hpp"
 #include "app/commands.hpp"
+#include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
 #include "calibration/calibration_loop.hpp"
 #include "calibration/campaign_evaluator.hpp"
@@ -44,10 +45,7 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
     cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
     cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
     cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
-    cmd->add_option("--jobs,-j", c.exec.jobs, "runs in parallel (0 = one per core)")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--timeout", c.exec.timeout_s, "per-run wall-clock limit [s]")->check(CLI::PositiveNumber);
-    cmd->add_option("--executor", c.exec.executor, "local or slurm")->check(CLI::IsMember({"local", "slurm"}));
-    cmd->add_option("--yade", c.exec.yade, "YADE launcher to run");
+    add_execution_options(cmd, c.exec);
 }
 
 nlohmann::json read_json(const std::string& path, const std::string& field) {

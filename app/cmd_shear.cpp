@@ -1,5 +1,6 @@
 // demcal shear / status / resume: YADE direct-shear campaigns and their failure lines.
 #include "app/commands.hpp"
+#include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/run_identity.hpp"
@@ -196,16 +197,6 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
     }
     if (outcome.interrupted) return 130;
     return outcome.failed > 0 ? 1 : 0;
-}
-
-void add_execution_options(CLI::App* cmd, ExecutionOptions& e) {
-    cmd->add_option("--jobs,-j", e.jobs, "runs in parallel (0 = one per core)")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--timeout", e.timeout_s, "per-run wall-clock limit [s]")->check(CLI::PositiveNumber);
-    cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--executor", e.executor, "local (process pool) or slurm (job arrays)")
-        ->check(CLI::IsMember({"local", "slurm"}));
-    cmd->add_option("--partition", e.slurm_partition, "SLURM partition (slurm executor)");
-    cmd->add_option("--yade", e.yade, "YADE launcher to run");
 }
 
 }  // namespace

@@ -1,0 +1,15 @@
+#include "app/execution_options.hpp"
+
+namespace demcal {
+
+void add_execution_options(CLI::App* cmd, orchestrator::ExecutionOptions& e) {
+    cmd->add_option("--jobs,-j", e.jobs, "runs in parallel (0 = one per core)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--timeout", e.timeout_s, "per-run wall-clock limit [s]")->check(CLI::PositiveNumber);
+    cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--executor", e.executor, "local (process pool) or slurm (job arrays)")
+        ->check(CLI::IsMember({"local", "slurm"}));
+    cmd->add_option("--partition", e.slurm_partition, "SLURM partition (slurm executor)");
+    cmd->add_option("--yade", e.yade, "YADE launcher to run");
+}
+
+}  // namespace demcal
