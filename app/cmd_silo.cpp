@@ -1,5 +1,346 @@
+// demcal silo: the seed's silo case (filling, opening, discharge) on the native DEM kernel.
+#include "analytics/discharge_models.hpp"
 #include "app/commands.hpp"
+#include "app/gnuplot.hpp"
+#include "kernel/silo/silo_case.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <thread>
 
 namespace demcal {
-void add_silo_command(CLI::App&) {}  // placeholder until the subcommand lands
+
+namespace fs = std::filesystem;
+namespace ks = kernel::silo;
+
+namespace {
+
+struct SiloCli {
+    double theta = 0;
+    double outlet = -1;  // -1: default (0.035 conical, a = 0.03 rectangular)
+    double diameter = 0.105;
+    double body_height = 0.4;
+    bool rect = false;
+    double a = -1, b = 0.05, c = 0.1;
+    long particles = 50000;
+    double fill_mass = 0;
+    int threads = 0;
+    unsigned long seed = 1;
+    std::string out;
+    std::string vtk;
+    double vtk_every = 0.05;
+    double max_time = 20;
+    double fill_time = 2.1;
+    double dt = 0;
+    double dt_fraction = 0.25;
+    double stiffness_scale = 1;
+    double stop_fraction = 1;
+    bool no_plots = false;
+};
+
+std::string fixed(double v, int digits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+    return buf;
+}
+
+std::string duration(double s) {
+    char buf[32];
+    const long t = std::lround(s);
+    if (t >= 3600)
+        std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
+    else if (t >= 60)
+        std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
+    else
+        std::snprintf(buf, sizeof buf, "%.1fs", s);
+    return buf;
+}
+
+ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
+    ks::SiloCaseSettings s;
+    if (o.rect) {
+        if (sub.count("--diameter")) throw UserError("--diameter applies to the conical silo, not with --rect");
+        if (sub.count("--outlet") && sub.count("--a"))
+            throw UserError("--outlet and --a both set the slot width of the rectangular hopper; give one");
+        const double a = o.a > 0 ? o.a : (o.outlet > 0 ? o.outlet : 0.03);
+        if (sub.count("--a") && !(o.a > 0)) throw UserError("a = " + std::to_string(o.a) + ": must be positive");
+        s.geometry = ks::SiloGeometry::rectangular(o.theta, a, o.b, o.c, o.body_height);
+    } else {
+        for (const char* opt : {"--a", "--b", "--c"})
+            if (sub.count(opt)) throw UserError(std::string(opt) + " applies to a rectangular hopper: add --rect");
+        s.geometry = ks::SiloGeometry::conical(o.theta, sub.count("--outlet") ? o.outlet : 0.035, o.diameter,
+                                               o.body_height);
+    }
+    if (sub.count("--particles") && sub.count("--fill-mass"))
+        throw UserError("--particles and --fill-mass both set the amount of grain; give one");
+    s.particles = o.particles;
+    s.fill_mass = o.fill_mass;
+    s.threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    if (sub.count("--threads") && o.threads < 1)
+        throw UserError("threads = " + std::to_string(o.threads) + ": must be at least 1");
+    s.seed = o.seed;
+    s.max_time = o.max_time;
+    s.fill_time_max = o.fill_time;
+    s.fill_time_min = std::min(s.fill_time_min, o.fill_time);
+    s.time_step = o.dt;
+    s.time_step_fraction = o.dt_fraction;
+    s.materials.stiffness_scale = o.stiffness_scale;
+    s.stop_fraction = o.stop_fraction;
+    s.vtk_dir = o.vtk;
+    s.vtk_interval = o.vtk_every;
+    try {
+        ks::validate(s);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+    return s;
+}
+
+nlohmann::json geometry_json(const ks::SiloGeometry& g) {
+    nlohmann::json j;
+    if (g.shape == ks::SiloShape::conical)
+        j = {{"shape", "conical"}, {"D_m", g.diameter}, {"outlet_m", g.outlet}};
+    else
+        j = {{"shape", "rectangular"}, {"a_m", g.outlet}, {"b_m", g.depth}, {"c_m", g.width}};
+    j["theta_deg"] = g.half_angle_deg;
+    j["body_height_m"] = g.body_height;
+    j["hopper_height_m"] = g.hopper_height();
+    return j;
+}
+
+// Beverloo (with the Rose-Tanaka hopper factor) for the measured bulk density: the sanity check of the rate.
+nlohmann::json beverloo_check(const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
+    const double dp = ks::wheat_equivalent_diameter();
+    const double k = 1.5, c = 0.58;
+    double w;
+    if (s.geometry.shape == ks::SiloShape::conical)
+        w = analytics::beverloo_rate(s.geometry.outlet, dp, r.bulk_density, c, k);
+    else
+        w = analytics::beverloo_slot_rate(s.geometry.depth, s.geometry.outlet, dp, r.bulk_density, 1.03, k);
+    const double f = analytics::rose_tanaka_factor(s.geometry.half_angle_deg, 45);
+    nlohmann::json j{{"model", s.geometry.shape == ks::SiloShape::conical ? "beverloo" : "beverloo_slot"},
+                     {"d_p_m", dp},
+                     {"k", k},
+                     {"C", s.geometry.shape == ks::SiloShape::conical ? c : 1.03},
+                     {"rho_b_kg_m3", r.bulk_density},
+                     {"rate_kg_s", w},
+                     {"rose_tanaka_factor", f},
+                     {"rate_with_hopper_factor_kg_s", w * f}};
+    if (r.fit.ok && w > 0) j["simulated_over_predicted"] = r.fit.rate / (w * f);
+    return j;
+}
+
+void write_plots(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
+    // mid-plane section: one filled square per cell, coloured by the mean vertical velocity
+    if (r.section && r.section->frames() > 0) {
+        const auto& sec = *r.section;
+        {
+            std::ofstream f(dir / "section.dat");
+            f << "# x_m z_m vz_m_s: mean vertical velocity in the mid-plane slab over " << sec.frames()
+              << " frames of the steady discharge\n";
+            for (int i = 0; i < sec.nx(); ++i)
+                for (int k = 0; k < sec.nz(); ++k) {
+                    const double v = sec.vz(i, k);
+                    if (!std::isnan(v)) f << sec.x_centre(i) << " " << sec.z_centre(k) << " " << v << "\n";
+                }
+        }
+        sec.write_outline(dir / "section_outline.dat");
+        double zmax = r.fill_height + 0.01;
+        const double half = 0.5 * sec.cell() * 1e3;
+        std::ostringstream g;
+        g << "set title 'Mid-plane section, vertical velocity (theta = " << s.geometry.half_angle_deg
+          << " deg, " << ks::to_string(r.flow.pattern) << " flow, ratio " << fixed(r.flow.ratio, 2) << ")'\n"
+          << "set xlabel 'x [mm]'\nset ylabel 'z [mm]'\nset size ratio -1\nset cblabel 'v_z [m/s]'\n"
+          << "set palette defined (0 'red', 0.5 'yellow', 0.8 'cyan', 1 'blue')\n"
+          << "set xrange [" << -s.geometry.top_half() * 1e3 - 5 << ":" << s.geometry.top_half() * 1e3 + 5 << "]\n"
+          << "set yrange [-15:" << zmax * 1e3 << "]\nunset key\n"
+          << "plot " << gnuplot_quote(dir / "section.dat") << " using ($1*1000):($2*1000):(" << half << "):(" << half
+          << "):3 with boxxyerror fs solid noborder palette, " << gnuplot_quote(dir / "section_outline.dat")
+          << " using ($1*1000):($2*1000) with lines lw 2 lc rgb 'black'\n";
+        render_gnuplot(dir / "section.png", g.str(), 700, 900);
+    }
+    if (!r.discharge.empty()) {
+        std::ostringstream g;
+        g << "set datafile separator ','\nset title 'Discharged mass (theta = " << s.geometry.half_angle_deg
+          << " deg)";
+        if (r.fit.ok) g << ": W = " << fixed(r.fit.rate * 1e3, 1) << " g/s, R^2 = " << fixed(r.fit.r_squared, 4);
+        g << "'\nset xlabel 'time since opening [s]'\nset ylabel 'discharged mass [g]'\nset key top left\n"
+          << "plot " << gnuplot_quote(dir / "discharge.csv") << " using 1:($2*1000) with lines lw 2 title 'kernel'";
+        if (r.fit.ok)
+            g << ", [" << r.fit.t_begin << ":" << r.fit.t_end << "] (" << r.fit.intercept << " + " << r.fit.rate
+              << " * x) * 1000 with lines dt 2 lw 2 title 'linear fit (steady part)'";
+        g << "\n";
+        render_gnuplot(dir / "discharge.png", g.str());
+    }
+}
+
+void run_silo(const SiloCli& o, CLI::App& sub) {
+    const ks::SiloCaseSettings s = settings_from(o, sub);
+    const fs::path dir = o.out.empty() ? fs::path("silo_theta" + fixed(o.theta, 0)) : fs::path(o.out);
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
+    if (!s.vtk_dir.empty()) {
+        fs::create_directories(s.vtk_dir, ec);
+        if (ec) throw UserError("vtk = '" + s.vtk_dir + "': cannot create the directory: " + ec.message());
+    }
+    std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
+              << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string() << std::endl;
+    auto progress = [](const ks::SiloProgress& p) {
+        std::cout << "[" << std::setw(7) << duration(p.wall_s) << "] " << std::left << std::setw(9) << p.phase
+                  << std::right << " t = " << fixed(p.time, 3) << " s";
+        if (p.phase == "discharge" || p.phase == "done")
+            std::cout << " (" << fixed(p.discharge_time, 3) << " s open)  discharged " << p.grains_discharged
+                      << " grains, " << fixed(p.discharged_mass * 1e3, 1) << " g; " << p.grains_in_silo
+                      << " in the silo";
+        else
+            std::cout << "  " << p.grains_in_silo << " grains, kinetic energy " << std::setprecision(3)
+                      << p.kinetic_energy_per_grain << " J/grain";
+        if (!p.note.empty()) std::cout << "  " << p.note;
+        std::cout << std::endl;
+    };
+    const ks::SiloCaseResult r = ks::run_silo_case(s, progress);
+
+    ks::write_discharge_csv(dir / "discharge.csv", r.discharge);
+    nlohmann::json j;
+    j["geometry"] = geometry_json(s.geometry);
+    j["grains"] = r.grains;
+    j["grain_mass_kg"] = r.grain_mass;
+    j["filled_mass_kg"] = r.filled_mass;
+    j["bulk_density_kg_m3"] = r.bulk_density;
+    j["fill"] = {{"time_s", r.fill_time},
+                 {"at_rest", r.fill_at_rest},
+                 {"kinetic_energy_per_grain_J", r.fill_kinetic_energy},
+                 {"rest_criterion_J", s.rest_energy_factor * r.grain_mass * s.gravity * ks::wheat_length},
+                 {"height_m", r.fill_height},
+                 {"steps", r.fill_steps},
+                 {"wall_s", r.fill_wall_s}};
+    j["discharge"] = {{"time_s", r.discharge_time},
+                      {"grains_discharged", r.grains_discharged},
+                      {"grains_left", r.grains_in_silo},
+                      {"emptied", r.emptied},
+                      {"stop_reason", r.stop_reason}};
+    nlohmann::json fit{{"ok", r.fit.ok},
+                       {"window", "discharged mass between " + fixed(100 * r.fit.lower_fraction, 0) + " % and " +
+                                      fixed(100 * r.fit.upper_fraction, 0) + " % of the filled mass"},
+                       {"t_begin_s", r.fit.t_begin},
+                       {"t_end_s", r.fit.t_end},
+                       {"samples", r.fit.n}};
+    if (r.fit.ok) {
+        fit["rate_kg_s"] = r.fit.rate;
+        fit["rate_se_kg_s"] = r.fit.rate_se;
+        fit["r_squared"] = r.fit.r_squared;
+        fit["uncertainty_note"] =
+            "standard error of the least-squares slope; the samples of a cumulative mass are correlated, so it "
+            "understates the run-to-run spread (repeat with other --seed values for that)";
+    } else {
+        fit["message"] = r.fit.message;
+    }
+    j["rate"] = fit;
+    j["flow_pattern"] = {{"pattern", ks::to_string(r.flow.pattern)},
+                         {"wall_to_axis_velocity_ratio", r.flow.ratio},
+                         {"wall_speed_m_s", r.flow.wall_speed},
+                         {"axis_speed_m_s", r.flow.axis_speed},
+                         {"wall_samples", r.flow.wall_samples},
+                         {"frames", r.flow.frames},
+                         {"measure", r.flow.measure}};
+    if (!r.flow.message.empty()) j["flow_pattern"]["message"] = r.flow.message;
+    if (r.bulk_density > 0) j["beverloo_check"] = beverloo_check(s, r);
+    j["steps"] = r.steps;
+    j["time_step_s"] = r.time_step;
+    j["wall_s"] = r.wall_s;
+    j["settings"] = {{"threads", s.threads},
+                     {"seed", s.seed},
+                     {"particles_requested", s.particles},
+                     {"fill_mass_requested_kg", s.fill_mass},
+                     {"stiffness_scale", s.materials.stiffness_scale},
+                     {"time_step_fraction_of_rayleigh", s.time_step_fraction},
+                     {"fill_time_max_s", s.fill_time_max},
+                     {"max_time_s", s.max_time},
+                     {"stop_fraction", s.stop_fraction},
+                     {"removal_depth_m", s.removal_depth},
+                     {"materials",
+                      {{"wheat", {{"G_Pa", s.materials.wheat.shear_modulus}, {"nu", s.materials.wheat.poisson},
+                                  {"rho_kg_m3", s.materials.wheat.density}}},
+                       {"steel", {{"G_Pa", s.materials.steel.shear_modulus}, {"nu", s.materials.steel.poisson},
+                                  {"rho_kg_m3", s.materials.steel.density}}},
+                       {"wheat_wheat", {{"restitution", s.materials.wheat_wheat.restitution},
+                                        {"friction", s.materials.wheat_wheat.friction},
+                                        {"rolling_friction", s.materials.wheat_wheat.rolling_friction}}},
+                       {"wheat_steel", {{"restitution", s.materials.wheat_steel.restitution},
+                                        {"friction", s.materials.wheat_steel.friction},
+                                        {"rolling_friction", s.materials.wheat_steel.rolling_friction}}}}}};
+    if (!s.vtk_dir.empty()) j["vtk"] = {{"dir", s.vtk_dir}, {"files", r.vtk_files}};
+    {
+        std::ofstream f(dir / "summary.json");
+        f << j.dump(2) << "\n";
+    }
+    if (!o.no_plots) write_plots(dir, s, r);
+
+    std::cout << "\n" << r.grains << " grains (" << fixed(r.filled_mass * 1e3, 1) << " g), filled in "
+              << fixed(r.fill_time, 3) << " s" << (r.fill_at_rest ? " (at rest)" : " (time limit, not at rest)")
+              << ", bulk density " << fixed(r.bulk_density, 0) << " kg/m^3\n";
+    std::cout << "discharge: " << r.grains_discharged << " grains in " << fixed(r.discharge_time, 3) << " s ("
+              << r.stop_reason << ")\n";
+    if (r.fit.ok)
+        std::cout << "rate W = " << fixed(r.fit.rate * 1e3, 2) << " +/- " << fixed(r.fit.rate_se * 1e3, 2)
+                  << " g/s (steady part " << fixed(r.fit.t_begin, 3) << ".." << fixed(r.fit.t_end, 3)
+                  << " s), R^2 = " << fixed(r.fit.r_squared, 5) << "\n";
+    else
+        std::cout << "rate: not determined (" << r.fit.message << ")\n";
+    std::cout << "flow pattern: " << ks::to_string(r.flow.pattern) << " (wall/axis velocity ratio "
+              << fixed(r.flow.ratio, 3) << ")\n";
+    std::cout << r.steps << " steps of " << std::setprecision(3) << r.time_step << " s, wall time "
+              << duration(r.wall_s) << "\nwrote " << (dir / "summary.json").string() << ", "
+              << (dir / "discharge.csv").string() << (o.no_plots ? "" : ", section.png, discharge.png") << "\n";
+}
+
+}  // namespace
+
+void add_silo_command(CLI::App& app) {
+    auto o = std::make_shared<SiloCli>();
+    CLI::App* sub = app.add_subcommand(
+        "silo",
+        "The seed's silo case on the native DEM kernel: wheat grains generated in the silo, filled against a closed "
+        "outlet, then discharged; writes discharge.csv, summary.json (rate, flow pattern), section.png");
+    sub->add_option("--theta", o->theta, "hopper half angle from the vertical [deg], 0 < theta < 90")->required();
+    sub->add_option("--outlet", o->outlet, "outlet diameter d [m] (conical, default 0.035) or slot width a (--rect)");
+    sub->add_option("--diameter", o->diameter, "silo diameter D [m]")->capture_default_str();
+    sub->add_option("--body-height", o->body_height, "height of the vertical body above the hopper [m]")
+        ->capture_default_str();
+    sub->add_flag("--rect", o->rect, "rectangular silo with a wedge hopper and a slot outlet spanning the depth");
+    sub->add_option("--a", o->a, "rectangular: outlet (slot) width a [m], default 0.03");
+    sub->add_option("--b", o->b, "rectangular: silo depth b [m] (the slot's length)")->capture_default_str();
+    sub->add_option("--c", o->c, "rectangular: silo width c [m]")->capture_default_str();
+    sub->add_option("--particles", o->particles, "number of grains")->capture_default_str();
+    sub->add_option("--fill-mass", o->fill_mass, "mass of grain [kg] (instead of --particles)");
+    sub->add_option("--threads", o->threads, "OpenMP threads (default: every core)");
+    sub->add_option("--seed", o->seed, "random seed of the generation")->capture_default_str();
+    sub->add_option("--out", o->out, "output directory (default silo_theta<DEG>)");
+    sub->add_option("--vtk", o->vtk, "write VTK snapshots of the spheres into this directory");
+    sub->add_option("--vtk-every", o->vtk_every, "simulated seconds between VTK snapshots")->capture_default_str();
+    sub->add_option("--max-time", o->max_time, "discharge time limit after the opening [s]")->capture_default_str();
+    sub->add_option("--fill-time", o->fill_time, "filling time limit [s] (ends earlier once the grains are at rest)")
+        ->capture_default_str();
+    sub->add_option("--dt", o->dt, "time step [s] (default: --dt-fraction x the Rayleigh time step)");
+    sub->add_option("--dt-fraction", o->dt_fraction, "time step as a fraction of the Rayleigh time step")
+        ->capture_default_str();
+    sub->add_option("--stiffness-scale", o->stiffness_scale,
+                    "scales the shear moduli of Table 2.1 (softer contacts allow a larger time step)")
+        ->capture_default_str();
+    sub->add_option("--stop-fraction", o->stop_fraction,
+                    "stop once this fraction of the filled mass has left (1: until empty)")
+        ->capture_default_str();
+    sub->add_flag("--no-plots", o->no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
+    sub->callback([o, sub] { run_silo(*o, *sub); });
+}
+
 }  // namespace demcal

@@ -16,11 +16,13 @@ std::string to_string(FlowPattern p) {
 
 FlowPatternClassifier::FlowPatternClassifier(const SiloGeometry& g, FlowPatternSettings s) : g_(g), s_(s) {}
 
-void FlowPatternClassifier::add_frame(const std::vector<Eigen::Vector3d>& pos, const std::vector<Eigen::Vector3d>& vel) {
+void FlowPatternClassifier::add_frame(const std::vector<Eigen::Vector3d>& pos, const std::vector<Eigen::Vector3d>& vel,
+                                      double tag) {
     const double hh = g_.hopper_height();
     const int nb = std::max(1, int(std::ceil(hh / s_.bin_height)));
     const double th = g_.half_angle_deg * 3.14159265358979323846 / 180;
     Frame f;
+    f.tag = tag;
     f.bins.resize(nb);
     for (size_t i = 0; i < pos.size(); ++i) {
         const Eigen::Vector3d& p = pos[i];
@@ -43,7 +45,7 @@ void FlowPatternClassifier::add_frame(const std::vector<Eigen::Vector3d>& pos, c
     frames_.push_back(std::move(f));
 }
 
-FlowPatternResult FlowPatternClassifier::result() const {
+FlowPatternResult FlowPatternClassifier::result(double tag_low, double tag_high) const {
     FlowPatternResult r;
     std::ostringstream m;
     m << "ratio of the mean downward velocity of the grains within " << s_.wall_layer * 1e3
@@ -53,10 +55,11 @@ FlowPatternResult FlowPatternClassifier::result() const {
       << " mm), over the steady discharge; mass flow >= " << s_.mass_threshold << ", funnel flow < "
       << s_.funnel_threshold << ", mixed in between";
     r.measure = m.str();
-    r.frames = long(frames_.size());
     double ratio_sum = 0, wall_sum = 0, axis_sum = 0;
     long used = 0;
-    for (const auto& f : frames_)
+    for (const auto& f : frames_) {
+        if (f.tag < tag_low || f.tag > tag_high) continue;
+        ++r.frames;
         for (const auto& b : f.bins) {
             if (b.wall_n == 0 || b.axis_n == 0) continue;
             const double axis = b.axis_sum / b.axis_n;
@@ -67,9 +70,10 @@ FlowPatternResult FlowPatternClassifier::result() const {
             used += b.wall_n;
             r.axis_samples += b.axis_n;
         }
+    }
     r.wall_samples = used;
     if (used == 0) {
-        r.message = frames_.empty() ? "no frame of the steady discharge was sampled"
+        r.message = r.frames == 0 ? "no frame of the steady discharge was sampled"
                                     : "no hopper height had both wall grains and moving axis grains";
         return r;
     }

@@ -50,9 +50,12 @@ struct FlowPatternResult {
 class FlowPatternClassifier {
 public:
     FlowPatternClassifier(const SiloGeometry& g, FlowPatternSettings s = {});
-    // One frame: centres of mass and velocities of the grains in the silo.
-    void add_frame(const std::vector<Eigen::Vector3d>& positions, const std::vector<Eigen::Vector3d>& velocities);
-    FlowPatternResult result() const;
+    // One frame: centres of mass and velocities of the grains in the silo; `tag` (e.g. the discharged mass at that
+    // moment) lets result() keep only the frames of a window chosen afterwards.
+    void add_frame(const std::vector<Eigen::Vector3d>& positions, const std::vector<Eigen::Vector3d>& velocities,
+                   double tag = 0);
+    // The measure over the frames whose tag lies in [tag_low, tag_high].
+    FlowPatternResult result(double tag_low = -1e300, double tag_high = 1e300) const;
     const FlowPatternSettings& settings() const { return s_; }
 
 private:
@@ -61,6 +64,7 @@ private:
         long wall_n = 0, axis_n = 0;
     };
     struct Frame {
+        double tag = 0;
         std::vector<Bin> bins;
     };
     SiloGeometry g_;

@@ -81,18 +81,20 @@ double SiloGeometry::transverse(const Eigen::Vector3d& p) const {
 }
 
 double SiloGeometry::distance_to_side_wall(const Eigen::Vector3d& p) const {
+    // In the (s, z) half plane the side wall is the polyline (r0, 0) - (R, H_h) - (R, top): the distance is the
+    // nearest of its two segments (a sphere just above the hopper's top edge can touch the flat hopper of a large
+    // theta), signed positive inside.
     const double s = transverse(p), z = p.z();
-    const double th = rad(half_angle_deg), hh = hopper_height();
-    double d;
-    if (z >= hh) {
-        d = top_half() - s;  // vertical body wall
-        // near the body-hopper edge the slanted wall can be closer (it cannot for points above it: convex corner)
-    } else {
-        // slanted wall: the line s = r0 + z tan(theta); perpendicular distance in the (s, z) half plane
-        d = (outlet_half() + z * std::tan(th) - s) * std::cos(th);
-        if (z < 0) d = outlet_half() - s;
-        d = std::min(d, top_half() - s);
-    }
+    const double r0 = outlet_half(), R = top_half(), hh = hopper_height();
+    auto seg = [&](double a0, double b0, double a1, double b1) {
+        const double ex = a1 - a0, ez = b1 - b0, l2 = ex * ex + ez * ez;
+        const double t = l2 > 0 ? std::clamp(((s - a0) * ex + (z - b0) * ez) / l2, 0.0, 1.0) : 0.0;
+        return std::hypot(s - (a0 + t * ex), z - (b0 + t * ez));
+    };
+    const double d_wall = std::min(seg(r0, 0, R, hh), seg(R, hh, R, std::max(top(), hh)));
+    const bool inside = z >= hh ? s <= R : s <= r0 + z * std::tan(rad(half_angle_deg));
+    double d = inside ? d_wall : -d_wall;
+    if (z < 0) d = r0 - s;
     if (shape == SiloShape::rectangular) d = std::min(d, 0.5 * depth - std::abs(p.y()));
     return d;
 }
