@@ -33,6 +33,7 @@ struct PairCoeffs {
   double damp = 0;       ///< 2 sqrt(5/6) |beta|, beta = ln e / sqrt(ln^2 e + pi^2) (>= 0; 0 for e = 1)
   double mu = 0;         ///< static friction coefficient
   double mu_roll = 0;    ///< rolling friction coefficient
+  double st_over_sn = 0; ///< sqrt(St / Sn) = sqrt(4 G* / E*): sqrt(St m*) = sqrt(Sn m*) * st_over_sn
 };
 
 /// beta(e) = ln e / sqrt(ln^2 e + pi^2) (< 0 for e < 1; 0 for e = 1).
@@ -49,6 +50,7 @@ inline PairCoeffs make_pair_coeffs(const Material& a, const Material& b, const P
   c.damp = 2.0 * std::sqrt(5.0 / 6.0) * std::abs(restitution_beta(p.restitution));
   c.mu = p.friction;
   c.mu_roll = p.rolling_friction;
+  c.st_over_sn = std::sqrt(4.0 * c.g_star / c.e_star);
   return c;
 }
 

@@ -77,14 +77,17 @@ class BasicSimulation {
   double timestep() const { return dt_; }
   /// Smallest Rayleigh time step over the spheres present (pi R sqrt(rho/G)/(0.1631 nu + 0.8766)) [s]; 0 if none.
   double rayleigh_timestep() const;
-  /// Verlet skin [m] (default: 0.1 * the mean sphere radius at the first step if never set). The neighbour list is
+  /// Verlet skin [m] (default: 0.2 * the mean sphere radius at the first step if never set). The neighbour list is
   /// rebuilt when a sphere has moved more than skin/2 since the last build.
   void set_skin(double skin);
   double skin() const { return skin_; }
-  /// Number of OpenMP threads (<= 0: omp_get_max_threads()). Results depend on nothing else but this... and not
-  /// even on it: every parallel loop writes disjoint data and every sum runs in a fixed order.
+  /// Number of OpenMP threads (default 1; <= 0: omp_get_max_threads()). The results do not depend on it: every
+  /// parallel loop writes disjoint data and every sum runs in a fixed order (tested bit for bit).
   void set_threads(int n);
   int threads() const { return threads_; }
+  /// Loops run on one thread while there are fewer than this many spheres (default 2000): below it, OpenMP barriers
+  /// cost more than they save (much more on an oversubscribed machine). 0: always parallel (tests).
+  void set_min_parallel(std::size_t n) { min_parallel_ = n; }
 
   /// Adds a wall; returns its id.
   int add_wall(const Wall& w);
@@ -194,6 +197,8 @@ class BasicSimulation {
   double dt_ = 0, time_ = 0, skin_ = -1;
   long steps_ = 0;
   int threads_ = 1;
+  std::size_t min_parallel_ = 2000;
+  int nt() const { return x_.size() >= min_parallel_ ? threads_ : 1; }
   bool forces_valid_ = false, prepared_ = false;
 };
 

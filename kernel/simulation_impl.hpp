@@ -156,7 +156,7 @@ BodyId BasicSimulation<Law>::add_sphere(const Vec3& position, double radius, int
   for (int s = 0; s < kWallSlots; ++s) { wall_slot_id_.push_back(-1); wall_slot_s_.push_back(Vec3::Zero()); wall_slot_f_.push_back(Vec3::Zero()); }
   body_ref_.push_back(std::int32_t(x_.size() - 1));
   body_id_.push_back(next_id_);
-  rebuild_body_index();
+  sphere_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   forces_valid_ = false;
   nl_.invalidate();
   return next_id_++;
@@ -190,7 +190,8 @@ BodyId BasicSimulation<Law>::add_clump(int tmpl, int material, const Vec3& com, 
   cmem_start_.push_back(std::uint32_t(cmem_.size()));
   body_ref_.push_back(-std::int32_t(c) - 1);
   body_id_.push_back(next_id_);
-  rebuild_body_index();
+  clump_body_.push_back(std::uint32_t(body_ref_.size() - 1));
+  for (std::size_t k = 0; k < t.offsets.size(); ++k) sphere_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   forces_valid_ = false;
   nl_.invalidate();
   return next_id_++;
@@ -237,7 +238,7 @@ void BasicSimulation<Law>::prepare() {
   if (skin_ <= 0) {
     double rs = 0;
     for (double r : r_) rs += r;
-    skin_ = r_.empty() ? 1e-4 : 0.1 * rs / double(r_.size());
+    skin_ = r_.empty() ? 1e-4 : 0.2 * rs / double(r_.size());
   }
 }
 
@@ -260,7 +261,7 @@ void BasicSimulation<Law>::kick_drift() {
   const double h = 0.5 * dt_, dt = dt_;
   const Vec3 g = gravity_;
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(nt())
   {
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < n; ++i) {
@@ -287,7 +288,7 @@ void BasicSimulation<Law>::kick() {
   const double h = 0.5 * dt_;
   const Vec3 g = gravity_;
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(nt())
   {
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < n; ++i) {
@@ -307,7 +308,7 @@ void BasicSimulation<Law>::kick() {
 
 template <class Law>
 void BasicSimulation<Law>::compute_forces() {
-  if (nl_.needs_rebuild(x_, threads_)) nl_.build(x_, r_, clump_, skin_, threads_);
+  if (nl_.needs_rebuild(x_, nt())) nl_.build(x_, r_, clump_, skin_, nt());
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
   pair_f_.resize(nl_.num_pairs());
   pair_tj_.resize(nl_.num_pairs());
@@ -317,7 +318,7 @@ void BasicSimulation<Law>::compute_forces() {
   const std::uint32_t* row = nl_.row.data();
   const std::int32_t* nbr = nl_.nbr.data();
   Vec3* hist = nl_.hist.data();
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(nt())
   {
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < n; ++i) {
@@ -655,7 +656,7 @@ double BasicSimulation<Law>::total_mass() const {
 template <class Law>
 std::vector<std::pair<std::int32_t, std::int32_t>> BasicSimulation<Law>::contact_pairs() {
   prepare();
-  if (nl_.needs_rebuild(x_, threads_)) nl_.build(x_, r_, clump_, skin_, threads_);
+  if (nl_.needs_rebuild(x_, nt())) nl_.build(x_, r_, clump_, skin_, nt());
   std::vector<std::pair<std::int32_t, std::int32_t>> out;
   for (std::size_t i = 0; i + 1 < nl_.row.size(); ++i)
     for (std::uint32_t p = nl_.row[i]; p < nl_.row[i + 1]; ++p) {

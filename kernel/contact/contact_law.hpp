@@ -11,14 +11,14 @@ namespace demcal::kernel {
 template <class Normal, class Tangential, class Rolling>
 struct ComposedLaw {
   /// One contact: g (geometry, dn > 0), k (kinematics), c (pair constants), s (tangential history, in/out).
-  static inline ContactResult compute(const PairCoeffs& c, const ContactGeometry& g, const ContactKinematics& k,
+  [[gnu::always_inline]] static inline ContactResult compute(const PairCoeffs& c, const ContactGeometry& g, const ContactKinematics& k,
                                       Vec3& s, double dt, bool wall) {
     ContactResult r;
     const double vn = k.v_rel.dot(g.n);
-    double sqrt_rdn;
-    const double fn = Normal::force(c, g.dn, g.r_star, g.m_star, vn, sqrt_rdn);
+    const NormalOut nrm = Normal::force(c, g.dn, g.r_star, g.m_star, vn);
+    const double fn = nrm.fn;
     const Vec3 vt = k.v_rel - vn * g.n;
-    const Vec3 ft = Tangential::force(c, g.n, vt, fn, sqrt_rdn, g.m_star, s, dt);
+    const Vec3 ft = Tangential::force(c, g.n, vt, nrm, s, dt);
     r.force_i = fn * g.n + ft;
     // tangential force acts at the contact point: lever -lever_i n from i, +lever_j n from j (force -ft)
     const Vec3 nxft = g.n.cross(ft);

@@ -9,14 +9,23 @@
 
 namespace demcal::kernel {
 
+/// What a normal model hands to the tangential one.
+struct NormalOut {
+  double fn;         ///< normal force along n (positive = repulsive) [N]
+  double sqrt_rdn;   ///< sqrt(R* dn) [m]
+  double sqrt_sn_m;  ///< sqrt(Sn m*) [kg/s]
+};
+
 struct HertzNormal {
-  /// Normal force magnitude along n (positive = repulsive) for overlap dn > 0 and normal relative velocity
-  /// vn = v_rel . n (negative while approaching). Returns sqrt(R* dn) in sqrt_rdn for the tangential model.
-  static inline double force(const PairCoeffs& c, double dn, double r_star, double m_star, double vn, double& sqrt_rdn) {
-    sqrt_rdn = std::sqrt(r_star * dn);
-    const double kn = (4.0 / 3.0) * c.e_star * sqrt_rdn;  // Fn_el = kn * dn
-    const double sn = 2.0 * c.e_star * sqrt_rdn;
-    return kn * dn - c.damp * std::sqrt(sn * m_star) * vn;
+  /// Normal force for overlap dn > 0 and normal relative velocity vn = v_rel . n (negative while approaching).
+  [[gnu::always_inline]] static inline NormalOut force(const PairCoeffs& c, double dn, double r_star, double m_star,
+                                                       double vn) {
+    NormalOut o;
+    o.sqrt_rdn = std::sqrt(r_star * dn);
+    const double sn = 2.0 * c.e_star * o.sqrt_rdn;  // Fn_el = 2/3 Sn dn
+    o.sqrt_sn_m = std::sqrt(sn * m_star);
+    o.fn = (2.0 / 3.0) * sn * dn - c.damp * o.sqrt_sn_m * vn;
+    return o;
   }
 };
 

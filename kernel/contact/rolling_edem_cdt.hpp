@@ -15,7 +15,7 @@ namespace demcal::kernel {
 struct EdemCdtRolling {
   static constexpr double omega_eps = 1e-12;  ///< [rad/s] below this |omega| no rolling torque
   /// Adds the rolling torques to ti (on i) and tj (on j; ignored for walls, wall = true).
-  static inline void torque(const PairCoeffs& c, double fn, double radius_i, double radius_j, const Vec3& wi,
+  [[gnu::always_inline]] static inline void torque(const PairCoeffs& c, double fn, double radius_i, double radius_j, const Vec3& wi,
                             const Vec3& wj, Vec3& ti, Vec3& tj, bool wall) {
     if (c.mu_roll == 0.0) return;
     const double a = c.mu_roll * std::abs(fn);
@@ -29,7 +29,7 @@ struct EdemCdtRolling {
 };
 
 struct NoRolling {
-  static inline void torque(const PairCoeffs&, double, double, double, const Vec3&, const Vec3&, Vec3&, Vec3&, bool) {}
+  [[gnu::always_inline]] static inline void torque(const PairCoeffs&, double, double, double, const Vec3&, const Vec3&, Vec3&, Vec3&, bool) {}
 };
 
 }  // namespace demcal::kernel
