@@ -56,7 +56,9 @@ void write_task_script(const Job& job) {
       << "cd " << shell_quote(job.dir.string()) << " || exit 1\nrm -f exit_status\nstart=$(date +%s.%N)\n";
     for (const auto& a : job.argv) s << shell_quote(a) << ' ';
     s << ">>stdout.log 2>>stderr.log </dev/null\ncode=$?\nend=$(date +%s.%N)\n"
-      << "cpu=$(times | tail -n 1 | awk '{split($1,u,/[ms]/); split($2,v,/[ms]/); print u[1]*60+u[2]+v[1]*60+v[2]}')\n"
+      // `times` in this shell, not in $(...): a subshell's children times start at zero.
+      << "times >times.txt\n"
+      << "cpu=$(tail -n 1 times.txt | awk '{split($1,u,/[ms]/); split($2,v,/[ms]/); print u[1]*60+u[2]+v[1]*60+v[2]}')\n"
       << "echo \"$code $start $end $cpu\" > exit_status.tmp && mv exit_status.tmp exit_status\nexit $code\n";
     write_text_file_atomically(job.dir / "run.sh", s.str());
     fs::permissions(job.dir / "run.sh", fs::perms::owner_all | fs::perms::group_read | fs::perms::others_read);

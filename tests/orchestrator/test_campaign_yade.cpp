@@ -76,7 +76,9 @@ TEST_CASE("a run whose script raises is recorded as failed and a hanging run is 
     const fs::path tmpl = dir / "faulty_shear_box.py";
     orchestrator::write_text_file_atomically(
         tmpl, faults + test::read_file(test::source_path("yade_scripts/shear_box.py")));
-    const double timeout = 40;
+    // Long enough for a tiny run on a loaded 2-core machine (15-30 s alone, 45 s seen under load); the other worker
+    // finishes the three good runs meanwhile, so the hang costs little extra time.
+    const double timeout = 90;
     const int code = test::run_demcal({"shear", tiny, "--normal-stress", "1000,1500,2e3,4e3,6e3", "--jobs", "2",
                                        "--retries", "0", "--timeout", std::to_string(timeout), "--template",
                                        tmpl.string(), "--campaign", (dir / "c").string()},
