@@ -22,6 +22,8 @@ class NeighborList {
   /// history (sign flipped where i and j swap order). The list must then be rebuilt before use (invalidated).
   void renumber(const std::vector<std::int32_t>& old2new, std::size_t new_count);
   void invalidate() { valid_ = false; }
+  /// Sphere positions at the last build (for the skin/2 displacement check).
+  const std::vector<Vec3>& built_positions() const { return x_built_; }
   bool valid() const { return valid_; }
 
   std::size_t num_pairs() const { return nbr.size(); }

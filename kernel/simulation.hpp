@@ -154,8 +154,8 @@ class BasicSimulation {
 
  private:
   void prepare();
-  void compute_forces();
-  void kick_drift();
+  void compute_forces(bool rebuild);
+  bool kick_drift(double kick);
   void kick();
   void update_members(std::size_t c, bool positions);
   void rebuild_body_index();

@@ -257,11 +257,16 @@ void BasicSimulation<Law>::update_members(std::size_t c, bool positions) {
 }
 
 template <class Law>
-void BasicSimulation<Law>::kick_drift() {
-  const double h = 0.5 * dt_, dt = dt_;
+bool BasicSimulation<Law>::kick_drift(double kick) {
+  // kick = 1: the first half kick of velocity Verlet; kick = 2: fused with the previous step's second half kick
+  const double h = 0.5 * dt_ * kick, dt = dt_;
   const Vec3 g = gravity_;
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
-#pragma omp parallel num_threads(nt())
+  const bool check = nl_.valid() && nl_.built_positions().size() == x_.size();
+  const Vec3* xb = check ? nl_.built_positions().data() : nullptr;
+  const double lim2 = 0.25 * skin_ * skin_;
+  int moved = check ? 0 : 1;
+#pragma omp parallel num_threads(nt()) reduction(| : moved)
   {
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < n; ++i) {
@@ -269,6 +274,7 @@ void BasicSimulation<Law>::kick_drift() {
       v_[i] += h * (f_[i] * inv_mass_[i] + g);
       w_[i] += (h * inv_inertia_[i]) * t_[i];
       x_[i] += dt * v_[i];
+      if (check && (x_[i] - xb[i]).squaredNorm() > lim2) moved = 1;
     }
 #pragma omp for schedule(static)
     for (std::int64_t c = 0; c < nc; ++c) {
@@ -279,8 +285,12 @@ void BasicSimulation<Law>::kick_drift() {
       detail::richardson(cq_[c], cL_[c], w, cI_[c], dt);
       cw_[c] = detail::omega_from_L(cq_[c], cL_[c], cI_[c]);
       update_members(std::size_t(c), true);
+      if (check)
+        for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k)
+          if ((x_[cmem_[k]] - xb[cmem_[k]]).squaredNorm() > lim2) moved = 1;
     }
   }
+  return moved != 0;
 }
 
 template <class Law>
@@ -307,8 +317,9 @@ void BasicSimulation<Law>::kick() {
 }
 
 template <class Law>
-void BasicSimulation<Law>::compute_forces() {
-  if (nl_.needs_rebuild(x_, nt())) nl_.build(x_, r_, clump_, skin_, nt());
+void BasicSimulation<Law>::compute_forces(bool rebuild) {
+  if (rebuild || !nl_.valid() || nl_.built_positions().size() != x_.size())
+    nl_.build(x_, r_, clump_, skin_, nt());
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
   pair_f_.resize(nl_.num_pairs());
   pair_tj_.resize(nl_.num_pairs());
@@ -338,13 +349,16 @@ void BasicSimulation<Law>::compute_forces() {
           continue;
         }
         const double dist = std::sqrt(d2);
+        const double rj = r_[j], mj = mass_[j];
         ContactGeometry geo;
-        geo.n = d / dist;
+        geo.n = d * (1.0 / dist);
         geo.dn = rs - dist;
         geo.radius_i = ri;
-        geo.radius_j = r_[j];
-        geo.r_star = ri * r_[j] / rs;
-        geo.m_star = mi * mass_[j] / (mi + mass_[j]);
+        geo.radius_j = rj;
+        // R* = ri rj / (ri + rj), m* = mi mj / (mi + mj) with one division
+        const double q = 1.0 / (rs * (mi + mj));
+        geo.r_star = ri * rj * (mi + mj) * q;
+        geo.m_star = mi * mj * rs * q;
         geo.lever_i = ri - 0.5 * geo.dn;
         geo.lever_j = r_[j] - 0.5 * geo.dn;
         ContactKinematics kin;
@@ -397,11 +411,12 @@ void BasicSimulation<Law>::compute_forces() {
             ++used;
           }
         }
-        for (int k = 0; k < kWallSlots; ++k) {
-          sid[k] = nid[k];
-          ss[k] = k < used ? ns[k] : Vec3::Zero();
-          sf[k] = k < used ? nf[k] : Vec3::Zero();
-        }
+        if (used > 0 || sid[0] >= 0)  // (slots are filled from the front: sid[0] < 0 means all empty)
+          for (int k = 0; k < kWallSlots; ++k) {
+            sid[k] = nid[k];
+            ss[k] = k < used ? ns[k] : Vec3::Zero();
+            sf[k] = k < used ? nf[k] : Vec3::Zero();
+          }
       }
       f_[i] = fi;
       t_[i] = ti;
@@ -447,16 +462,17 @@ template <class Law>
 void BasicSimulation<Law>::step(long nsteps) {
   prepare();
   if (!forces_valid_) {
-    compute_forces();
+    compute_forces(nl_.needs_rebuild(x_, nt()));
     forces_valid_ = true;
   }
+  // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass
   for (long s = 0; s < nsteps; ++s) {
-    kick_drift();
-    compute_forces();
-    kick();
+    const bool moved = kick_drift(s == 0 ? 1.0 : 2.0);
+    compute_forces(moved);
     time_ += dt_;
     ++steps_;
   }
+  if (nsteps > 0) kick();
 }
 
 template <class Law>

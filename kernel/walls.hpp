@@ -98,12 +98,13 @@ struct Wall {
         return true;
       }
       case Shape::AxiSegment: {
+        // quick reject on the segment's bounding box in (rho, z), without a square root
+        if (p.z() + r <= std::min(z0, z1) || p.z() - r >= std::max(z0, z1)) return false;
         const double dx = p.x() - cx, dy = p.y() - cy;
-        const double rho = std::sqrt(dx * dx + dy * dy);
-        // quick reject on the segment's bounding box in (rho, z)
-        if (rho + r <= std::min(r0, r1) || rho - r >= std::max(r0, r1) || p.z() + r <= std::min(z0, z1) ||
-            p.z() - r >= std::max(z0, z1))
-          return false;
+        const double rho2 = dx * dx + dy * dy;
+        const double rlo = std::min(r0, r1) - r, rhi = std::max(r0, r1) + r;
+        if ((rlo > 0 && rho2 <= rlo * rlo) || rho2 >= rhi * rhi) return false;
+        const double rho = std::sqrt(rho2);
         const double ex = r1 - r0, ez = z1 - z0;
         const double len2 = ex * ex + ez * ez;
         double t = len2 > 0 ? ((rho - r0) * ex + (p.z() - z0) * ez) / len2 : 0.0;

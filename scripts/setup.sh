@@ -10,7 +10,7 @@ PKGS=(
   slurmctld slurmd slurm-client munge
 )
 # liggghts and mpi are only for bench/ (peer comparison); opt in with DEMCAL_BENCH_DEPS=1
-if [ "${DEMCAL_BENCH_DEPS:-0}" = 1 ]; then PKGS+=(liggghts openmpi-bin); fi
+if [ "${DEMCAL_BENCH_DEPS:-0}" = 1 ]; then PKGS+=(liggghts openmpi-bin time); fi
 SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
 missing=()
 for p in "${PKGS[@]}"; do dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p"); done
