@@ -1,6 +1,7 @@
 // demcal sensitivity / calibrate / enlarge: the failure-line sensitivity study (seed Table 3.1), the calibration loop
 // and the particle-enlargement laws (seed eqs. 3.1-3.2). Every simulation is a stored, cached, resumable campaign run.
 #include "analytics/scaling_law.hpp"
+#include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
@@ -46,16 +47,6 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
     cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
     cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     add_execution_options(cmd, c.exec);
-}
-
-nlohmann::json read_json(const std::string& path, const std::string& field) {
-    std::ifstream f(path);
-    if (!f) throw UserError(field + " = '" + path + "' cannot be read");
-    try {
-        return nlohmann::json::parse(f);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw UserError(field + " = '" + path + "' is not valid JSON: " + e.what());
-    }
 }
 
 // "name=low:high" items (repeatable option) -> map; throws naming the item.
@@ -222,7 +213,7 @@ void add_sensitivity(CLI::App& app) {
     cmd->add_option("--alpha", o->alpha, "significance level of the F tests")->capture_default_str();
     add_campaign_options(cmd, o->campaign);
     cmd->callback([o] {
-        const auto base = orchestrator::validate_material(read_json(o->base_file, "base"), o->base_file);
+        const auto base = orchestrator::validate_material(read_json_file(o->base_file, "base"), o->base_file);
         check_study(base, *o);  // option errors before any campaign
         CampaignSession session(o->campaign, "sensitivity");
         const auto study = run_study(base, *o, session.evaluate);
@@ -298,7 +289,7 @@ void add_calibrate(CLI::App& app) {
     add_campaign_options(cmd, o->study.campaign);
     cmd->callback([o] {
         const auto& camp = o->study.campaign;
-        const auto start = orchestrator::validate_material(read_json(o->start_file, "start"), o->start_file);
+        const auto start = orchestrator::validate_material(read_json_file(o->start_file, "start"), o->start_file);
         const auto targets = targets_of(*o);
         const auto bounds = parse_ranges(o->bounds, "bounds");
         CalibrationOptions options;
@@ -319,7 +310,7 @@ void add_calibrate(CLI::App& app) {
 
         SensitivityStudy study;
         if (!o->sensitivity_file.empty()) {
-            study = SensitivityStudy::from_json(read_json(o->sensitivity_file, "sensitivity"));
+            study = SensitivityStudy::from_json(read_json_file(o->sensitivity_file, "sensitivity"));
         } else {
             study = run_study(start, o->study, session.evaluate);
             write_study(dir, study, camp.plot_format);
@@ -407,7 +398,7 @@ void add_enlarge(CLI::App& app) {
     cmd->callback([o] {
         std::vector<double> r, e, nu;
         for (const auto& file : o->materials) {
-            const auto m = orchestrator::validate_material(read_json(file, "material"), file);
+            const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
             r.push_back(m.at("particle_radius").get<double>());
             e.push_back(m.at("young_modulus").get<double>());
             nu.push_back(m.at("poisson_ratio").get<double>());

@@ -3,6 +3,7 @@
 #include "analytics/diagnose.hpp"
 #include "analytics/discharge_models.hpp"
 #include "analytics/measured_data.hpp"
+#include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
 
@@ -33,16 +34,6 @@ optional model constants (defaults in brackets):
   phi_d_deg [45] (Rose-Tanaka stagnant-zone angle to the horizontal),
   delta_e_deg, phi_w_deg (effective internal and wall friction angles: with both, Jenike's mass-flow limit decides
   the flow pattern and each model says whether it applies))";
-
-nlohmann::json read_json_file(const std::string& path, const char* what) {
-    std::ifstream in(path);
-    if (!in) throw UserError(std::string(what) + ": cannot open " + path);
-    try {
-        return nlohmann::json::parse(in);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw UserError(std::string(what) + ": " + path + " is not valid JSON: " + e.what());
-    }
-}
 
 void write_text(const std::string& path, const std::string& text) {
     std::ofstream out(path);

@@ -1,4 +1,5 @@
 // demcal shear / status / resume: YADE direct-shear campaigns and their failure lines.
+#include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
@@ -33,29 +34,6 @@ struct ShearCliOptions {
     std::string plot_format = "png";
     ExecutionOptions exec;
 };
-
-std::string duration_text(double s) {
-    if (s < 0) return "?";
-    char buf[32];
-    const long t = std::lround(s);
-    if (t >= 3600)
-        std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
-    else if (t >= 60)
-        std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
-    else
-        std::snprintf(buf, sizeof buf, "%lds", t);
-    return buf;
-}
-
-nlohmann::json read_json_file(const std::string& path, const std::string& what) {
-    std::ifstream f(path);
-    if (!f) throw UserError(what + " = '" + path + "' cannot be read");
-    try {
-        return nlohmann::json::parse(f);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw UserError(what + " = '" + path + "' is not valid JSON: " + e.what());
-    }
-}
 
 void print_progress(const CampaignProgress& p) {
     if (p.event == "started") return;  // one line per finished run keeps an overnight log readable
