@@ -14,7 +14,7 @@ $demcal shear examples/calibration/hidden-tiny.json --normal-stress $stresses --
 target=$(python3 -c "
 import json,glob
 j=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['peak_failure_line']
-print('mu_b=%.6g,tau_c=%.6g' % (j['mu_b'], j['tau_c']))")
+print('mu_b=%.6g,tau_c=%.6g' % (j['mu_b'], j['tau_c_Pa']))")
 echo "target: $target"
 common=(--target "$target" --start examples/materials/sand-tiny.json --strict --normal-stress $stresses --jobs 2
         "${template[@]}"
