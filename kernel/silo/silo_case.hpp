@@ -39,7 +39,9 @@ struct SiloCaseSettings {
     double section_cell = 0.0025;    // [m]
     double section_half_thickness = 0.011;  // slab |y| < 2 d_p [m]
     FlowPatternSettings flow;
-    double skin = 0;                 // Verlet skin [m]; 0: the kernel's default
+    // Verlet skin [m] (0: the kernel's default, 0.1 mean radius). Grains leave the outlet at ~1 m/s: a 1 mm skin keeps
+    // the list for several steps (measured: the reduced 70 deg case ran 1.7 times faster than with the default).
+    double skin = 0.001;
     int threads = 1;
     unsigned long seed = 1;
     std::string vtk_dir;             // empty: no VTK
