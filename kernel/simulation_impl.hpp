@@ -268,8 +268,8 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
   int moved = check ? 0 : 1;
 #pragma omp parallel num_threads(nt()) reduction(| : moved)
   {
-#pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < n; ++i) {
+#pragma omp for schedule(static) nowait
+    for (std::int64_t i = 0; i < n; ++i) {  // single spheres (clump members are moved by their clump below)
       if (clump_[i] >= 0) continue;
       v_[i] += h * (f_[i] * inv_mass_[i] + g);
       w_[i] += (h * inv_inertia_[i]) * t_[i];
@@ -300,7 +300,7 @@ void BasicSimulation<Law>::kick() {
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
 #pragma omp parallel num_threads(nt())
   {
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
     for (std::int64_t i = 0; i < n; ++i) {
       if (clump_[i] >= 0) continue;
       v_[i] += h * (f_[i] * inv_mass_[i] + g);
