@@ -1,5 +1,6 @@
 // demcal silo: the seed's silo case (filling, opening, discharge) on the native DEM kernel.
 #include "analytics/discharge_models.hpp"
+#include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
 #include "kernel/silo/silo_case.hpp"
@@ -24,7 +25,8 @@ namespace ks = kernel::silo;
 namespace {
 
 struct SiloCli {
-    double theta = 0;
+    std::string geometry_file;
+    double theta = -1;  // -1: not given
     double outlet = -1;  // -1: default (0.035 conical, a = 0.03 rectangular)
     double diameter = 0.105;
     double body_height = 0.4;
@@ -52,32 +54,57 @@ std::string fixed(double v, int digits) {
     return buf;
 }
 
-std::string duration(double s) {
-    char buf[32];
-    const long t = std::lround(s);
-    if (t >= 3600)
-        std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
-    else if (t >= 60)
-        std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
-    else
-        std::snprintf(buf, sizeof buf, "%.1fs", s);
-    return buf;
+// Reads --geometry FILE.json into the options the command line did not set itself.
+void apply_geometry_file(SiloCli& o, CLI::App& sub) {
+    const nlohmann::json j = read_json_file(o.geometry_file, "geometry");
+    if (!j.is_object()) throw UserError("geometry = '" + o.geometry_file + "': must be a JSON object");
+    auto number = [&](const std::string& key) {
+        const auto& v = j.at(key);
+        if (!v.is_number()) throw UserError(o.geometry_file + ": " + key + " = " + v.dump() + ": must be a number");
+        return v.get<double>();
+    };
+    for (const auto& [key, value] : j.items()) {
+        if (key == "shape") {
+            if (!value.is_string() || (value != "conical" && value != "rectangular"))
+                throw UserError(o.geometry_file + ": shape = " + value.dump() + ": must be \"conical\" or \"rectangular\"");
+            if (!sub.count("--rect")) o.rect = value == "rectangular";
+        } else if (key == "theta_deg") {
+            if (!sub.count("--theta")) o.theta = number(key);
+        } else if (key == "outlet_m") {
+            if (!sub.count("--outlet") && !sub.count("--a")) o.outlet = number(key);
+        } else if (key == "D_m") {
+            if (!sub.count("--diameter")) o.diameter = number(key);
+        } else if (key == "body_height_m") {
+            if (!sub.count("--body-height")) o.body_height = number(key);
+        } else if (key == "a_m") {
+            if (!sub.count("--a") && !sub.count("--outlet")) o.a = number(key);
+        } else if (key == "b_m") {
+            if (!sub.count("--b")) o.b = number(key);
+        } else if (key == "c_m") {
+            if (!sub.count("--c")) o.c = number(key);
+        } else if (key.rfind("_", 0) != 0) {  // keys starting with '_' are comments
+            throw UserError(o.geometry_file + ": unknown key '" + key +
+                            "' (known: shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m)");
+        }
+    }
 }
 
-ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
+ks::SiloCaseSettings settings_from(SiloCli o, CLI::App& sub) {
     ks::SiloCaseSettings s;
+    if (!o.geometry_file.empty()) apply_geometry_file(o, sub);
+    if (o.theta == -1 && !sub.count("--theta"))
+        throw UserError("theta: missing; give --theta DEG (or theta_deg in --geometry)");
     if (o.rect) {
         if (sub.count("--diameter")) throw UserError("--diameter applies to the conical silo, not with --rect");
         if (sub.count("--outlet") && sub.count("--a"))
             throw UserError("--outlet and --a both set the slot width of the rectangular hopper; give one");
-        const double a = o.a > 0 ? o.a : (o.outlet > 0 ? o.outlet : 0.03);
         if (sub.count("--a") && !(o.a > 0)) throw UserError("a = " + std::to_string(o.a) + ": must be positive");
+        const double a = o.a != -1 ? o.a : (o.outlet != -1 ? o.outlet : 0.03);
         s.geometry = ks::SiloGeometry::rectangular(o.theta, a, o.b, o.c, o.body_height);
     } else {
         for (const char* opt : {"--a", "--b", "--c"})
             if (sub.count(opt)) throw UserError(std::string(opt) + " applies to a rectangular hopper: add --rect");
-        s.geometry = ks::SiloGeometry::conical(o.theta, sub.count("--outlet") ? o.outlet : 0.035, o.diameter,
-                                               o.body_height);
+        s.geometry = ks::SiloGeometry::conical(o.theta, o.outlet != -1 ? o.outlet : 0.035, o.diameter, o.body_height);
     }
     if (sub.count("--particles") && sub.count("--fill-mass"))
         throw UserError("--particles and --fill-mass both set the amount of grain; give one");
@@ -184,7 +211,8 @@ void write_plots(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::S
 
 void run_silo(const SiloCli& o, CLI::App& sub) {
     const ks::SiloCaseSettings s = settings_from(o, sub);
-    const fs::path dir = o.out.empty() ? fs::path("silo_theta" + fixed(o.theta, 0)) : fs::path(o.out);
+    const fs::path dir =
+        o.out.empty() ? fs::path("silo_theta" + fixed(s.geometry.half_angle_deg, 0)) : fs::path(o.out);
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
@@ -195,7 +223,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
               << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string() << std::endl;
     auto progress = [](const ks::SiloProgress& p) {
-        std::cout << "[" << std::setw(7) << duration(p.wall_s) << "] " << std::left << std::setw(9) << p.phase
+        std::cout << "[" << std::setw(7) << duration_text(p.wall_s) << "] " << std::left << std::setw(9) << p.phase
                   << std::right << " t = " << fixed(p.time, 3) << " s";
         if (p.phase == "discharge" || p.phase == "done")
             std::cout << " (" << fixed(p.discharge_time, 3) << " s open)  discharged " << p.grains_discharged
@@ -230,7 +258,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
                       {"stop_reason", r.stop_reason}};
     nlohmann::json fit{{"ok", r.fit.ok},
                        {"window", "discharged mass between " + fixed(100 * r.fit.lower_fraction, 0) + " % and " +
-                                      fixed(100 * r.fit.upper_fraction, 0) + " % of the filled mass"},
+                                      fixed(100 * r.fit.upper_fraction, 0) + " % of the mass discharged at the end"},
                        {"t_begin_s", r.fit.t_begin},
                        {"t_end_s", r.fit.t_end},
                        {"samples", r.fit.n}};
@@ -299,7 +327,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     std::cout << "flow pattern: " << ks::to_string(r.flow.pattern) << " (wall/axis velocity ratio "
               << fixed(r.flow.ratio, 3) << ")\n";
     std::cout << r.steps << " steps of " << std::setprecision(3) << r.time_step << " s, wall time "
-              << duration(r.wall_s) << "\nwrote " << (dir / "summary.json").string() << ", "
+              << duration_text(r.wall_s) << "\nwrote " << (dir / "summary.json").string() << ", "
               << (dir / "discharge.csv").string() << (o.no_plots ? "" : ", section.png, discharge.png") << "\n";
 }
 
@@ -311,7 +339,11 @@ void add_silo_command(CLI::App& app) {
         "silo",
         "The seed's silo case on the native DEM kernel: wheat grains generated in the silo, filled against a closed "
         "outlet, then discharged; writes discharge.csv, summary.json (rate, flow pattern), section.png");
-    sub->add_option("--theta", o->theta, "hopper half angle from the vertical [deg], 0 < theta < 90")->required();
+    sub->add_option("--theta", o->theta, "hopper half angle from the vertical [deg], 0 < theta < 90 (required unless "
+                                         "--geometry gives theta_deg)");
+    sub->add_option("--geometry", o->geometry_file,
+                    "geometry JSON (shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m; see "
+                    "examples/silo/); options given on the command line win");
     sub->add_option("--outlet", o->outlet, "outlet diameter d [m] (conical, default 0.035) or slot width a (--rect)");
     sub->add_option("--diameter", o->diameter, "silo diameter D [m]")->capture_default_str();
     sub->add_option("--body-height", o->body_height, "height of the vertical body above the hopper [m]")
