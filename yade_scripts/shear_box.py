@@ -68,6 +68,7 @@ SERVO_PERIOD = 10                # steps between lid velocity updates
 SERVO_GAIN = 1.0                 # fraction of the force error corrected per update, relative to the lid contact stiffness
 INTEGRAL_GAIN = 0.1              # integral part of the servo: this fraction of the proportional speed accumulates per update
 STIFFNESS_SMOOTHING = 0.1        # weight of the newest lid stiffness / force in their running means (see servo_step)
+INTEGRAL_LEAK = 0.1              # ...outside it, this fraction of the integral decays per update
 INTEGRAL_BAND = 0.25             # ...only while the force error is below this fraction of the target
 APPROACH_BELOW = 0.10            # while consolidating, a force error above this fraction of the target: fast approach
 CONSOLIDATION_CHUNK = 200        # steps between quasi-static checks
@@ -389,6 +390,10 @@ def main():
             # dilation burst (mean error beyond the band) is followed, not left to the weak proportional part.
             if not servo["approach"] or abs(error_mean) < INTEGRAL_BAND * force_target:
                 servo["v_integral"] -= INTEGRAL_GAIN * SERVO_GAIN * error_mean / (stiffness * O.dt * SERVO_PERIOD)
+            else:
+                # Outside the band it leaks away rather than freezing: a frozen downward integral balanced the
+                # proportional part at 2.5x the target stress on a static sample (friction 0.25, 3 kPa, measured).
+                servo["v_integral"] *= 1.0 - INTEGRAL_LEAK
                 servo["v_integral"] = min(servo["cap_up"], max(-servo["cap_down"], servo["v_integral"]))
             vz += servo["v_integral"]
         else:
