@@ -317,9 +317,57 @@ void BasicSimulation<Law>::kick() {
 }
 
 template <class Law>
+void BasicSimulation<Law>::reorder_spheres() {
+  const std::size_t n = x_.size();
+  if (n < 2) return;
+  Vec3 lo = x_[0], hi = x_[0];
+  double rmax = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(x_[i]);
+    hi = hi.cwiseMax(x_[i]);
+    rmax = std::max(rmax, r_[i]);
+  }
+  if (!lo.allFinite() || !hi.allFinite()) return;  // the neighbour build reports it
+  double cs = 2 * rmax + skin_;
+  auto ncell = [&](double c, int d) { return std::uint64_t((hi[d] - lo[d]) / c) + 1; };
+  while (double(ncell(cs, 0)) * double(ncell(cs, 1)) * double(ncell(cs, 2)) > 4.0 * double(n) + 64) cs *= 1.26;
+  const std::uint64_t nx = ncell(cs, 0), ny = ncell(cs, 1);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> key(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 c = (x_[i] - lo) / cs;
+    key[i] = {(std::uint64_t(c.z()) * ny + std::uint64_t(c.y())) * nx + std::uint64_t(c.x()), std::uint32_t(i)};
+  }
+  std::sort(key.begin(), key.end());  // by cell, then by old index: deterministic
+  std::vector<std::int32_t> old2new(n);
+  bool identity = true;
+  for (std::size_t k = 0; k < n; ++k) {
+    old2new[key[k].second] = std::int32_t(k);
+    identity = identity && key[k].second == k;
+  }
+  if (identity) return;
+  auto permute = [&](auto& vec, std::size_t per) {
+    auto tmp = vec;
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t m = 0; m < per; ++m) vec[k * per + m] = tmp[std::size_t(key[k].second) * per + m];
+  };
+  permute(x_, 1); permute(v_, 1); permute(w_, 1); permute(f_, 1); permute(t_, 1);
+  permute(r_, 1); permute(mass_, 1); permute(inv_mass_, 1); permute(inv_inertia_, 1); permute(mat_, 1);
+  permute(clump_, 1);
+  permute(wall_slot_id_, kWallSlots); permute(wall_slot_s_, kWallSlots); permute(wall_slot_f_, kWallSlots);
+  for (auto& m : cmem_) m = std::uint32_t(old2new[m]);
+  for (auto& ref : body_ref_)
+    if (ref >= 0) ref = old2new[ref];
+  rebuild_body_index();
+  nl_.renumber(old2new, n);
+}
+
+template <class Law>
 void BasicSimulation<Law>::compute_forces(bool rebuild) {
-  if (rebuild || !nl_.valid() || nl_.built_positions().size() != x_.size())
+  if (rebuild || !nl_.valid() || nl_.built_positions().size() != x_.size()) {
+    if (reorder_every_ > 0 && builds_since_reorder_ % reorder_every_ == 0) reorder_spheres();
+    ++builds_since_reorder_;
     nl_.build(x_, r_, clump_, skin_, nt());
+  }
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
   pair_f_.resize(nl_.num_pairs());
   pair_tj_.resize(nl_.num_pairs());
