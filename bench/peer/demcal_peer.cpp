@@ -3,7 +3,7 @@
 // and floor z = 0; gravity 9.81; Hertz-Mindlin with tangential history, no rolling friction; particles E = 1.0024e9,
 // nu = 0.4, rho = 1430; walls E = 2.08e9, nu = 0.3; e = 0.5 (pp) / 0.6 (pw), mu = 0.3 / 0.25; dt = 5e-7; skin
 // 0.3 mm (LIGGGHTS `neighbor 0.0003 bin`). 200 warm-up steps, then STEPS timed steps.
-// Usage: demcal_peer [STEPS=2000] [THREADS=1]. Prints one JSON line.
+// Usage: demcal_peer [STEPS=2000] [THREADS=1] [REORDER_EVERY=10 (neighbour builds; 0 = never)]. Prints one JSON line.
 #include <omp.h>
 #include <sys/resource.h>
 
@@ -30,6 +30,7 @@ long status_kb(const char* key) {  // VmHWM / VmRSS from /proc/self/status [kB]
 int main(int argc, char** argv) {
   const long steps = argc > 1 ? std::atol(argv[1]) : 2000;
   const int threads = argc > 2 ? std::atoi(argv[2]) : 1;
+  const int reorder = argc > 3 ? std::atoi(argv[3]) : 10;
   if (steps <= 0 || threads <= 0) {
     std::fprintf(stderr, "usage: demcal_peer [STEPS > 0] [THREADS > 0]\n");
     return 2;
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
   sim.set_timestep(5e-7);
   sim.set_skin(0.0003);
   sim.set_threads(threads);
+  sim.set_reorder_every(reorder);
   sim.step(200);
   const auto t0 = std::chrono::steady_clock::now();
   struct rusage ru0, ru1;
@@ -74,11 +76,11 @@ int main(int argc, char** argv) {
   mean_z /= double(n);
   const long hwm = status_kb("VmHWM:");
   std::printf(
-      "{\"code\":\"demcal\",\"spheres\":%zu,\"steps\":%ld,\"threads\":%d,\"wall_s\":%.4f,\"cpu_s\":%.4f,"
+      "{\"code\":\"demcal\",\"spheres\":%zu,\"steps\":%ld,\"threads\":%d,\"reorder_every\":%d,\"wall_s\":%.4f,\"cpu_s\":%.4f,"
       "\"particle_steps_per_s\":%.6g,\"peak_rss_kb\":%ld,\"rss_before_kb\":%ld,\"bytes_per_particle\":%.1f,"
       "\"kernel_bytes_per_particle\":%.1f,\"neighbor_builds\":%zu,\"pairs\":%zu,\"kinetic_energy_J\":%.9g,\"rotational_kinetic_energy_J\":%.6g,"
       "\"mean_z_m\":%.8f,\"max_speed_m_s\":%.6g}\n",
-      n, steps, threads, wall, cpu, double(n) * double(steps) / wall, hwm, rss0, 1024.0 * double(hwm) / double(n),
+      n, steps, threads, reorder, wall, cpu, double(n) * double(steps) / wall, hwm, rss0, 1024.0 * double(hwm) / double(n),
       double(sim.memory_bytes()) / double(n), sim.neighbor_builds(), sim.neighbor_pairs(), sim.kinetic_energy(), sim.rotational_kinetic_energy(), mean_z,
       max_v);
   return 0;
