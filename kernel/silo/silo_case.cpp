@@ -182,6 +182,7 @@ void validate(const SiloCaseSettings& s) {
     if (!(s.stop_fraction > 0 && s.stop_fraction <= 1))
         bad("stop_fraction", s.stop_fraction, "must lie in (0, 1]");
     if (!(s.threads >= 1)) bad("threads", s.threads, "must be at least 1");
+    if (!(s.skin >= 0) || s.skin > 0.01) bad("skin", s.skin, "must lie in [0, 0.01] m (0: automatic)");
     if (!s.vtk_dir.empty() && !(s.vtk_interval > 0)) bad("vtk_every", s.vtk_interval, "must be > 0 s");
     if (!(s.record_interval > 0)) bad("record_interval", s.record_interval, "must be > 0 s");
     if (!(s.steady_lower >= 0 && s.steady_lower < s.steady_upper && s.steady_upper <= 1))
@@ -218,7 +219,7 @@ SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void
     r.grains = long(placed.size());
     const double dt = s.time_step > 0 ? s.time_step : s.time_step_fraction * sim.rayleigh_timestep();
     sim.set_timestep(dt);
-    if (s.skin > 0) sim.set_skin(s.skin);
+    sim.set_skin(s.skin > 0 ? s.skin : std::clamp(40 * dt * 1.0, 0.0002, 0.001));
     r.time_step = dt;
 
     SiloProgress pr;
@@ -235,7 +236,8 @@ SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void
     };
     {
         std::ostringstream note;
-        note << "generated up to z = " << gen.top() << " m (walls to " << wall_top << " m), dt = " << dt << " s";
+        note << "generated up to z = " << gen.top() << " m (walls to " << wall_top << " m), dt = " << dt
+             << " s, skin " << sim.skin() << " m";
         report("generated", note.str());
     }
 
