@@ -267,10 +267,14 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (r.fit.ok) {
         fit["rate_kg_s"] = r.fit.rate;
         fit["rate_se_kg_s"] = r.fit.rate_se;
+        fit["rate_batch_se_kg_s"] = r.fit.rate_batch_se;
+        fit["batches"] = r.fit.batches;
         fit["r_squared"] = r.fit.r_squared;
         fit["uncertainty_note"] =
-            "standard error of the least-squares slope; the samples of a cumulative mass are correlated, so it "
-            "understates the run-to-run spread (repeat with other --seed values for that)";
+            "rate_se_kg_s: standard error of the least-squares slope; the samples of a cumulative mass are correlated, "
+            "so it understates the uncertainty. rate_batch_se_kg_s: slopes fitted over four equal time spans of the "
+            "window, the standard error of their mean (the flow's own fluctuation). Neither is the run-to-run spread: "
+            "repeat with other --seed values for that";
     } else {
         fit["message"] = r.fit.message;
     }
@@ -323,7 +327,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
               << r.stop_reason << ")\n";
     if (r.fit.ok)
         std::cout << "rate W = " << fixed(r.fit.rate * 1e3, 2) << " +/- " << fixed(r.fit.rate_se * 1e3, 2)
-                  << " g/s (steady part " << fixed(r.fit.t_begin, 3) << ".." << fixed(r.fit.t_end, 3)
+                  << " g/s (slope SE; batch SE " << fixed(r.fit.rate_batch_se * 1e3, 2) << " g/s) (steady part " << fixed(r.fit.t_begin, 3) << ".." << fixed(r.fit.t_end, 3)
                   << " s), R^2 = " << fixed(r.fit.r_squared, 5) << "\n";
     else
         std::cout << "rate: not determined (" << r.fit.message << ")\n";

@@ -50,6 +50,39 @@ DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, dou
     f.r_squared = smm > 0 ? 1 - sse / smm : 1.0;
     f.rate_se = std::sqrt(sse / (n - 2) / stt);
     f.ok = std::isfinite(f.rate);
+    // batch slopes over four equal time spans of the window (each needs 3 samples)
+    constexpr int nb = 4;
+    std::vector<double> slopes;
+    for (int b = 0; b < nb; ++b) {
+        const double t0 = f.t_begin + (f.t_end - f.t_begin) * b / nb, t1 = f.t_begin + (f.t_end - f.t_begin) * (b + 1) / nb;
+        double bt = 0, bm = 0;
+        int bn = 0;
+        for (const auto& s : samples)
+            if (s.mass >= lo && s.mass <= hi && s.time >= t0 && (s.time < t1 || (b == nb - 1 && s.time <= t1))) {
+                bt += s.time;
+                bm += s.mass;
+                ++bn;
+            }
+        if (bn < 3) continue;
+        bt /= bn;
+        bm /= bn;
+        double btt = 0, btm = 0;
+        for (const auto& s : samples)
+            if (s.mass >= lo && s.mass <= hi && s.time >= t0 && (s.time < t1 || (b == nb - 1 && s.time <= t1))) {
+                btt += (s.time - bt) * (s.time - bt);
+                btm += (s.time - bt) * (s.mass - bm);
+            }
+        if (btt > 0) slopes.push_back(btm / btt);
+    }
+    if (slopes.size() >= 2) {
+        double mean = 0, var = 0;
+        for (double v : slopes) mean += v;
+        mean /= double(slopes.size());
+        for (double v : slopes) var += (v - mean) * (v - mean);
+        var /= double(slopes.size() - 1);
+        f.batches = int(slopes.size());
+        f.rate_batch_se = std::sqrt(var / double(slopes.size()));
+    }
     return f;
 }
 

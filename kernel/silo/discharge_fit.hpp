@@ -16,6 +16,10 @@ struct DischargeFit {
     double rate = 0;         // slope [kg/s]
     double rate_se = 0;      // standard error of the slope [kg/s]
     double intercept = 0;    // [kg]
+    // Batch estimate: the window cut into `batches` equal time spans, a slope fitted in each; the standard error of
+    // their mean (sd / sqrt(batches)). It sees the fluctuation of the flow that rate_se (correlated samples) misses.
+    double rate_batch_se = 0;
+    int batches = 0;
     double r_squared = 0;
     int n = 0;               // samples used
     double t_begin = 0, t_end = 0;        // the time window used [s]

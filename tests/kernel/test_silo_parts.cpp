@@ -108,6 +108,9 @@ TEST_CASE("discharge rate: least squares over the steady part", "[silo]") {
     CHECK(f.rate_se > 0);
     CHECK(f.rate_se < 0.002);
     CHECK(f.n > 50);
+    CHECK(f.batches == 4);
+    CHECK(f.rate_batch_se > 0);
+    CHECK(f.rate_batch_se < 0.01);
     CHECK(fit_discharge_rate({{0, 0}, {1, 1}}, 1).ok == false);
 }
 
