@@ -158,7 +158,7 @@ class BasicSimulation {
 
  private:
   void prepare();
-  void compute_forces(bool rebuild);
+  void compute_forces(bool rebuild, double dt_history);
   bool kick_drift(double kick);
   void kick();
   void update_members(std::size_t c, bool positions);

@@ -362,7 +362,7 @@ void BasicSimulation<Law>::reorder_spheres() {
 }
 
 template <class Law>
-void BasicSimulation<Law>::compute_forces(bool rebuild) {
+void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   if (rebuild || !nl_.valid() || nl_.built_positions().size() != x_.size()) {
     if (reorder_every_ > 0 && builds_since_reorder_ % reorder_every_ == 0) reorder_spheres();
     ++builds_since_reorder_;
@@ -372,7 +372,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild) {
   pair_f_.resize(nl_.num_pairs());
   pair_tj_.resize(nl_.num_pairs());
   const int nm = nm_coeffs_;
-  const double dt = dt_;
+  const double dt = dt_history;  // the tangential springs advance by vt * dt_history
   const int nw = int(walls_.size());
   const std::uint32_t* row = nl_.row.data();
   const std::int32_t* nbr = nl_.nbr.data();
@@ -510,13 +510,15 @@ template <class Law>
 void BasicSimulation<Law>::step(long nsteps) {
   prepare();
   if (!forces_valid_) {
-    compute_forces(nl_.needs_rebuild(x_, nt()));
+    // forces of the current state (after an insertion, a removal, a wall toggled, velocities set): time does not
+    // advance, so neither do the tangential springs
+    compute_forces(nl_.needs_rebuild(x_, nt()), 0.0);
     forces_valid_ = true;
   }
   // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass
   for (long s = 0; s < nsteps; ++s) {
     const bool moved = kick_drift(s == 0 ? 1.0 : 2.0);
-    compute_forces(moved);
+    compute_forces(moved, dt_);
     time_ += dt_;
     ++steps_;
   }

@@ -45,7 +45,9 @@ run_one() {  # name rep command...  (a failed run is retried once, then left out
 }
 runs=(lig1 lig2 yade1 dem1 dem2)
 [ "${YADE_J2:-0}" = 1 ] && runs+=(yade2)
-for rep in $(seq 1 "$REPS"); do
+# SUMMARY_ONLY=1: recompute the summary from the logs already in $LOGS
+[ "${SUMMARY_ONLY:-0}" = 1 ] && REPS_RUN=0 || REPS_RUN="$REPS"
+for rep in $(seq 1 "$REPS_RUN"); do
   order=("${runs[@]}")
   if [ $((rep % 2)) = 0 ]; then order=(); for ((k=${#runs[@]}-1; k>=0; k--)); do order+=("${runs[k]}"); done; fi
   for r in "${order[@]}"; do
@@ -66,6 +68,10 @@ logs, reps, steps, runs = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.a
 def maxrss(path):
     m = re.search(r"Maximum resident set size \(kbytes\): (\d+)", open(path).read())
     return int(m.group(1)) if m else None
+def cpu_seconds(path):  # user + system time of the whole process tree (setup and warm-up included)
+    t = open(path).read()
+    u = re.search(r"User time \(seconds\): ([0-9.]+)", t); s = re.search(r"System time \(seconds\): ([0-9.]+)", t)
+    return float(u.group(1)) + float(s.group(1)) if u and s else None
 res = {}
 for r in runs:
     rows = []
@@ -86,6 +92,11 @@ for r in runs:
             row.update(particles=n, workers=j["threads"], seconds=j["wall_s"], rate=j["particle_steps_per_s"],
                        ke=j.get("kinetic_energy_J"), mean_z=j.get("mean_z_m"))
         row["bytes_per_particle"] = 1024.0 * row["maxrss_kb"] / row["particles"] if row["maxrss_kb"] else None
+        cpu = cpu_seconds(f"{logs}/{r}_{k}.time")
+        # particle-steps per CPU second over the whole process (200 warm-up steps and the setup included): robust to
+        # the load of other jobs, but a cost, not a speed, for runs with 2 workers
+        row["cpu_rate"] = row["particles"] * (steps + 200) / cpu if cpu else None
+        row["rep"] = k
         rows.append(row)
     if not rows:
         continue
@@ -93,27 +104,39 @@ for r in runs:
     res[r] = {"runs_ok": len(rows), "median_rate": statistics.median(rates), "min_rate": min(rates), "max_rate": max(rates),
               "rates": rates, "particles": rows[0]["particles"], "workers": rows[0]["workers"],
               "median_bytes_per_particle": statistics.median([x["bytes_per_particle"] for x in rows]),
-              "ke_J": rows[-1]["ke"]}
+              "ke_J": rows[-1]["ke"], "median_cpu_rate": statistics.median([x["cpu_rate"] for x in rows]),
+              "by_rep": {x["rep"]: x["rate"] for x in rows}}
 ratio = lambda a, b: res[a]["median_rate"] / res[b]["median_rate"] if a in res and b in res else None
 summary = {"steps": steps, "reps": reps, "host": platform.node(), "cpus": os.cpu_count(),
            "load_avg_end": os.getloadavg(), "runs": res,
            "ratios": {"demcal1/liggghts1": ratio("dem1", "lig1"), "demcal2/liggghts2": ratio("dem2", "lig2"),
                       "demcal1/yade1": ratio("dem1", "yade1"), "demcal2/yade1": ratio("dem2", "yade1")}}
+def per_rep(a, b):  # ratio within each alternation (similar load), then the median
+    if a not in res or b not in res: return None
+    common = sorted(set(res[a]["by_rep"]) & set(res[b]["by_rep"]))
+    return statistics.median([res[a]["by_rep"][k] / res[b]["by_rep"][k] for k in common]) if common else None
+summary["ratios_per_rep_median"] = {k: per_rep(*{"demcal1/liggghts1": ("dem1", "lig1"), "demcal2/liggghts2": ("dem2", "lig2"),
+    "demcal1/yade1": ("dem1", "yade1"), "demcal2/yade1": ("dem2", "yade1")}[k]) for k in summary["ratios"]}
+cpu_ratio = lambda a, b: res[a]["median_cpu_rate"] / res[b]["median_cpu_rate"] if a in res and b in res else None
+summary["cpu_time_ratios"] = {"demcal1/liggghts1": cpu_ratio("dem1", "lig1"), "demcal1/yade1": cpu_ratio("dem1", "yade1")}
 json.dump(summary, open(f"{logs}/summary.json", "w"), indent=1)
 names = {"lig1": "LIGGGHTS, 1 process", "lig2": "LIGGGHTS, 2 MPI ranks", "yade1": "YADE, 1 thread",
          "yade2": "YADE, 2 threads", "dem1": "demcal kernel, 1 thread", "dem2": "demcal kernel, 2 threads"}
-out = ["| code | particles | median particle-steps/s | min - max | peak RSS / particle (B) | KE at the end (J) |",
-       "| --- | --- | --- | --- | --- | --- |"]
+out = ["| code | particles | runs | median particle-steps/s | min - max | per CPU second (whole process) | peak RSS / particle (B) | KE at the end (J) |",
+       "| --- | --- | --- | --- | --- | --- | --- | --- |"]
 for r in runs:
     if r not in res:
-        out.append(f"| {names[r]} | - | failed | - | - | - |"); continue
+        out.append(f"| {names[r]} | - | 0 | failed | - | - | - | - |"); continue
     x = res[r]
-    out.append(f"| {names[r]} | {x['particles']} | {x['median_rate']:.3g} | {x['min_rate']:.3g} - {x['max_rate']:.3g} | "
-               f"{x['median_bytes_per_particle']:.0f} | {x['ke_J'] if x['ke_J'] is not None else '-'} |")
+    out.append(f"| {names[r]} | {x['particles']} | {x['runs_ok']} | {x['median_rate']:.3g} | {x['min_rate']:.3g} - {x['max_rate']:.3g} | "
+               f"{x['median_cpu_rate']:.3g} | {x['median_bytes_per_particle']:.0f} | {x['ke_J'] if x['ke_J'] is not None else '-'} |")
 out.append("")
 for k, v in summary["ratios"].items():
-    if v is not None: out.append(f"- {k}: {v:.2f}")
-out.append(f"- load average at the end: {' '.join('%.2f' % l for l in summary['load_avg_end'])}")
+    if v is not None:
+        out.append(f"- {k}: {v:.2f} (ratio of medians); {summary['ratios_per_rep_median'][k]:.2f} (median of the per-alternation ratios)")
+for k, v in summary["cpu_time_ratios"].items():
+    if v is not None: out.append(f"- {k} per CPU second (whole process): {v:.2f}")
+out.append(f"- load average when summarised: {' '.join('%.2f' % l for l in summary['load_avg_end'])}")
 open(f"{logs}/summary.md", "w").write("\n".join(out) + "\n")
 print("\n".join(out))
 PY
