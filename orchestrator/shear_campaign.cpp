@@ -138,7 +138,9 @@ ShearCampaignRunner::ShearCampaignRunner(const fs::path& dir, ExecutionOptions o
     : dir_(fs::absolute(dir).lexically_normal()), options_(std::move(options)) {
     fs::create_directories(dir_);
     const fs::path lock = dir_ / ".lock";
-    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT, 0644);
+    // O_CLOEXEC: YADE children must not inherit the lock, or a resume right after kill -9 of the orchestrator finds
+    // the directory "in use" until the last orphan has died.
+    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (lock_fd_ < 0) throw std::runtime_error("cannot open " + lock.string());
     // flock is released by the kernel when the process dies, even by kill -9: no stale locks.
     if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {

@@ -1,5 +1,5 @@
 // `demcal sensitivity` over real YADE runs of the tiny box (examples/materials/sand-tiny.json): one parameter at three
-// levels (6 runs), killed with SIGKILL half-way and resumed by running the same command again.
+// levels at three stresses (9 runs), killed with SIGKILL half-way and resumed by running the same command again.
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -37,13 +37,13 @@ int finished_runs(const fs::path& dir) {
 
 TEST_CASE("a sensitivity study on real YADE runs, killed with SIGKILL, resumes re-using every finished run",
           "[yade][slow]") {
-    const fs::path dir = fs::temp_directory_path() / "demcal-test-sensitivity-yade";
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-sensitivity-yade-" + std::to_string(getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
-    // Two stresses, three friction levels, the base (0.5) in the middle: 6 runs of a few hundred spheres.
+    // Three stresses (a line needs 3 points), three friction levels, the base (0.5) in the middle: 9 tiny runs.
     const std::string args = std::string(" sensitivity ") + DEMCAL_SOURCE_DIR +
                              "/examples/materials/sand-tiny.json --params friction_coefficient --levels 3 --span 0.4"
-                             " --normal-stress 2e3,6e3 --jobs 2 --campaign " + dir.string();
+                             " --normal-stress 2e3,4e3,6e3 --jobs 2 --campaign " + dir.string();
     const pid_t pid = fork();
     REQUIRE(pid >= 0);
     if (pid == 0) {
@@ -69,7 +69,7 @@ TEST_CASE("a sensitivity study on real YADE runs, killed with SIGKILL, resumes r
     const auto study = nlohmann::json::parse(slurp(dir / "sensitivity.json"));
     // Every run finished before the kill is reused, none computed twice.
     CHECK(study.at("simulations_reused").get<int>() >= done_before_kill);
-    CHECK(study.at("simulations_run").get<int>() + done_before_kill <= 6 + 4);  // 3 levels x 2 stresses (+ base reuse)
+    CHECK(study.at("simulations_run").get<int>() + done_before_kill <= 9 + 4);  // 3 levels x 3 stresses (+ running at the kill)
     const auto& p = study.at("parameters").at(0);
     CHECK(p.at("name") == "friction_coefficient");
     REQUIRE(p.at("levels").size() == 3);
