@@ -1,4 +1,5 @@
 #include "kernel/silo/silo_case.hpp"
+#include "kernel/silo/input_error.hpp"
 
 #include "kernel/clump.hpp"
 #include "kernel/simulation.hpp"
@@ -19,14 +20,6 @@ namespace {
 
 constexpr double pi = 3.14159265358979323846;
 
-std::string num(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-[[noreturn]] void bad(const std::string& field, double value, const std::string& why) {
-    throw std::invalid_argument(field + " = " + num(value) + ": " + why);
-}
 
 // Random sequential addition of rigid clumps (no overlap) into the silo, slab by slab from the outlet upwards.
 // Slabs above the silo's top extend the body (the "generation column"); the caller extends the body wall to match.
@@ -169,24 +162,24 @@ int add_silo_walls(Simulation& sim, const SiloGeometry& g, int steel, double wal
 
 void validate(const SiloCaseSettings& s) {
     validate(s.geometry, wheat_length);
-    if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) bad("fill_mass", s.fill_mass, "must be >= 0 kg");
-    if (s.fill_mass == 0 && s.particles < 1) bad("particles", double(s.particles), "must be at least 1");
-    if (s.particles > 5000000) bad("particles", double(s.particles), "more than 5,000,000 grains");
+    if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
+    if (s.fill_mass == 0 && s.particles < 1) reject_setting("particles", double(s.particles), "must be at least 1");
+    if (s.particles > 5000000) reject_setting("particles", double(s.particles), "more than 5,000,000 grains");
     if (!(s.materials.stiffness_scale > 0) || s.materials.stiffness_scale > 100)
-        bad("stiffness_scale", s.materials.stiffness_scale, "must lie in (0, 100]");
-    if (s.time_step < 0 || !std::isfinite(s.time_step)) bad("dt", s.time_step, "must be >= 0 s (0: automatic)");
+        reject_setting("stiffness_scale", s.materials.stiffness_scale, "must lie in (0, 100]");
+    if (s.time_step < 0 || !std::isfinite(s.time_step)) reject_setting("dt", s.time_step, "must be >= 0 s (0: automatic)");
     if (!(s.time_step_fraction > 0 && s.time_step_fraction <= 1))
-        bad("dt_fraction", s.time_step_fraction, "must lie in (0, 1] (of the Rayleigh time step)");
-    if (!(s.fill_time_max > 0) || !std::isfinite(s.fill_time_max)) bad("fill_time", s.fill_time_max, "must be > 0 s");
-    if (!(s.max_time > 0) || !std::isfinite(s.max_time)) bad("max_time", s.max_time, "must be > 0 s");
+        reject_setting("dt_fraction", s.time_step_fraction, "must lie in (0, 1] (of the Rayleigh time step)");
+    if (!(s.fill_time_max > 0) || !std::isfinite(s.fill_time_max)) reject_setting("fill_time", s.fill_time_max, "must be > 0 s");
+    if (!(s.max_time > 0) || !std::isfinite(s.max_time)) reject_setting("max_time", s.max_time, "must be > 0 s");
     if (!(s.stop_fraction > 0 && s.stop_fraction <= 1))
-        bad("stop_fraction", s.stop_fraction, "must lie in (0, 1]");
-    if (!(s.threads >= 1)) bad("threads", s.threads, "must be at least 1");
-    if (!(s.skin >= 0) || s.skin > 0.01) bad("skin", s.skin, "must lie in [0, 0.01] m (0: automatic)");
-    if (!s.vtk_dir.empty() && !(s.vtk_interval > 0)) bad("vtk_every", s.vtk_interval, "must be > 0 s");
-    if (!(s.record_interval > 0)) bad("record_interval", s.record_interval, "must be > 0 s");
+        reject_setting("stop_fraction", s.stop_fraction, "must lie in (0, 1]");
+    if (!(s.threads >= 1)) reject_setting("threads", s.threads, "must be at least 1");
+    if (!(s.skin >= 0) || s.skin > 0.01) reject_setting("skin", s.skin, "must lie in [0, 0.01] m (0: automatic)");
+    if (!s.vtk_dir.empty() && !(s.vtk_interval > 0)) reject_setting("vtk_every", s.vtk_interval, "must be > 0 s");
+    if (!(s.record_interval > 0)) reject_setting("record_interval", s.record_interval, "must be > 0 s");
     if (!(s.steady_lower >= 0 && s.steady_lower < s.steady_upper && s.steady_upper <= 1))
-        bad("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
+        reject_setting("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
 }
 
 SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress) {
@@ -364,16 +357,16 @@ SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void
             break;
         }
         if (mass_out >= s.stop_fraction * r.filled_mass * (1 - 1e-12)) {
-            r.stop_reason = "stop fraction " + num(s.stop_fraction) + " of the filled mass discharged";
+            r.stop_reason = "stop fraction " + setting_text(s.stop_fraction) + " of the filled mass discharged";
             break;
         }
         if (t - last_out_time > stall_time) {
-            r.stop_reason = "flow stopped: no grain left for " + num(stall_time) + " s, " +
+            r.stop_reason = "flow stopped: no grain left for " + setting_text(stall_time) + " s, " +
                             std::to_string(sim.num_bodies()) + " grains remain";
             break;
         }
         if (t >= s.max_time) {
-            r.stop_reason = "time limit " + num(s.max_time) + " s";
+            r.stop_reason = "time limit " + setting_text(s.max_time) + " s";
             break;
         }
     }

@@ -1,4 +1,5 @@
 #include "kernel/silo/silo_geometry.hpp"
+#include "kernel/silo/input_error.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,14 +12,6 @@ namespace {
 constexpr double pi = 3.14159265358979323846;
 double rad(double deg) { return deg * pi / 180.0; }
 
-std::string num(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-[[noreturn]] void bad(const std::string& field, double value, const std::string& why) {
-    throw std::invalid_argument(field + " = " + num(value) + ": " + why);
-}
 }  // namespace
 
 SiloGeometry SiloGeometry::conical(double theta_deg, double outlet_d, double diameter_D, double body_h) {
@@ -117,33 +110,33 @@ std::string SiloGeometry::describe() const {
 }
 
 void validate(const SiloGeometry& g, double particle_size, double min_outlet_particles) {
-    if (!(particle_size > 0)) bad("particle_size", particle_size, "must be positive");
+    if (!(particle_size > 0)) reject_setting("particle_size", particle_size, "must be positive");
     if (!(g.half_angle_deg > 0 && g.half_angle_deg < 90))
-        bad("theta", g.half_angle_deg, "the hopper half angle must lie strictly between 0 and 90 deg");
-    if (!(g.body_height >= 0) || !std::isfinite(g.body_height)) bad("body_height", g.body_height, "must be >= 0 m");
+        reject_setting("theta", g.half_angle_deg, "the hopper half angle must lie strictly between 0 and 90 deg");
+    if (!(g.body_height >= 0) || !std::isfinite(g.body_height)) reject_setting("body_height", g.body_height, "must be >= 0 m");
     const char* outlet_name = g.shape == SiloShape::conical ? "outlet" : "a (outlet width)";
-    if (!(g.outlet > 0) || !std::isfinite(g.outlet)) bad(outlet_name, g.outlet, "must be positive");
+    if (!(g.outlet > 0) || !std::isfinite(g.outlet)) reject_setting(outlet_name, g.outlet, "must be positive");
     if (g.outlet < min_outlet_particles * particle_size)
-        bad(outlet_name, g.outlet,
-            "the outlet must be at least " + num(min_outlet_particles) + " particle sizes (" +
-                num(min_outlet_particles * particle_size) + " m for d_p = " + num(particle_size) +
+        reject_setting(outlet_name, g.outlet,
+            "the outlet must be at least " + setting_text(min_outlet_particles) + " particle sizes (" +
+                setting_text(min_outlet_particles * particle_size) + " m for d_p = " + setting_text(particle_size) +
                 " m), or the grains arch over it");
     if (g.shape == SiloShape::conical) {
         if (!(g.diameter > g.outlet) || !std::isfinite(g.diameter))
-            bad("diameter", g.diameter, "the silo diameter D must be larger than the outlet (" + num(g.outlet) + " m)");
+            reject_setting("diameter", g.diameter, "the silo diameter D must be larger than the outlet (" + setting_text(g.outlet) + " m)");
     } else {
         if (!(g.width > g.outlet) || !std::isfinite(g.width))
-            bad("c (width)", g.width, "the silo width c must be larger than the outlet width a (" + num(g.outlet) + " m)");
-        if (!(g.depth > 0) || !std::isfinite(g.depth)) bad("b (depth)", g.depth, "must be positive");
+            reject_setting("c (width)", g.width, "the silo width c must be larger than the outlet width a (" + setting_text(g.outlet) + " m)");
+        if (!(g.depth > 0) || !std::isfinite(g.depth)) reject_setting("b (depth)", g.depth, "must be positive");
         if (g.depth < min_outlet_particles * particle_size)
-            bad("b (depth)", g.depth,
-                "the slot spans the depth b, which must be at least " + num(min_outlet_particles) +
-                    " particle sizes (" + num(min_outlet_particles * particle_size) + " m)");
+            reject_setting("b (depth)", g.depth,
+                "the slot spans the depth b, which must be at least " + setting_text(min_outlet_particles) +
+                    " particle sizes (" + setting_text(min_outlet_particles * particle_size) + " m)");
     }
     const double size = g.shape == SiloShape::conical ? g.diameter : g.width;
     if (g.hopper_height() > 20 * size)
-        bad("theta", g.half_angle_deg,
-            "the hopper would be " + num(g.hopper_height()) + " m tall (more than 20 silo sizes)");
+        reject_setting("theta", g.half_angle_deg,
+            "the hopper would be " + setting_text(g.hopper_height()) + " m tall (more than 20 silo sizes)");
 }
 
 }  // namespace demcal::kernel::silo
