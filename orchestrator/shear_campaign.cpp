@@ -4,6 +4,7 @@
 #include "orchestrator/shear_params.hpp"
 #include "orchestrator/slurm_executor.hpp"
 
+#include <optional>
 #include <fcntl.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -134,6 +135,20 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
         throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");
 }
 
+namespace {
+// The result a run left in its directory, if it is a usable one.
+std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
+    const fs::path file = run_dir / "result.json";
+    if (!fs::exists(file)) return std::nullopt;
+    try {
+        auto result = nlohmann::json::parse(read_text_file(file));
+        if (result.contains("peak_shear_stress") && result["peak_shear_stress"].is_number()) return result;
+    } catch (const std::exception&) {
+    }
+    return std::nullopt;
+}
+}  // namespace
+
 ShearCampaignRunner::ShearCampaignRunner(const fs::path& dir, ExecutionOptions options)
     : dir_(fs::absolute(dir).lexically_normal()), options_(std::move(options)) {
     fs::create_directories(dir_);
@@ -165,6 +180,12 @@ void ShearCampaignRunner::recover_stale_runs() {
             cancel_stale_slurm_task(r.pgid);
         else
             kill_stale_process_group(r.pgid, r.run_dir);
+        // A run that wrote its result just before the orchestrator died is finished: keep it. The file is removed
+        // before every attempt and the script writes it atomically as its last act, so it is this attempt's, whole.
+        if (const auto result = finished_result(r.run_dir)) {
+            store_->mark_done(r.hash, *result, 0, result->value("wall_time_s", 0.0), 0.0);
+            continue;
+        }
         store_->reset_to_pending(r.hash, "the orchestrator (pid " + std::to_string(r.owner_pid) +
                                              ") stopped while the run was running");
     }

@@ -1,4 +1,6 @@
 #include "orchestrator/campaign_store.hpp"
+#include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_campaign.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -50,5 +52,32 @@ TEST_CASE("the store keeps runs, states, results and attempts across reopening",
     CHECK(s.run("h2")->state == RunState::pending);
     CHECK(s.attempts("h2").back().cause == "interrupted");
     CHECK(s.runs_in_state(RunState::running).empty());
+    fs::remove_all(d);
+}
+
+TEST_CASE("a run that wrote its result just before the orchestrator died is kept as done on reopening", "[store]") {
+    const fs::path d = fresh_dir("stale-runs");
+    std::int64_t cid;
+    {
+        CampaignStore s(d / "campaign.sqlite");
+        cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
+        for (const std::string h : {"finished", "unfinished", "garbled"}) {
+            fs::create_directories(d / "runs" / h);
+            s.ensure_run(cid, h, {{"normal_stress", 1e4}}, d / "runs" / h, {{"replicate", 0}});
+            s.mark_running(h, 999999, 999999, "local");  // no such process group: the orchestrator died with it
+        }
+    }
+    demcal::orchestrator::write_text_file_atomically(d / "runs/finished/result.json",
+                                                     R"({"peak_shear_stress": 4321.0, "wall_time_s": 17.5})");
+    demcal::orchestrator::write_text_file_atomically(d / "runs/garbled/result.json", R"({"peak_shear_st)");
+    { ShearCampaignRunner reopened(d, ExecutionOptions{}); }
+    CampaignStore s(d / "campaign.sqlite");
+    const auto finished = s.run("finished");
+    REQUIRE(finished);
+    CHECK(finished->state == RunState::done);
+    CHECK(finished->result.at("peak_shear_stress").get<double>() == 4321.0);
+    CHECK(finished->wall_s == 17.5);
+    CHECK(s.run("unfinished")->state == RunState::pending);
+    CHECK(s.run("garbled")->state == RunState::pending);  // a partial file is not a result
     fs::remove_all(d);
 }
