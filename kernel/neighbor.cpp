@@ -19,6 +19,36 @@ bool NeighborList::needs_rebuild(const std::vector<Vec3>& x, int threads) const 
   return moved != 0;
 }
 
+bool CellGrid::fit(const std::vector<Vec3>& x, const std::vector<double>& r, double skin) {
+  const std::size_t n = x.size();
+  if (n == 0) return false;
+  Vec3 hi = x[0];
+  lo = x[0];
+  double rmax = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(x[i]);
+    hi = hi.cwiseMax(x[i]);
+    rmax = std::max(rmax, r[i]);
+  }
+  if (!lo.allFinite() || !hi.allFinite()) return false;
+  size = 2 * rmax + skin;
+  const double max_cells = std::max<double>(64.0, 4.0 * double(n));
+  auto ncell = [&](double c, int d) { return std::int64_t((hi[d] - lo[d]) / c) + 1; };
+  while (double(ncell(size, 0)) * double(ncell(size, 1)) * double(ncell(size, 2)) > max_cells) size *= 1.26;
+  nx = ncell(size, 0);
+  ny = ncell(size, 1);
+  nz = ncell(size, 2);
+  return true;
+}
+
+std::uint32_t CellGrid::cell_of(const Vec3& p) const {
+  const double inv = 1.0 / size;
+  const std::int64_t cx = std::min<std::int64_t>(nx - 1, std::int64_t((p.x() - lo.x()) * inv));
+  const std::int64_t cy = std::min<std::int64_t>(ny - 1, std::int64_t((p.y() - lo.y()) * inv));
+  const std::int64_t cz = std::min<std::int64_t>(nz - 1, std::int64_t((p.z() - lo.z()) * inv));
+  return std::uint32_t((cz * ny + cy) * nx + cx);
+}
+
 void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& r,
                          const std::vector<std::int32_t>& group, double skin, int threads) {
   const std::size_t n = x.size();
@@ -40,29 +70,15 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
     return;
   }
   // grid
-  Vec3 lo = x[0], hi = x[0];
-  double rmax = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    lo = lo.cwiseMin(x[i]);
-    hi = hi.cwiseMax(x[i]);
-    rmax = std::max(rmax, r[i]);
-  }
-  if (!lo.allFinite() || !hi.allFinite())
+  CellGrid grid;
+  if (!grid.fit(x, r, skin))
     throw std::runtime_error("NeighborList::build: a sphere position is not finite (the simulation blew up?)");
-  double cs = 2 * rmax + skin;
-  const double max_cells = std::max<double>(64.0, 4.0 * double(n));
-  auto ncell = [&](double c, int d) { return std::int64_t((hi[d] - lo[d]) / c) + 1; };
-  while (double(ncell(cs, 0)) * double(ncell(cs, 1)) * double(ncell(cs, 2)) > max_cells) cs *= 1.26;
-  const std::int64_t nx = ncell(cs, 0), ny = ncell(cs, 1), nz = ncell(cs, 2);
-  const std::size_t nc = std::size_t(nx * ny * nz);
-  const double inv = 1.0 / cs;
+  const std::int64_t nx = grid.nx, ny = grid.ny, nz = grid.nz;
+  const std::size_t nc = grid.count();
   cell_of_.resize(n);
   cell_start_.assign(nc + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::int64_t cx = std::min<std::int64_t>(nx - 1, std::int64_t((x[i].x() - lo.x()) * inv));
-    const std::int64_t cy = std::min<std::int64_t>(ny - 1, std::int64_t((x[i].y() - lo.y()) * inv));
-    const std::int64_t cz = std::min<std::int64_t>(nz - 1, std::int64_t((x[i].z() - lo.z()) * inv));
-    cell_of_[i] = std::uint32_t((cz * ny + cy) * nx + cx);
+    cell_of_[i] = grid.cell_of(x[i]);
     ++cell_start_[cell_of_[i] + 1];
   }
   for (std::size_t c = 0; c < nc; ++c) cell_start_[c + 1] += cell_start_[c];

@@ -9,6 +9,19 @@
 
 namespace demcal::kernel {
 
+/// The linked-cell grid over a set of spheres: cells of at least 2 r_max + skin, coarsened until there are at most
+/// max(64, 4 n) of them. Shared by the neighbour build and the cell-order renumbering, so both see the same cells.
+struct CellGrid {
+  Vec3 lo;
+  double size = 0;
+  std::int64_t nx = 0, ny = 0, nz = 0;
+  /// False (grid unset) when a position is not finite.
+  bool fit(const std::vector<Vec3>& x, const std::vector<double>& r, double skin);
+  std::size_t count() const { return std::size_t(nx * ny * nz); }
+  /// Linear index (z slowest) of the cell holding p, clamped into the grid.
+  std::uint32_t cell_of(const Vec3& p) const;
+};
+
 class NeighborList {
  public:
   /// Rebuilds the list: pairs (i < j) with |x_i - x_j| < r_i + r_j + skin, excluding pairs of the same clump

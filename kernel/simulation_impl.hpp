@@ -320,23 +320,10 @@ template <class Law>
 void BasicSimulation<Law>::reorder_spheres() {
   const std::size_t n = x_.size();
   if (n < 2) return;
-  Vec3 lo = x_[0], hi = x_[0];
-  double rmax = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    lo = lo.cwiseMin(x_[i]);
-    hi = hi.cwiseMax(x_[i]);
-    rmax = std::max(rmax, r_[i]);
-  }
-  if (!lo.allFinite() || !hi.allFinite()) return;  // the neighbour build reports it
-  double cs = 2 * rmax + skin_;
-  auto ncell = [&](double c, int d) { return std::uint64_t((hi[d] - lo[d]) / c) + 1; };
-  while (double(ncell(cs, 0)) * double(ncell(cs, 1)) * double(ncell(cs, 2)) > 4.0 * double(n) + 64) cs *= 1.26;
-  const std::uint64_t nx = ncell(cs, 0), ny = ncell(cs, 1);
+  CellGrid grid;
+  if (!grid.fit(x_, r_, skin_)) return;  // the neighbour build reports it
   std::vector<std::pair<std::uint64_t, std::uint32_t>> key(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 c = (x_[i] - lo) / cs;
-    key[i] = {(std::uint64_t(c.z()) * ny + std::uint64_t(c.y())) * nx + std::uint64_t(c.x()), std::uint32_t(i)};
-  }
+  for (std::size_t i = 0; i < n; ++i) key[i] = {grid.cell_of(x_[i]), std::uint32_t(i)};
   std::sort(key.begin(), key.end());  // by cell, then by old index: deterministic
   std::vector<std::int32_t> old2new(n);
   bool identity = true;
