@@ -14,6 +14,7 @@ REPS="${REPS:-3}"
 STEPS="${STEPS:-2000}"
 BUILD="${BUILD_DIR:-$ROOT/build}"
 LOGS="${LOGS:-$HERE/logs}"
+mkdir -p "$LOGS" && LOGS="$(cd "$LOGS" && pwd)"  # the runs cd into a scratch folder
 for tool in liggghts mpirun yade /usr/bin/time python3; do
   command -v "$tool" >/dev/null || { echo "run.sh: $tool missing: DEMCAL_BENCH_DEPS=1 bash scripts/setup.sh" >&2; exit 2; }
 done
@@ -22,7 +23,7 @@ if [ ! -x "$BUILD/bench/peer/demcal_peer" ]; then
   cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build "$BUILD" -j2 --target demcal_peer >/dev/null
 fi
-DEMCAL="$BUILD/bench/peer/demcal_peer"
+DEMCAL="$(cd "$BUILD" && pwd)/bench/peer/demcal_peer"  # absolute: the runs cd into a scratch folder
 # OpenMP threads sleep at barriers instead of spinning: on this 2-core machine shared with other jobs, spinning
 # threads steal the core the other thread needs (measured: 2.6e6 vs 7.1e6 particle-steps/s with 2 threads under load)
 export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-passive}"
