@@ -161,9 +161,11 @@ class BasicSimulation {
   void compute_forces(bool rebuild, double dt_history);
   bool kick_drift(double kick);
   void kick();
-  void update_members(std::size_t c, bool positions);
+  void update_members(std::size_t c, const Mat3& R, bool positions);  // R: the clump's rotation matrix
   void rebuild_body_index();
   void reorder_spheres();
+  void rebuild_neighbors();  // the neighbour list and the wall candidates, always together
+  void find_wall_candidates();
 
   // materials
   std::vector<Material> materials_;
@@ -183,6 +185,8 @@ class BasicSimulation {
   std::vector<std::int32_t> wall_slot_id_;                  // kWallSlots per sphere, -1 empty
   std::vector<Vec3> wall_slot_s_, wall_slot_f_;             // history, force on the sphere
   std::vector<Vec3> pair_f_, pair_tj_;                      // per pair: force on i, torque on j
+  static constexpr int kMaxWallCandidates = 64;             // walls tracked per sphere (bit mask)
+  std::vector<std::uint64_t> wall_cand_;                    // per sphere: walls within reach at the last build
 
   // per clump
   std::vector<Vec3> cx_, cv_, cw_, cL_, cI_, cF_, cT_;
