@@ -139,11 +139,13 @@ SensitivityOptions sensitivity_options(const SensitivityCli& o) {
 }
 
 void print_level(const std::string& param, const SensitivityLevel& l) {
-    std::cout << "  " << std::left << std::setw(22) << param << std::right << " = " << std::setw(10) << l.value
-              << "  mu_b " << std::fixed << std::setprecision(4) << l.mu_b << " +/- " << l.se_mu_b << "  tau_c "
-              << std::setprecision(1) << l.tau_c << " +/- " << l.se_tau_c << " Pa  (" << l.simulations_run
-              << " run, " << l.simulations_reused << " reused)" << std::endl;
-    std::cout.unsetf(std::ios::fixed);
+    // a stream of its own: std::cout's precision is not left at 1 for the next level's value (it printed 0.75 as 0.8)
+    std::ostringstream line;
+    line << "  " << std::left << std::setw(22) << param << std::right << " = " << std::setw(10) << l.value
+         << "  mu_b " << std::fixed << std::setprecision(4) << l.mu_b << " +/- " << l.se_mu_b << "  tau_c "
+         << std::setprecision(1) << l.tau_c << " +/- " << l.se_tau_c << " Pa  (" << l.simulations_run << " run, "
+         << l.simulations_reused << " reused)";
+    std::cout << line.str() << std::endl;
 }
 
 // One PNG per parameter: mu_b and tau_c against the parameter, with error bars and the selected fit.
@@ -343,17 +345,18 @@ void add_calibrate(CLI::App& app) {
         std::ofstream log(log_path, std::ios::app);
         const auto result = calibrate(start, targets, controls, &study, session.evaluate, options,
                                       [&](const CalibrationIteration& it) {
-                                          std::cout << "  #" << std::setw(2) << it.evaluation << " " << std::left
-                                                    << std::setw(10) << it.phase << std::right;
-                                          for (const auto& [name, v] : it.values) std::cout << " " << name << "=" << v;
-                                          std::cout << std::fixed << std::setprecision(4) << "  mu_b " << it.mu_b
-                                                    << " +/- " << it.mu_b_half_width << std::setprecision(1)
-                                                    << "  tau_c " << it.tau_c << " +/- " << it.tau_c_half_width
-                                                    << " Pa" << std::setprecision(2) << "  miss " << it.mismatch
-                                                    << (it.accepted ? "  ACCEPTED (" + it.accepted_by + ")" : "")
-                                                    << "  [" << it.simulations_run << " run, "
-                                                    << it.simulations_reused << " reused]" << std::endl;
-                                          std::cout.unsetf(std::ios::fixed);
+                                          std::ostringstream line;  // own stream: cout's format stays as it was
+                                          line << "  #" << std::setw(2) << it.evaluation << " " << std::left
+                                               << std::setw(10) << it.phase << std::right;
+                                          for (const auto& [name, v] : it.values) line << " " << name << "=" << v;
+                                          line << std::fixed << std::setprecision(4) << "  mu_b " << it.mu_b
+                                               << " +/- " << it.mu_b_half_width << std::setprecision(1)
+                                               << "  tau_c " << it.tau_c << " +/- " << it.tau_c_half_width
+                                               << " Pa" << std::setprecision(2) << "  miss " << it.mismatch
+                                               << (it.accepted ? "  ACCEPTED (" + it.accepted_by + ")" : "")
+                                               << "  [" << it.simulations_run << " run, "
+                                               << it.simulations_reused << " reused]";
+                                          std::cout << line.str() << std::endl;
                                           log << it.to_json().dump() << "\n" << std::flush;
                                       });
         auto summary = result.to_json();

@@ -55,6 +55,8 @@ void print_progress(const CampaignProgress& p) {
 }
 
 void print_line(const char* title, const analytics::FailureLine& fl) {
+    std::ios saved(nullptr);
+    saved.copyfmt(std::cout);  // restored at the end: later output keeps cout's default format
     std::cout << std::fixed << std::setprecision(4) << title << ": tau = " << fl.mu_b << " sigma + "
               << std::setprecision(1) << fl.tau_c << " Pa\n"
               << std::setprecision(4) << "  mu_b  = " << fl.mu_b << " +/- " << fl.se_mu_b << "  (95% CI "
@@ -68,7 +70,7 @@ void print_line(const char* title, const analytics::FailureLine& fl) {
                   << fl.lack_of_fit->df_lack_of_fit << ", " << fl.lack_of_fit->df_pure_error
                   << " dof), p = " << fl.lack_of_fit->p_value
                   << (fl.lack_of_fit->p_value < 0.05 ? "  -> the line does not fit the means" : "") << "\n";
-    std::cout.unsetf(std::ios::fixed);
+    std::cout.copyfmt(saved);
 }
 
 // Failure line with its points and 95 % band, and the shear curves, for one campaign.

@@ -232,8 +232,11 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
                       << " grains, " << fixed(p.discharged_mass * 1e3, 1) << " g; " << p.grains_in_silo
                       << " in the silo";
         else
-            std::cout << "  " << p.grains_in_silo << " grains, kinetic energy " << std::setprecision(3)
-                      << p.kinetic_energy_per_grain << " J/grain";
+        {
+            std::ostringstream ke;  // own stream: cout keeps its default precision
+            ke << std::setprecision(3) << p.kinetic_energy_per_grain;
+            std::cout << "  " << p.grains_in_silo << " grains, kinetic energy " << ke.str() << " J/grain";
+        }
         if (!p.note.empty()) std::cout << "  " << p.note;
         std::cout << std::endl;
     };

@@ -10,20 +10,22 @@ template=(${3:+--template "$3"})
 stresses=${STRESSES:-2e3,3e3,4e3,5e3}
 hidden=${HIDDEN:-examples/calibration/hidden-tiny.json}
 start=${START:-examples/materials/sand-tiny.json}
+replicates=${REPLICATES:-1}                        # packings per stress (averages the packing noise out)
+params=${PARAMS:-friction_coefficient,bond_shear_strength,bond_normal_strength}
+strict=(${STRICT---strict})                         # STRICT= : also stop when the target is inside the simulated CI
 # The tiny box is too noisy to show a friction effect (calibration/README.md); the overnight variant on sand.json's box:
 #   HIDDEN=examples/calibration/hidden-sand.json START=examples/materials/sand.json STRESSES=5e3,10e3,15e3,20e3 \
 #   bench/calibration/yade_recovery.sh build/app/demcal campaigns/recovery-sand
 mkdir -p "$dir"
-$demcal shear "$hidden" --normal-stress $stresses --jobs 2 --campaign "$dir/target" \
+$demcal shear "$hidden" --normal-stress $stresses --replicates "$replicates" --jobs 2 --campaign "$dir/target" \
   "${template[@]}" | tee "$dir/target.log"
 target=$(python3 -c "
 import json,glob
 j=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['peak_failure_line']
 print('mu_b=%.6g,tau_c=%.6g' % (j['mu_b'], j['tau_c_Pa']))")
 echo "target: $target"
-common=(--target "$target" --start "$start" --strict --normal-stress $stresses --jobs 2
-        "${template[@]}"
-        --params friction_coefficient,bond_shear_strength,bond_normal_strength --levels 3 --campaign "$dir/loop")
+common=(--target "$target" --start "$start" "${strict[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
+        "${template[@]}" --params "$params" --levels 3 --campaign "$dir/loop")
 $demcal calibrate "${common[@]}" --max-evaluations 7 | tee "$dir/surrogate.log" || true
 # The coordinate baseline costs tens of failure lines: run it with COORDINATE=1.
 if [[ ${COORDINATE:-0} == 1 ]]; then
