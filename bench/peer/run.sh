@@ -44,7 +44,7 @@ run_one() {  # name rep command...  (a failed run is retried once, then left out
   done
   rm -f "$LOGS/${name}_$rep.log"
 }
-runs=(lig1 lig2 yade1 dem1 dem2)
+runs=(${RUNS:-lig1 lig2 yade1 dem1 dem2})  # RUNS="lig1 lig2 dem1 dem2": a subset (e.g. after a kernel change)
 [ "${YADE_J2:-0}" = 1 ] && runs+=(yade2)
 # SUMMARY_ONLY=1: recompute the summary from the logs already in $LOGS
 [ "${SUMMARY_ONLY:-0}" = 1 ] && REPS_RUN=0 || REPS_RUN="$REPS"
