@@ -1,5 +1,8 @@
 #include "orchestrator/run_identity.hpp"
 
+#include <cmath>
+#include <cstdint>
+
 #include <openssl/evp.h>
 
 #include <fstream>
@@ -23,8 +26,27 @@ std::string sha256_hex(const std::string& bytes) {
     return out;
 }
 
+namespace {
+// The same number written 30000 in one material file and 30000.0 by a computed level (a double) is one run:
+// integral doubles become integers before hashing (measured: a sensitivity study re-ran its base failure line
+// for every parameter whose file value was an integer).
+nlohmann::json canonical_numbers(const nlohmann::json& j) {
+    if (j.is_object() || j.is_array()) {
+        nlohmann::json out = j;
+        for (auto& v : out) v = canonical_numbers(v);
+        return out;
+    }
+    if (j.is_number_float()) {
+        const double v = j.get<double>();
+        if (std::isfinite(v) && std::trunc(v) == v && std::fabs(v) < 9007199254740992.0)  // 2^53: exact
+            return static_cast<std::int64_t>(v);
+    }
+    return j;
+}
+}  // namespace
+
 std::string run_identity(const std::string& template_text, const nlohmann::json& params) {
-    return sha256_hex(sha256_hex(template_text) + "\n" + params.dump());
+    return sha256_hex(sha256_hex(template_text) + "\n" + canonical_numbers(params).dump());
 }
 
 std::string read_text_file(const std::filesystem::path& p) {

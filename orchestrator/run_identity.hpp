@@ -10,7 +10,8 @@ namespace demcal::orchestrator {
 
 std::string sha256_hex(const std::string& bytes);
 
-// Canonical form: nlohmann's dump sorts object keys, and numbers print in shortest round-trip form.
+// Canonical form: nlohmann's dump sorts object keys, numbers print in shortest round-trip form, and an integral
+// double counts as the integer (30000.0 and 30000 are one run).
 std::string run_identity(const std::string& template_text, const nlohmann::json& params);
 
 std::string read_text_file(const std::filesystem::path& p);

@@ -64,5 +64,12 @@ TEST_CASE("run identity depends on every parameter and the template, not on key 
     CHECK(run_identity("template", a) != run_identity("template ", a));
     CHECK(run_identity("template", a) != run_identity("template", make_run_params(m, 1e4, 2)));
     CHECK(run_identity("template", a) != run_identity("template", make_run_params(m, 1.00001e4, 1)));
+    // a level computed as a double equal to the file's integer is the same run (the base level of a study)
+    nlohmann::json as_double = a;
+    as_double["density"] = double(a["density"].get<int>());
+    REQUIRE(a["density"].is_number_integer());
+    CHECK(run_identity("template", a) == run_identity("template", as_double));
+    as_double["density"] = a["density"].get<int>() + 0.5;
+    CHECK(run_identity("template", a) != run_identity("template", as_double));
     CHECK(sha256_hex("abc") == "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");  // FIPS 180-2
 }
