@@ -666,6 +666,16 @@ CalibrationResult calibrate(const nlohmann::json& start, const std::vector<Macro
         result.best = chosen;
         result.message = "matched after " + std::to_string(result.evaluations) + " failure-line evaluations (" +
                          result.iterations[chosen].accepted_by + ")";
+        const CalibrationIteration& acc = result.iterations[chosen];
+        if (acc.accepted_by == "simulated interval" && acc.mismatch > 1) {
+            // Accepted only because the simulated interval is wide: say so, it is not a match at the tolerance.
+            std::ostringstream why;
+            why.precision(2);
+            why << "; the simulated line is " << acc.mismatch
+                << " tolerances from the target, accepted only because its own interval is that wide: add packings "
+                   "(--replicates) or normal stresses, or pass --strict";
+            result.message += why.str();
+        }
     }
     result.material = start;
     for (const auto& [name, value] : result.iterations[result.best].values) result.material[name] = value;
