@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# Recovery check on real YADE runs (tiny box): a hidden material's failure line is the target; the loop starts from
-# sand-tiny, runs a small sensitivity study (3 parameters x 3 levels) and calibrates; then the coordinate baseline runs
-# over the same bounds in the same store. Usage: bench/calibration/yade_recovery.sh [DEMCAL] [DIR] [TEMPLATE]
+# Recovery check on real YADE runs: a hidden material's failure line is the target; the loop starts from START
+# (sand-tiny by default), runs a sensitivity study (PARAMS x LEVELS) and calibrates; with COORDINATE=1 the coordinate
+# baseline then runs over the same bounds in the same store. Usage: bench/calibration/yade_recovery.sh [DEMCAL] [DIR]
+# [TEMPLATE]. The runs of calibration/README.md on sand.json's box:
+#   HIDDEN=examples/calibration/hidden-sand-low.json START=examples/materials/sand.json STRESSES=5e3,12.5e3,20e3 \
+#   REPLICATES=3 PARAMS=friction_coefficient,bond_shear_strength bench/calibration/yade_recovery.sh build/app/demcal DIR
 # Four stresses: a line still fits when one run fails its normal-stress check (the tiny box's servo sometimes does).
 set -euo pipefail
 demcal=${1:-build-cal/app/demcal}
@@ -12,6 +15,7 @@ hidden=${HIDDEN:-examples/calibration/hidden-tiny.json}
 start=${START:-examples/materials/sand-tiny.json}
 replicates=${REPLICATES:-1}                        # packings per stress (averages the packing noise out)
 params=${PARAMS:-friction_coefficient,bond_shear_strength,bond_normal_strength}
+levels=${LEVELS:-5}                                 # 3 levels cannot tell a parabola (sand box: friction -> mu_b)
 strict=(${STRICT---strict})                         # STRICT= : also stop when the target is inside the simulated CI
 # The tiny box is too noisy to show a friction effect (calibration/README.md); the overnight variant on sand.json's box:
 #   HIDDEN=examples/calibration/hidden-sand.json START=examples/materials/sand.json STRESSES=5e3,10e3,15e3,20e3 \
@@ -25,7 +29,7 @@ j=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['peak_failure
 print('mu_b=%.6g,tau_c=%.6g' % (j['mu_b'], j['tau_c_Pa']))")
 echo "target: $target"
 common=(--target "$target" --start "$start" "${strict[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
-        "${template[@]}" --params "$params" --levels 3 --campaign "$dir/loop")
+        "${template[@]}" --params "$params" --levels "$levels" --campaign "$dir/loop")
 $demcal calibrate "${common[@]}" --max-evaluations 7 | tee "$dir/surrogate.log" || true
 # The coordinate baseline costs tens of failure lines: run it with COORDINATE=1.
 if [[ ${COORDINATE:-0} == 1 ]]; then
