@@ -163,6 +163,18 @@ class BasicSimulation {
   void kick();
   void update_members(std::size_t c, const Mat3& R, bool positions);  // R: the clump's rotation matrix
   void rebuild_body_index();
+  // Every per-sphere array (with its entries per sphere) and every per-clump array, listed once: renumbering and
+  // removal apply the same permutation or compaction to all of them.
+  template <class F>
+  void for_each_sphere_array(F&& f) {
+    f(x_, 1); f(v_, 1); f(w_, 1); f(f_, 1); f(t_, 1);
+    f(r_, 1); f(mass_, 1); f(inv_mass_, 1); f(inv_inertia_, 1); f(mat_, 1); f(clump_, 1);
+    f(wall_slot_id_, kWallSlots); f(wall_slot_s_, kWallSlots); f(wall_slot_f_, kWallSlots);
+  }
+  template <class F>
+  void for_each_clump_array(F&& f) {
+    f(cx_); f(cv_); f(cw_); f(cL_); f(cI_); f(cF_); f(cT_); f(cq_); f(cm_); f(ctmpl_); f(cmat_);
+  }
   void reorder_spheres();
   void rebuild_neighbors();  // the neighbour list and the wall candidates, always together
   void find_wall_candidates();

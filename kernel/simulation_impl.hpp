@@ -364,10 +364,7 @@ void BasicSimulation<Law>::reorder_spheres() {
     for (std::size_t k = 0; k < n; ++k)
       for (std::size_t m = 0; m < per; ++m) vec[k * per + m] = tmp[std::size_t(key[k].old) * per + m];
   };
-  permute(x_, 1); permute(v_, 1); permute(w_, 1); permute(f_, 1); permute(t_, 1);
-  permute(r_, 1); permute(mass_, 1); permute(inv_mass_, 1); permute(inv_inertia_, 1); permute(mat_, 1);
-  permute(clump_, 1);
-  permute(wall_slot_id_, kWallSlots); permute(wall_slot_s_, kWallSlots); permute(wall_slot_f_, kWallSlots);
+  for_each_sphere_array(permute);
   if (nc > 0) {
     // clumps in the order of their (now contiguous) members
     std::vector<std::uint32_t> corder(nc);
@@ -390,8 +387,7 @@ void BasicSimulation<Law>::reorder_spheres() {
     }
     cmem_start_ = std::move(mem_start);
     cmem_ = std::move(mem);
-    cpermute(cx_); cpermute(cv_); cpermute(cw_); cpermute(cL_); cpermute(cI_); cpermute(cF_); cpermute(cT_);
-    cpermute(cq_); cpermute(cm_); cpermute(ctmpl_); cpermute(cmat_);
+    for_each_clump_array(cpermute);
     for (auto& c : clump_)
       if (c >= 0) c = cold2new[c];
     for (auto& ref : body_ref_)
@@ -687,10 +683,7 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
     }
     vec.resize(o * per);
   };
-  compact(x_, 1); compact(v_, 1); compact(w_, 1); compact(f_, 1); compact(t_, 1);
-  compact(r_, 1); compact(mass_, 1); compact(inv_mass_, 1); compact(inv_inertia_, 1); compact(mat_, 1);
-  compact(clump_, 1);
-  compact(wall_slot_id_, kWallSlots); compact(wall_slot_s_, kWallSlots); compact(wall_slot_f_, kWallSlots);
+  for_each_sphere_array(compact);
   for (auto& c : clump_)
     if (c >= 0) c = c_old2new[c];
   // compact per-clump arrays
@@ -708,8 +701,7 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   }
   cmem_start_ = std::move(mem_start);
   cmem_ = std::move(mem);
-  ccompact(cx_); ccompact(cv_); ccompact(cw_); ccompact(cL_); ccompact(cI_); ccompact(cF_); ccompact(cT_);
-  ccompact(cq_); ccompact(cm_); ccompact(ctmpl_); ccompact(cmat_);
+  for_each_clump_array(ccompact);
   // bodies
   std::vector<std::int32_t> refs;
   std::vector<BodyId> ids;
@@ -816,7 +808,8 @@ template <class Law>
 std::size_t BasicSimulation<Law>::memory_bytes() const {
   const std::size_t n = x_.size();
   std::size_t b = n * (5 * sizeof(Vec3) + 4 * sizeof(double) + 2 * sizeof(std::int32_t) +
-                       kWallSlots * (sizeof(std::int32_t) + 2 * sizeof(Vec3)) + sizeof(std::uint32_t));
+                       kWallSlots * (sizeof(std::int32_t) + 2 * sizeof(Vec3)) + sizeof(std::uint32_t) +
+                       sizeof(std::uint64_t));  // the last: the wall mask
   b += nl_.num_pairs() * (sizeof(std::int32_t) + 3 * sizeof(Vec3) + sizeof(std::uint32_t)) + 2 * (n + 1) * 4;
   b += cx_.size() * (7 * sizeof(Vec3) + sizeof(Quat) + sizeof(double) + 3 * 4);
   return b;
