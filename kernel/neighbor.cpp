@@ -193,3 +193,21 @@ std::vector<std::pair<std::int32_t, std::int32_t>> brute_force_contacts(const st
 }
 
 }  // namespace demcal::kernel
+
+namespace demcal::kernel {
+
+void NeighborList::save(StateWriter& w) const {
+  w.array(row); w.array(nbr); w.array(hist); w.array(trow); w.array(tpair); w.array(x_built_);
+  w.value(skin_); w.value(valid_); w.value(std::uint64_t(builds_));
+}
+
+void NeighborList::load(StateReader& r) {
+  r.array(row, "neighbour rows"); r.array(nbr, "neighbours"); r.array(hist, "pair histories");
+  r.array(trow, "transposed rows"); r.array(tpair, "transposed pairs"); r.array(x_built_, "build positions");
+  r.value(skin_, "neighbour skin"); r.value(valid_, "neighbour list state");
+  builds_ = std::size_t(r.value<std::uint64_t>("neighbour builds"));
+  if (row.size() > 0 && (row.back() != nbr.size() || hist.size() != nbr.size() || tpair.size() != nbr.size()))
+    r.fail("neighbour list", "inconsistent sizes");
+}
+
+}  // namespace demcal::kernel

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <utility>
 #include <vector>
+#include "kernel/state_io.hpp"
 #include "kernel/types.hpp"
 
 namespace demcal::kernel {
@@ -38,6 +39,10 @@ class NeighborList {
   /// Sphere positions at the last build (for the skin/2 displacement check).
   const std::vector<Vec3>& built_positions() const { return x_built_; }
   bool valid() const { return valid_; }
+
+  /// Checkpoint: the list, its histories and its build positions (kernel/state_io.hpp).
+  void save(StateWriter& w) const;
+  void load(StateReader& r);
 
   std::size_t num_pairs() const { return nbr.size(); }
   std::size_t num_builds() const { return builds_; }

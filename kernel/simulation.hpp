@@ -17,6 +17,8 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <iosfwd>
+#include <string>
 #include <vector>
 
 #include "kernel/clump.hpp"
@@ -146,6 +148,16 @@ class BasicSimulation {
   Vec3 angular_momentum(const Vec3& origin = Vec3::Zero()) const;
   double total_mass() const;
 
+  // ---------------------------------------------------------------- checkpoint
+  /// Writes the whole dynamic state (bodies, contact histories, neighbour list, wall switches, time, step count) so
+  /// that load_state() continues bit for bit as if the run had never stopped. The configuration (materials, pairs,
+  /// clump templates, walls) is not restored: set it up the same way before load_state(); its numbers are written
+  /// and checked. Thread count and parallel threshold are not part of the state (results do not depend on them).
+  void save_state(std::ostream& os) const;
+  /// Replaces the dynamic state by one save_state() wrote. Throws std::runtime_error naming `source` and what
+  /// differs when the configuration set up here is not the one the state was saved with, or the data are cut short.
+  void load_state(std::istream& is, const std::string& source);
+
   // ---------------------------------------------------------------- diagnostics
   /// Sphere pairs (i < j) overlapping now, found through the neighbour list (builds it if needed).
   std::vector<std::pair<std::int32_t, std::int32_t>> contact_pairs();
@@ -175,6 +187,7 @@ class BasicSimulation {
   void for_each_clump_array(F&& f) {
     f(cx_); f(cv_); f(cw_); f(cL_); f(cI_); f(cF_); f(cT_); f(cq_); f(cm_); f(ctmpl_); f(cmat_);
   }
+  std::vector<double> configuration_numbers() const;  // what load_state() checks
   void reorder_spheres();
   void rebuild_neighbors();  // the neighbour list and the wall candidates, always together
   void find_wall_candidates();

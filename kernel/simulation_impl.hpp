@@ -5,8 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <istream>
+#include <ostream>
 #include <stdexcept>
 #include <string>
+
+#include "kernel/state_io.hpp"
 
 #include "kernel/simulation.hpp"
 
@@ -802,6 +806,97 @@ std::vector<std::pair<std::int32_t, std::int32_t>> BasicSimulation<Law>::contact
 template <class Law>
 std::vector<std::pair<std::int32_t, std::int32_t>> BasicSimulation<Law>::contact_pairs_brute_force() const {
   return brute_force_contacts(x_, r_, clump_);
+}
+
+// ---------------------------------------------------------------- checkpoint
+
+template <class Law>
+std::vector<double> BasicSimulation<Law>::configuration_numbers() const {
+  std::vector<double> c;
+  auto vec = [&](const Vec3& v) { c.insert(c.end(), {v.x(), v.y(), v.z()}); };
+  c.push_back(double(materials_.size()));
+  for (const Material& m : materials_) c.insert(c.end(), {m.young, m.poisson, m.density});
+  for (std::size_t k = 0; k < pair_props_.size(); ++k) {
+    const PairProperties& p = pair_props_[k];
+    c.insert(c.end(), {double(pair_set_[k]), p.restitution, p.friction, p.rolling_friction});
+  }
+  c.push_back(double(templates_.size()));
+  for (const ClumpTemplate& t : templates_) {
+    c.insert(c.end(), {double(t.offsets.size()), t.mass});
+    vec(t.inertia);
+    for (const Vec3& o : t.offsets) vec(o);
+    for (double r : t.radii) c.push_back(r);
+  }
+  c.push_back(double(walls_.size()));
+  for (const Wall& w : walls_) {
+    c.insert(c.end(), {double(int(w.shape)), double(w.material), w.half_u, w.half_v, w.cx, w.cy, w.r0, w.z0, w.r1, w.z1});
+    vec(w.point); vec(w.normal); vec(w.u); vec(w.v);
+  }
+  return c;
+}
+
+template <class Law>
+void BasicSimulation<Law>::save_state(std::ostream& os) const {
+  StateWriter w(os);
+  w.text("demcal-kernel-state/1");
+  w.array(configuration_numbers());
+  std::vector<char> enabled;
+  for (const Wall& wall : walls_) enabled.push_back(wall.enabled);
+  w.array(enabled);
+  w.array(wall_force_);
+  // the for_each lists only hand out references; nothing is modified
+  auto* self = const_cast<BasicSimulation*>(this);
+  self->for_each_sphere_array([&](auto& a, int) { w.array(a); });
+  self->for_each_clump_array([&](auto& a) { w.array(a); });
+  w.array(pair_f_); w.array(pair_tj_); w.array(wall_cand_);
+  w.array(cmem_start_); w.array(cmem_);
+  w.array(body_ref_); w.array(body_id_);
+  w.value(next_id_);
+  nl_.save(w);
+  w.value(gravity_); w.value(dt_); w.value(time_); w.value(skin_); w.value(steps_);
+  w.value(reorder_every_); w.value(std::uint64_t(builds_since_reorder_)); w.value(forces_valid_);
+  if (!w.ok()) throw std::runtime_error("save_state: the stream failed while writing");
+}
+
+template <class Law>
+void BasicSimulation<Law>::load_state(std::istream& is, const std::string& source) {
+  StateReader r(is, source);
+  const std::string tag = r.text("format tag");
+  if (tag != "demcal-kernel-state/1")
+    r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a demcal kernel state (demcal-kernel-state/1)");
+  std::vector<double> saved;
+  r.array(saved, "configuration");
+  const std::vector<double> now = configuration_numbers();
+  if (saved != now) {
+    std::size_t k = 0;
+    while (k < saved.size() && k < now.size() && saved[k] == now[k]) ++k;
+    throw std::runtime_error(source + ": the materials, pairs, clump templates or walls set up now differ from the "
+                             "saved ones (first difference at configuration number " + std::to_string(k) + ")");
+  }
+  std::vector<char> enabled;
+  r.array(enabled, "wall switches");
+  r.array(wall_force_, "wall forces");
+  if (enabled.size() != walls_.size() || wall_force_.size() != walls_.size()) r.fail("walls", "wrong count");
+  for (std::size_t k = 0; k < walls_.size(); ++k) walls_[k].enabled = enabled[k] != 0;
+  for_each_sphere_array([&](auto& a, int) { r.array(a, "sphere arrays"); });
+  for_each_clump_array([&](auto& a) { r.array(a, "clump arrays"); });
+  r.array(pair_f_, "pair forces"); r.array(pair_tj_, "pair torques"); r.array(wall_cand_, "wall candidates");
+  r.array(cmem_start_, "clump members"); r.array(cmem_, "clump members");
+  r.array(body_ref_, "bodies"); r.array(body_id_, "body ids");
+  r.value(next_id_, "next body id");
+  nl_.load(r);
+  r.value(gravity_, "gravity"); r.value(dt_, "time step"); r.value(time_, "time"); r.value(skin_, "skin");
+  r.value(steps_, "step count"); r.value(reorder_every_, "reorder period");
+  builds_since_reorder_ = std::size_t(r.value<std::uint64_t>("builds since the last reorder"));
+  r.value(forces_valid_, "force state");
+  const std::size_t n = x_.size(), nc = cx_.size();
+  bool sizes_ok = wall_slot_id_.size() == n * kWallSlots && clump_.size() == n && cq_.size() == nc &&
+                  (nc == 0 ? cmem_start_.size() <= 1 : cmem_start_.size() == nc + 1) && body_id_.size() == body_ref_.size();
+  for (auto t : ctmpl_) sizes_ok = sizes_ok && t >= 0 && t < std::int32_t(templates_.size());
+  for (auto m : mat_) sizes_ok = sizes_ok && m >= 0 && m < std::int32_t(materials_.size());
+  if (!sizes_ok) r.fail("state", "inconsistent array sizes or indices");
+  rebuild_body_index();
+  prepared_ = false;  // pair coefficients are derived from the configuration again
 }
 
 template <class Law>
