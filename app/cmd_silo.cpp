@@ -47,7 +47,12 @@ struct SiloCli {
     double stop_fraction = 1;
     double skin = 0;
     bool no_plots = false;
+    double checkpoint_every = 900;
+    bool no_checkpoint = false;
+    std::string resume;
 };
+
+constexpr const char* kCheckpointName = "checkpoint.bin";
 
 std::string fixed(double v, int digits) {
     char buf[64];
@@ -211,10 +216,34 @@ void write_plots(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::S
     }
 }
 
+void print_progress(const ks::SiloProgress& p) {
+    std::cout << "[" << std::setw(7) << duration_text(p.wall_s) << "] " << std::left << std::setw(10) << p.phase
+              << std::right << " t = " << fixed(p.time, 3) << " s";
+    if (p.phase == "discharge" || p.phase == "done")
+        std::cout << " (" << fixed(p.discharge_time, 3) << " s open)  discharged " << p.grains_discharged
+                  << " grains, " << fixed(p.discharged_mass * 1e3, 1) << " g; " << p.grains_in_silo
+                  << " in the silo";
+    else if (p.phase != "checkpoint")
+    {
+        std::ostringstream ke;  // own stream: cout keeps its default precision
+        ke << std::setprecision(3) << p.kinetic_energy_per_grain;
+        std::cout << "  " << p.grains_in_silo << " grains, kinetic energy " << ke.str() << " J/grain";
+    }
+    if (!p.note.empty()) std::cout << "  " << p.note;
+    std::cout << std::endl;
+}
+
+void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots);
+
+// A new run into `dir` (refused when dir holds the checkpoint of an unfinished run: it would be overwritten).
 void run_silo(const SiloCli& o, CLI::App& sub) {
-    const ks::SiloCaseSettings s = settings_from(o, sub);
+    ks::SiloCaseSettings s = settings_from(o, sub);
     const fs::path dir =
         o.out.empty() ? fs::path("silo_theta" + fixed(s.geometry.half_angle_deg, 0)) : fs::path(o.out);
+    if (fs::exists(dir / kCheckpointName))
+        throw UserError("out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
+                        "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
+                        " to start over");
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
@@ -222,25 +251,52 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         fs::create_directories(s.vtk_dir, ec);
         if (ec) throw UserError("vtk = '" + s.vtk_dir + "': cannot create the directory: " + ec.message());
     }
+    if (!o.no_checkpoint) {
+        s.checkpoint_file = (dir / kCheckpointName).string();
+        s.checkpoint_interval = o.checkpoint_every;
+    }
     std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
-              << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string() << std::endl;
-    auto progress = [](const ks::SiloProgress& p) {
-        std::cout << "[" << std::setw(7) << duration_text(p.wall_s) << "] " << std::left << std::setw(9) << p.phase
-                  << std::right << " t = " << fixed(p.time, 3) << " s";
-        if (p.phase == "discharge" || p.phase == "done")
-            std::cout << " (" << fixed(p.discharge_time, 3) << " s open)  discharged " << p.grains_discharged
-                      << " grains, " << fixed(p.discharged_mass * 1e3, 1) << " g; " << p.grains_in_silo
-                      << " in the silo";
-        else
-        {
-            std::ostringstream ke;  // own stream: cout keeps its default precision
-            ke << std::setprecision(3) << p.kinetic_energy_per_grain;
-            std::cout << "  " << p.grains_in_silo << " grains, kinetic energy " << ke.str() << " J/grain";
-        }
-        if (!p.note.empty()) std::cout << "  " << p.note;
-        std::cout << std::endl;
-    };
-    const ks::SiloCaseResult r = ks::run_silo_case(s, progress);
+              << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string();
+    if (!s.checkpoint_file.empty())
+        std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
+                  << " (continue an interrupted run with `demcal silo --resume " << dir.string() << "`)";
+    std::cout << std::endl;
+    write_outputs(dir, s, ks::run_silo_case(s, print_progress), o.no_plots);
+}
+
+// Continues the run whose checkpoint lies in o.resume, with the settings stored in it.
+void resume_silo(const SiloCli& o, CLI::App& sub) {
+    for (const auto* opt : sub.get_options()) {
+        const std::string name = opt->get_name();
+        if (opt->count() > 0 && name != "--resume" && name != "--threads" && name != "--checkpoint-every" &&
+            name != "--no-plots")
+            throw UserError(name + " cannot be combined with --resume: a resumed run keeps the settings stored in "
+                                   "its checkpoint (only --threads, --checkpoint-every and --no-plots apply)");
+    }
+    const fs::path dir(o.resume);
+    const fs::path file = dir / kCheckpointName;
+    if (!fs::exists(file)) {
+        std::string why = fs::exists(dir / "summary.json") ? " (summary.json is there: that run has finished)"
+                                                              : fs::exists(dir) ? "" : " (no such directory)";
+        throw UserError("resume = '" + dir.string() + "' holds no " + kCheckpointName + why);
+    }
+    if (o.no_checkpoint) throw UserError("--no-checkpoint cannot be combined with --resume");
+    const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    ks::SiloCaseSettings s;
+    try {
+        s = ks::read_checkpoint_settings(file.string());
+    } catch (const std::runtime_error& e) {
+        throw UserError(e.what());
+    }
+    s.threads = threads;
+    s.checkpoint_file = file.string();  // removed once the outputs are written
+    std::cout << "demcal silo --resume: " << s.geometry.describe() << "\n  " << threads << " thread(s), seed "
+              << s.seed << ", stiffness scale " << s.materials.stiffness_scale << ", checkpoint " << file.string()
+              << std::endl;
+    write_outputs(dir, s, ks::resume_silo_case(file.string(), threads, o.checkpoint_every, print_progress), o.no_plots);
+}
+
+void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
 
     ks::write_discharge_csv(dir / "discharge.csv", r.discharge);
     nlohmann::json j;
@@ -294,6 +350,8 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     j["steps"] = r.steps;
     j["time_step_s"] = r.time_step;
     j["wall_s"] = r.wall_s;
+    j["sessions"] = r.sessions;
+    j["checkpoints"] = r.checkpoints;
     j["settings"] = {{"threads", s.threads},
                      {"seed", s.seed},
                      {"particles_requested", s.particles},
@@ -321,7 +379,13 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         std::ofstream f(dir / "summary.json");
         f << j.dump(2) << "\n";
     }
-    if (!o.no_plots) write_plots(dir, s, r);
+    if (!no_plots) write_plots(dir, s, r);
+    // every output is written: the checkpoint has served its purpose (and would block a new run in this directory)
+    if (!s.checkpoint_file.empty()) {
+        std::error_code ec;
+        fs::remove(s.checkpoint_file, ec);
+        fs::remove(s.checkpoint_file + ".tmp", ec);
+    }
 
     std::cout << "\n" << r.grains << " grains (" << fixed(r.filled_mass * 1e3, 1) << " g), filled in "
               << fixed(r.fill_time, 3) << " s" << (r.fill_at_rest ? " (at rest)" : " (time limit, not at rest)")
@@ -337,8 +401,10 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     std::cout << "flow pattern: " << ks::to_string(r.flow.pattern) << " (wall/axis velocity ratio "
               << fixed(r.flow.ratio, 3) << ")\n";
     std::cout << r.steps << " steps of " << std::setprecision(3) << r.time_step << " s, wall time "
-              << duration_text(r.wall_s) << "\nwrote " << (dir / "summary.json").string() << ", "
-              << (dir / "discharge.csv").string() << (o.no_plots ? "" : ", section.png, discharge.png") << "\n";
+              << duration_text(r.wall_s);
+    if (r.sessions > 1) std::cout << " over " << r.sessions << " sessions (resumed from checkpoints)";
+    std::cout << "\nwrote " << (dir / "summary.json").string() << ", "
+              << (dir / "discharge.csv").string() << (no_plots ? "" : ", section.png, discharge.png") << "\n";
 }
 
 }  // namespace
@@ -384,7 +450,19 @@ void add_silo_command(CLI::App& app) {
     sub->add_option("--skin", o->skin, "Verlet skin of the neighbour list [m] (0: 40 dt x 1 m/s within 0.2-1 mm)")
         ->capture_default_str();
     sub->add_flag("--no-plots", o->no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
-    sub->callback([o, sub] { run_silo(*o, *sub); });
+    sub->add_option("--checkpoint-every", o->checkpoint_every,
+                    "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "
+                    "the outputs are written)")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    sub->add_flag("--no-checkpoint", o->no_checkpoint, "write no checkpoint");
+    sub->add_option("--resume", o->resume,
+                    "continue the interrupted run whose output directory (and checkpoint.bin) is DIR, bit for bit, "
+                    "with the settings stored in its checkpoint");
+    sub->callback([o, sub] {
+        if (!o->resume.empty()) resume_silo(*o, *sub);
+        else run_silo(*o, *sub);
+    });
 }
 
 }  // namespace demcal

@@ -206,7 +206,7 @@ void NeighborList::load(StateReader& r) {
   r.array(trow, "transposed rows"); r.array(tpair, "transposed pairs"); r.array(x_built_, "build positions");
   r.value(skin_, "neighbour skin"); r.value(valid_, "neighbour list state");
   builds_ = std::size_t(r.value<std::uint64_t>("neighbour builds"));
-  if (row.size() > 0 && (row.back() != nbr.size() || hist.size() != nbr.size() || tpair.size() != nbr.size()))
+  if (hist.size() != nbr.size() || (valid_ && (row.empty() || row.back() != nbr.size() || tpair.size() != nbr.size())))
     r.fail("neighbour list", "inconsistent sizes");
 }
 

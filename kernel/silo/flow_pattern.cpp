@@ -87,3 +87,25 @@ FlowPatternResult FlowPatternClassifier::result(double tag_low, double tag_high)
 }
 
 }  // namespace demcal::kernel::silo
+
+namespace demcal::kernel::silo {
+
+void FlowPatternClassifier::save(StateWriter& w) const {
+    w.value(std::uint64_t(frames_.size()));
+    for (const Frame& f : frames_) {
+        w.value(f.tag);
+        w.array(f.bins);
+    }
+}
+
+void FlowPatternClassifier::load(StateReader& r) {
+    const auto n = r.value<std::uint64_t>("flow-pattern frames");
+    if (n > 100000000) r.fail("flow-pattern frames", "implausible count " + std::to_string(n));
+    frames_.assign(n, Frame{});
+    for (Frame& f : frames_) {
+        r.value(f.tag, "flow-pattern frame");
+        r.array(f.bins, "flow-pattern bins");
+    }
+}
+
+}  // namespace demcal::kernel::silo

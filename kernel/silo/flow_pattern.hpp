@@ -19,6 +19,7 @@
 // flow from 40 deg, the seed's sequence.
 #pragma once
 #include "kernel/silo/silo_geometry.hpp"
+#include "kernel/state_io.hpp"
 
 #include <Eigen/Core>
 
@@ -61,6 +62,9 @@ public:
     // The measure over the frames whose tag lies in [tag_low, tag_high].
     FlowPatternResult result(double tag_low = -1e300, double tag_high = 1e300) const;
     const FlowPatternSettings& settings() const { return s_; }
+    // Checkpoint: the frames gathered so far (the geometry and settings come from the run's settings).
+    void save(StateWriter& w) const;
+    void load(StateReader& r);
 
 private:
     struct Bin {

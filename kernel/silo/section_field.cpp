@@ -62,3 +62,21 @@ void SectionField::write_outline(const std::filesystem::path& file) const {
 }
 
 }  // namespace demcal::kernel::silo
+
+namespace demcal::kernel::silo {
+
+void SectionField::save(StateWriter& w) const {
+    w.value(frames_);
+    w.array(sum_);
+    w.array(count_);
+}
+
+void SectionField::load(StateReader& r) {
+    const std::size_t cells = sum_.size();
+    r.value(frames_, "section frames");
+    r.array(sum_, "section sums");
+    r.array(count_, "section counts");
+    if (sum_.size() != cells || count_.size() != cells) r.fail("section", "the grid differs from the run's settings");
+}
+
+}  // namespace demcal::kernel::silo

@@ -3,6 +3,7 @@
 // in it over the frames added.
 #pragma once
 #include "kernel/silo/silo_geometry.hpp"
+#include "kernel/state_io.hpp"
 
 #include <Eigen/Core>
 
@@ -28,6 +29,9 @@ public:
     void write_grid(const std::filesystem::path& file) const;
     // The silo outline in the section, "x z" per point, blank line between the two sides.
     void write_outline(const std::filesystem::path& file) const;
+    // Checkpoint: the sums and counts gathered so far (the grid comes from the constructor's arguments).
+    void save(StateWriter& w) const;
+    void load(StateReader& r);
 
 private:
     SiloGeometry g_;

@@ -5,13 +5,21 @@
 #include "kernel/simulation.hpp"
 #include "kernel/walls.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 #include <unordered_map>
 
 namespace demcal::kernel::silo {
@@ -178,213 +186,453 @@ void validate(const SiloCaseSettings& s) {
     if (!(s.skin >= 0) || s.skin > 0.01) reject_setting("skin", s.skin, "must lie in [0, 0.01] m (0: automatic)");
     if (!s.vtk_dir.empty() && !(s.vtk_interval > 0)) reject_setting("vtk_every", s.vtk_interval, "must be > 0 s");
     if (!(s.record_interval > 0)) reject_setting("record_interval", s.record_interval, "must be > 0 s");
+    if (!(s.checkpoint_interval >= 0) || !std::isfinite(s.checkpoint_interval))
+        reject_setting("checkpoint_interval", s.checkpoint_interval, "must be >= 0 s (0: every record interval)");
     if (!(s.steady_lower >= 0 && s.steady_lower < s.steady_upper && s.steady_upper <= 1))
         reject_setting("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
 }
 
-SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress) {
-    validate(s);
-    using clock = std::chrono::steady_clock;
-    const auto t_start = clock::now();
-    auto wall = [&] { return std::chrono::duration<double>(clock::now() - t_start).count(); };
-    const SiloGeometry& g = s.geometry;
+namespace {
 
-    Simulation sim;
-    sim.set_threads(s.threads);
-    sim.set_gravity(Vec3(0, 0, -s.gravity));
-    const int wheat = sim.add_material(to_kernel(s.materials.wheat_scaled(), "wheat"));
-    const int steel = sim.add_material(to_kernel(s.materials.steel_scaled(), "steel"));
-    sim.set_pair(wheat, wheat, to_kernel(s.materials.wheat_wheat));
-    sim.set_pair(wheat, steel, to_kernel(s.materials.wheat_steel));
-    const ClumpTemplate tmpl = wheat_clump_template(s.materials.wheat.density);
-    const int grain = sim.add_clump_template(tmpl);
+constexpr const char* kCheckpointTag = "demcal-silo-checkpoint/1";
 
-    SiloCaseResult r;
-    r.grain_mass = tmpl.mass;
-    const long n = s.fill_mass > 0 ? std::max(1L, std::lround(s.fill_mass / tmpl.mass)) : s.particles;
+// Every setting that shapes the run, named once: the checkpoint stores the settings through this list.
+template <class S, class F>
+void for_each_setting(S& s, F&& f) {
+    f("shape", s.geometry.shape);
+    f("diameter", s.geometry.diameter);
+    f("body_height", s.geometry.body_height);
+    f("theta", s.geometry.half_angle_deg);
+    f("outlet", s.geometry.outlet);
+    f("depth", s.geometry.depth);
+    f("width", s.geometry.width);
+    for (auto* m : {&s.materials.wheat, &s.materials.steel}) {
+        f("shear_modulus", m->shear_modulus);
+        f("poisson", m->poisson);
+        f("density", m->density);
+    }
+    for (auto* p : {&s.materials.wheat_wheat, &s.materials.wheat_steel}) {
+        f("restitution", p->restitution);
+        f("friction", p->friction);
+        f("rolling_friction", p->rolling_friction);
+    }
+    f("stiffness_scale", s.materials.stiffness_scale);
+    f("particles", s.particles);
+    f("fill_mass", s.fill_mass);
+    f("gravity", s.gravity);
+    f("time_step", s.time_step);
+    f("time_step_fraction", s.time_step_fraction);
+    f("fill_time_min", s.fill_time_min);
+    f("fill_time_max", s.fill_time_max);
+    f("rest_energy_factor", s.rest_energy_factor);
+    f("max_time", s.max_time);
+    f("stop_fraction", s.stop_fraction);
+    f("removal_depth", s.removal_depth);
+    f("record_interval", s.record_interval);
+    f("frame_interval", s.frame_interval);
+    f("steady_lower", s.steady_lower);
+    f("steady_upper", s.steady_upper);
+    f("section_cell", s.section_cell);
+    f("section_half_thickness", s.section_half_thickness);
+    f("wall_layer", s.flow.wall_layer);
+    f("edge_clearance", s.flow.edge_clearance);
+    f("axis_fraction", s.flow.axis_fraction);
+    f("axis_min", s.flow.axis_min);
+    f("bin_height", s.flow.bin_height);
+    f("min_axis_speed", s.flow.min_axis_speed);
+    f("mass_threshold", s.flow.mass_threshold);
+    f("funnel_threshold", s.flow.funnel_threshold);
+    f("skin", s.skin);
+    f("seed", s.seed);
+    f("vtk_dir", s.vtk_dir);
+    f("vtk_interval", s.vtk_interval);
+    f("progress_interval", s.progress_interval);
+}
 
-    // ---- generation: random sequential addition slab by slab (3 mm slabs, 30 attempts per grain volume)
-    Generator gen(g, tmpl, s.seed);
-    const auto placed = gen.generate(n, 0.003, 30.0);
-    const double wall_top = std::max(g.top(), gen.top() + 0.01);
-    const int plate = add_silo_walls(sim, g, steel, wall_top);
-    for (const auto& p : placed) sim.add_clump(grain, wheat, p.com, p.q);
-    r.grains = long(placed.size());
-    const double dt = s.time_step > 0 ? s.time_step : s.time_step_fraction * sim.rayleigh_timestep();
-    sim.set_timestep(dt);
-    sim.set_skin(s.skin > 0 ? s.skin : std::clamp(40 * dt * 1.0, 0.0002, 0.001));
-    r.time_step = dt;
+void write_settings(StateWriter& w, const SiloCaseSettings& s) {
+    for_each_setting(s, [&](const char*, const auto& v) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) w.text(v);
+        else w.value(v);
+    });
+}
 
-    SiloProgress pr;
-    auto report = [&](const std::string& phase, const std::string& note = "") {
-        if (!progress) return;
-        pr.phase = phase;
-        pr.time = sim.time();
-        pr.step = sim.steps_done();
-        pr.grains_in_silo = long(sim.num_bodies());
-        pr.kinetic_energy_per_grain = sim.num_bodies() ? sim.kinetic_energy() / double(sim.num_bodies()) : 0;
-        pr.wall_s = wall();
-        pr.note = note;
-        progress(pr);
-    };
-    {
-        std::ostringstream note;
-        note << "generated up to z = " << gen.top() << " m (walls to " << wall_top << " m), dt = " << dt
-             << " s, skin " << sim.skin() << " m";
-        report("generated", note.str());
+SiloCaseSettings read_settings(StateReader& r) {
+    SiloCaseSettings s;
+    for_each_setting(s, [&](const char* name, auto& v) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
+        else r.value(v, name);
+    });
+    return s;
+}
+
+std::string read_tag(StateReader& r) { return r.text("format tag"); }
+
+// One run of the case: generation, filling, opening, discharge; every variable that carries over from one record
+// interval to the next is a member, so that a checkpoint can hold the whole run.
+class SiloRun {
+public:
+    using Progress = std::function<void(const SiloProgress&)>;
+
+    SiloRun(const SiloCaseSettings& s, Progress progress)
+        : s_(s), progress_(std::move(progress)), tmpl_(wheat_clump_template(s.materials.wheat.density)) {
+        validate(s_);
+        sim_.set_threads(s_.threads);
+        sim_.set_gravity(Vec3(0, 0, -s_.gravity));
+        wheat_ = sim_.add_material(to_kernel(s_.materials.wheat_scaled(), "wheat"));
+        steel_ = sim_.add_material(to_kernel(s_.materials.steel_scaled(), "steel"));
+        sim_.set_pair(wheat_, wheat_, to_kernel(s_.materials.wheat_wheat));
+        sim_.set_pair(wheat_, steel_, to_kernel(s_.materials.wheat_steel));
+        grain_ = sim_.add_clump_template(tmpl_);
+        r_.grain_mass = tmpl_.mass;
     }
 
-    // ---- VTK
-    long vtk_next_step = 0;
-    const long vtk_every = s.vtk_dir.empty() ? 0 : std::max(1L, std::lround(s.vtk_interval / dt));
-    auto maybe_vtk = [&](bool force = false) {
-        if (s.vtk_dir.empty() || (!force && sim.steps_done() < vtk_next_step)) return;
+    // A new run: random sequential addition slab by slab (3 mm slabs, 30 attempts per grain volume).
+    void generate() {
+        const long n = s_.fill_mass > 0 ? std::max(1L, std::lround(s_.fill_mass / tmpl_.mass)) : s_.particles;
+        Generator gen(s_.geometry, tmpl_, s_.seed);
+        const auto placed = gen.generate(n, 0.003, 30.0);
+        wall_top_ = std::max(s_.geometry.top(), gen.top() + 0.01);
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_);
+        for (const auto& p : placed) sim_.add_clump(grain_, wheat_, p.com, p.q);
+        r_.grains = long(placed.size());
+        const double dt = s_.time_step > 0 ? s_.time_step : s_.time_step_fraction * sim_.rayleigh_timestep();
+        sim_.set_timestep(dt);
+        sim_.set_skin(s_.skin > 0 ? s_.skin : std::clamp(40 * dt * 1.0, 0.0002, 0.001));
+        r_.time_step = dt;
+        next_progress_ = progress_every();
+        std::ostringstream note;
+        note << "generated up to z = " << gen.top() << " m (walls to " << wall_top_ << " m), dt = " << dt
+             << " s, skin " << sim_.skin() << " m";
+        report("generated", note.str());
+        maybe_vtk(true);
+    }
+
+    SiloCaseResult run() {
+        if (phase_ == Phase::filling) {
+            fill();
+            open();
+        }
+        discharge();
+        finish();
+        return r_;
+    }
+
+    // ---- checkpoint
+    void save(const std::string& file) {
+        const std::string tmp = file + ".tmp";
+        ++r_.checkpoints;
+        {
+            std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+            if (!os) throw std::runtime_error("checkpoint '" + tmp + "': cannot open for writing");
+            StateWriter w(os);
+            w.text(kCheckpointTag);
+            write_settings(w, s_);
+            w.value(phase_); w.value(wall_top_); w.value(plate_);
+            w.value(lost_); w.value(next_progress_); w.value(vtk_next_step_); w.value(ke_);
+            w.value(t_open_); w.value(next_frame_); w.value(mass_out_); w.value(grains_out_); w.value(last_out_time_);
+            w.value(wall());
+            w.value(r_.grains); w.value(r_.time_step); w.value(r_.fill_time); w.value(r_.fill_at_rest);
+            w.value(r_.fill_kinetic_energy); w.value(r_.fill_height); w.value(r_.bulk_density); w.value(r_.filled_mass);
+            w.value(r_.fill_steps); w.value(r_.fill_wall_s); w.value(r_.sessions); w.value(r_.checkpoints);
+            w.value(r_.vtk_files);
+            w.array(r_.discharge);
+            const bool open = phase_ == Phase::discharge;
+            if (open) {
+                classifier_->save(w);
+                r_.section->save(w);
+            }
+            sim_.save_state(os);
+            os.flush();
+            if (!os) throw std::runtime_error("checkpoint '" + tmp + "': write failed (disk full?)");
+        }
+        sync_file(tmp);
+        std::error_code ec;
+        std::filesystem::rename(tmp, file, ec);
+        if (ec) throw std::runtime_error("checkpoint '" + file + "': cannot replace it: " + ec.message());
+        last_checkpoint_wall_ = wall();
+        std::ostringstream note;
+        note << "checkpoint " << r_.checkpoints << " written to " << file;
+        report("checkpoint", note.str());
+    }
+
+    // Restores everything save() wrote; the settings were read already (they built this object).
+    void load(std::istream& is, const std::string& source) {
+        StateReader r(is, source);
+        read_tag(r);
+        read_settings(r);
+        r.value(phase_, "phase"); r.value(wall_top_, "wall top"); r.value(plate_, "plate");
+        r.value(lost_, "lost grains"); r.value(next_progress_, "progress step"); r.value(vtk_next_step_, "vtk step");
+        r.value(ke_, "kinetic energy"); r.value(t_open_, "opening time"); r.value(next_frame_, "frame step");
+        r.value(mass_out_, "discharged mass"); r.value(grains_out_, "discharged grains");
+        r.value(last_out_time_, "last discharge time"); r.value(wall_before_, "wall time");
+        r.value(r_.grains, "grains"); r.value(r_.time_step, "time step"); r.value(r_.fill_time, "fill time");
+        r.value(r_.fill_at_rest, "fill state"); r.value(r_.fill_kinetic_energy, "fill energy");
+        r.value(r_.fill_height, "fill height"); r.value(r_.bulk_density, "bulk density");
+        r.value(r_.filled_mass, "filled mass"); r.value(r_.fill_steps, "fill steps");
+        r.value(r_.fill_wall_s, "fill wall time"); r.value(r_.sessions, "sessions");
+        r.value(r_.checkpoints, "checkpoints"); r.value(r_.vtk_files, "vtk files");
+        r.array(r_.discharge, "discharge record");
+        if (phase_ != Phase::filling && phase_ != Phase::discharge) r.fail("phase", "unknown value");
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_);
+        if (phase_ == Phase::discharge) {
+            make_discharge_recorders();
+            classifier_->load(r);
+            r_.section->load(r);
+        }
+        sim_.load_state(is, source);
+        ++r_.sessions;
+        last_checkpoint_wall_ = wall();
+        std::ostringstream note;
+        note << "resumed from " << source << " (session " << r_.sessions << ", checkpoint " << r_.checkpoints << ")";
+        report("resumed", note.str());
+    }
+
+private:
+    enum class Phase : std::int32_t { filling = 0, discharge = 1 };
+
+    double wall() const {
+        return wall_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start_).count();
+    }
+    long progress_every() const { return std::max(1L, std::lround(s_.progress_interval / r_.time_step)); }
+    long chunk() const { return std::max(1L, std::lround(s_.record_interval / r_.time_step)); }
+    bool is_below_outlet(const BodyState& b) const { return b.position.z() < -s_.removal_depth; }
+
+    static void sync_file(const std::string& file) {
+        const int fd = ::open(file.c_str(), O_RDONLY);
+        if (fd >= 0) {
+            ::fsync(fd);
+            ::close(fd);
+        }
+    }
+
+    void report(const std::string& phase, const std::string& note = "") {
+        if (!progress_) return;
+        pr_.phase = phase;
+        pr_.time = sim_.time();
+        pr_.step = sim_.steps_done();
+        pr_.grains_in_silo = long(sim_.num_bodies());
+        pr_.kinetic_energy_per_grain = sim_.num_bodies() ? sim_.kinetic_energy() / double(sim_.num_bodies()) : 0;
+        pr_.discharge_time = phase_ == Phase::discharge ? sim_.time() - t_open_ : 0;
+        pr_.grains_discharged = grains_out_;
+        pr_.discharged_mass = mass_out_;
+        pr_.wall_s = wall();
+        pr_.note = note;
+        progress_(pr_);
+    }
+
+    // At the end of a record interval, once every check of the interval is done: the state is then the one the
+    // next interval starts from, which is what a resumed run needs.
+    void maybe_checkpoint() {
+        if (s_.checkpoint_file.empty() || wall() - last_checkpoint_wall_ < s_.checkpoint_interval) return;
+        save(s_.checkpoint_file);
+    }
+
+    void maybe_vtk(bool force = false) {
+        if (s_.vtk_dir.empty() || (!force && sim_.steps_done() < vtk_next_step_)) return;
         SphereSnapshot snap;
-        const size_t ns = sim.num_spheres();
+        const size_t ns = sim_.num_spheres();
         for (size_t k = 0; k < ns; ++k) {
-            const SphereState st = sim.sphere(k);
+            const SphereState st = sim_.sphere(k);
             snap.positions.push_back(st.position);
             snap.velocities.push_back(st.velocity);
             snap.radii.push_back(st.radius);
             snap.clump.push_back(long(st.body));
         }
         char name[64];
-        std::snprintf(name, sizeof name, "silo_%06ld.vtk", r.vtk_files);
-        write_vtk(std::filesystem::path(s.vtk_dir) / name, snap, sim.time());
-        ++r.vtk_files;
-        vtk_next_step = sim.steps_done() + vtk_every;
-    };
-
-    // ---- filling against the closed plate
-    const double rest_energy = s.rest_energy_factor * tmpl.mass * s.gravity * wheat_length;
-    const long chunk = std::max(1L, std::lround(s.record_interval / dt));
-    const long progress_every = std::max(1L, std::lround(s.progress_interval / dt));
-    long next_progress = progress_every;
-    long lost = 0;
-    auto below = [&](const BodyState& b) { return b.position.z() < -s.removal_depth; };
-    maybe_vtk(true);
-    double ke = 0;
-    while (true) {
-        sim.step(chunk);
-        lost += long(sim.remove_bodies_if(below).count);  // grains through a gap in the closed silo: none expected
-        ke = sim.num_bodies() ? sim.kinetic_energy() / double(sim.num_bodies()) : 0;
-        maybe_vtk();
-        if (!std::isfinite(ke)) throw std::runtime_error("filling: the kinetic energy is not finite (unstable step?)");
-        if (sim.steps_done() >= next_progress) {
-            report("filling");
-            next_progress += progress_every;
-        }
-        if (sim.time() >= s.fill_time_min && ke < rest_energy) {
-            r.fill_at_rest = true;
-            break;
-        }
-        if (sim.time() >= s.fill_time_max) break;
+        std::snprintf(name, sizeof name, "silo_%06ld.vtk", r_.vtk_files);
+        write_vtk(std::filesystem::path(s_.vtk_dir) / name, snap, sim_.time());
+        ++r_.vtk_files;
+        vtk_next_step_ = sim_.steps_done() + std::max(1L, std::lround(s_.vtk_interval / r_.time_step));
     }
-    r.fill_time = sim.time();
-    r.fill_steps = sim.steps_done();
-    r.fill_kinetic_energy = ke;
-    r.fill_wall_s = wall();
-    // the filled bed: height and bulk density below 0.8 of its height
-    {
+
+    // Filling against the closed plate until the grains are at rest (or the time limit).
+    void fill() {
+        const double rest_energy = s_.rest_energy_factor * tmpl_.mass * s_.gravity * wheat_length;
+        auto below = [this](const BodyState& b) { return is_below_outlet(b); };
+        while (true) {
+            sim_.step(chunk());
+            lost_ += long(sim_.remove_bodies_if(below).count);  // grains through a gap in the closed silo: none expected
+            ke_ = sim_.num_bodies() ? sim_.kinetic_energy() / double(sim_.num_bodies()) : 0;
+            maybe_vtk();
+            if (!std::isfinite(ke_)) throw std::runtime_error("filling: the kinetic energy is not finite (unstable step?)");
+            if (sim_.steps_done() >= next_progress_) {
+                report("filling");
+                next_progress_ += progress_every();
+            }
+            if (sim_.time() >= s_.fill_time_min && ke_ < rest_energy) {
+                r_.fill_at_rest = true;
+                break;
+            }
+            if (sim_.time() >= s_.fill_time_max) break;
+            maybe_checkpoint();
+        }
+        r_.fill_time = sim_.time();
+        r_.fill_steps = sim_.steps_done();
+        r_.fill_kinetic_energy = ke_;
+        r_.fill_wall_s = wall();
+        // the filled bed: height and bulk density below 0.8 of its height
         double top = 0, mass_below = 0;
-        for (size_t i = 0; i < sim.num_bodies(); ++i) top = std::max(top, sim.body(i).position.z());
+        for (size_t i = 0; i < sim_.num_bodies(); ++i) top = std::max(top, sim_.body(i).position.z());
         const double zref = 0.8 * top;
-        for (size_t i = 0; i < sim.num_bodies(); ++i) {
-            const BodyState b = sim.body(i);
+        for (size_t i = 0; i < sim_.num_bodies(); ++i) {
+            const BodyState b = sim_.body(i);
             if (b.position.z() < zref) mass_below += b.mass;
         }
-        r.fill_height = top;
-        r.bulk_density = zref > 0 ? mass_below / g.volume_below(zref) : 0;
-    }
-    const long filled_grains = long(sim.num_bodies());
-    r.filled_mass = sim.total_mass();
-    {
+        r_.fill_height = top;
+        r_.bulk_density = zref > 0 ? mass_below / s_.geometry.volume_below(zref) : 0;
+        r_.filled_mass = sim_.total_mass();
         std::ostringstream note;
-        note << (r.fill_at_rest ? "at rest" : "time limit reached") << ", bed height " << r.fill_height
-             << " m, bulk density " << r.bulk_density << " kg/m^3";
-        if (lost) note << ", " << lost << " grains lost through the closed outlet";
+        note << (r_.fill_at_rest ? "at rest" : "time limit reached") << ", bed height " << r_.fill_height
+             << " m, bulk density " << r_.bulk_density << " kg/m^3";
+        if (lost_) note << ", " << lost_ << " grains lost through the closed outlet";
         report("filled", note.str());
     }
 
-    // ---- discharge
-    sim.set_wall_enabled(plate, false);
-    const double t_open = sim.time();
-    const long open_step = sim.steps_done();
-    FlowPatternClassifier classifier(g, s.flow);
-    r.section = std::make_shared<SectionField>(g, s.section_cell, s.section_half_thickness, r.fill_height + 0.01);
-    const long frame_every = std::max(1L, std::lround(s.frame_interval / dt));
-    long next_frame = sim.steps_done();
-    double mass_out = 0;
-    long grains_out = 0;
-    r.discharge.push_back({0.0, 0.0, 0});
-    double last_out_time = 0;
-    const double stall_time = 0.5;  // no grain discharged for this long with grains left: the flow has stopped
-    while (true) {
-        sim.step(chunk);
-        const RemovalResult rem = sim.remove_bodies_if(below);
-        mass_out += rem.mass;
-        grains_out += long(rem.count);
-        const double t = sim.time() - t_open;
-        if (rem.count) last_out_time = t;
-        r.discharge.push_back({t, mass_out, grains_out});
-        maybe_vtk();
-        if (sim.steps_done() >= next_frame) {
-            next_frame += frame_every;
-            const double frac = mass_out / r.filled_mass;
-            if (frac >= s.steady_lower * 0.5 && frac <= s.steady_upper) {  // tagged; the window is chosen at the end
-                std::vector<Eigen::Vector3d> pos, vel;
-                pos.reserve(sim.num_bodies());
-                vel.reserve(sim.num_bodies());
-                for (size_t i = 0; i < sim.num_bodies(); ++i) {
-                    const BodyState b = sim.body(i);
-                    pos.push_back(b.position);
-                    vel.push_back(b.velocity);
+    void make_discharge_recorders() {
+        classifier_ = std::make_unique<FlowPatternClassifier>(s_.geometry, s_.flow);
+        r_.section = std::make_shared<SectionField>(s_.geometry, s_.section_cell, s_.section_half_thickness,
+                                                    r_.fill_height + 0.01);
+    }
+
+    void open() {
+        sim_.set_wall_enabled(plate_, false);
+        t_open_ = sim_.time();
+        make_discharge_recorders();
+        next_frame_ = sim_.steps_done();
+        r_.discharge.push_back({0.0, 0.0, 0});
+        phase_ = Phase::discharge;
+    }
+
+    void discharge() {
+        const long frame_every = std::max(1L, std::lround(s_.frame_interval / r_.time_step));
+        const double stall_time = 0.5;  // no grain discharged for this long with grains left: the flow has stopped
+        auto below = [this](const BodyState& b) { return is_below_outlet(b); };
+        while (true) {
+            sim_.step(chunk());
+            const RemovalResult rem = sim_.remove_bodies_if(below);
+            mass_out_ += rem.mass;
+            grains_out_ += long(rem.count);
+            const double t = sim_.time() - t_open_;
+            if (rem.count) last_out_time_ = t;
+            r_.discharge.push_back({t, mass_out_, grains_out_});
+            maybe_vtk();
+            if (sim_.steps_done() >= next_frame_) {
+                next_frame_ += frame_every;
+                const double frac = mass_out_ / r_.filled_mass;
+                if (frac >= s_.steady_lower * 0.5 && frac <= s_.steady_upper) {  // tagged; the window is chosen at the end
+                    std::vector<Eigen::Vector3d> pos, vel;
+                    pos.reserve(sim_.num_bodies());
+                    vel.reserve(sim_.num_bodies());
+                    for (size_t i = 0; i < sim_.num_bodies(); ++i) {
+                        const BodyState b = sim_.body(i);
+                        pos.push_back(b.position);
+                        vel.push_back(b.velocity);
+                    }
+                    classifier_->add_frame(pos, vel, mass_out_);
+                    if (frac >= 0.3 && frac <= 0.5) r_.section->add_frame(pos, vel);
                 }
-                classifier.add_frame(pos, vel, mass_out);
-                if (frac >= 0.3 && frac <= 0.5) r.section->add_frame(pos, vel);
             }
-        }
-        pr.discharge_time = t;
-        pr.grains_discharged = grains_out;
-        pr.discharged_mass = mass_out;
-        if (sim.steps_done() >= next_progress) {
-            report("discharge");
-            next_progress += progress_every;
-        }
-        if (sim.num_bodies() == 0) {
-            r.emptied = true;
-            r.stop_reason = "empty";
-            break;
-        }
-        if (mass_out >= s.stop_fraction * r.filled_mass * (1 - 1e-12)) {
-            r.stop_reason = "stop fraction " + setting_text(s.stop_fraction) + " of the filled mass discharged";
-            break;
-        }
-        if (t - last_out_time > stall_time) {
-            r.stop_reason = "flow stopped: no grain left for " + setting_text(stall_time) + " s, " +
-                            std::to_string(sim.num_bodies()) + " grains remain";
-            break;
-        }
-        if (t >= s.max_time) {
-            r.stop_reason = "time limit " + setting_text(s.max_time) + " s";
-            break;
+            if (sim_.steps_done() >= next_progress_) {
+                report("discharge");
+                next_progress_ += progress_every();
+            }
+            if (sim_.num_bodies() == 0) {
+                r_.emptied = true;
+                r_.stop_reason = "empty";
+                break;
+            }
+            if (mass_out_ >= s_.stop_fraction * r_.filled_mass * (1 - 1e-12)) {
+                r_.stop_reason = "stop fraction " + setting_text(s_.stop_fraction) + " of the filled mass discharged";
+                break;
+            }
+            if (t - last_out_time_ > stall_time) {
+                r_.stop_reason = "flow stopped: no grain left for " + setting_text(stall_time) + " s, " +
+                                 std::to_string(sim_.num_bodies()) + " grains remain";
+                break;
+            }
+            if (t >= s_.max_time) {
+                r_.stop_reason = "time limit " + setting_text(s_.max_time) + " s";
+                break;
+            }
+            maybe_checkpoint();
         }
     }
-    maybe_vtk(true);
-    r.discharge_time = sim.time() - t_open;
-    r.grains_discharged = grains_out;
-    r.grains_in_silo = long(sim.num_bodies());
-    r.steps = sim.steps_done();
-    (void)open_step;
-    (void)filled_grains;
-    // the steady part: between steady_lower and steady_upper of the mass discharged at the end
-    std::vector<DischargeSample> samples;
-    for (const auto& d : r.discharge) samples.push_back({d.time, d.mass});
-    r.fit = fit_discharge_rate(samples, mass_out, s.steady_lower, s.steady_upper);
-    r.flow = classifier.result(s.steady_lower * mass_out, s.steady_upper * mass_out);
-    r.wall_s = wall();
-    report("done", r.stop_reason);
-    return r;
+
+    void finish() {
+        maybe_vtk(true);
+        r_.discharge_time = sim_.time() - t_open_;
+        r_.grains_discharged = grains_out_;
+        r_.grains_in_silo = long(sim_.num_bodies());
+        r_.steps = sim_.steps_done();
+        // the steady part: between steady_lower and steady_upper of the mass discharged at the end
+        std::vector<DischargeSample> samples;
+        for (const auto& d : r_.discharge) samples.push_back({d.time, d.mass});
+        r_.fit = fit_discharge_rate(samples, mass_out_, s_.steady_lower, s_.steady_upper);
+        r_.flow = classifier_->result(s_.steady_lower * mass_out_, s_.steady_upper * mass_out_);
+        r_.wall_s = wall();
+        report("done", r_.stop_reason);
+    }
+
+    SiloCaseSettings s_;
+    Progress progress_;
+    ClumpTemplate tmpl_;
+    Simulation sim_;
+    int wheat_ = 0, steel_ = 0, grain_ = 0, plate_ = -1;
+    SiloCaseResult r_;
+    SiloProgress pr_;
+    std::unique_ptr<FlowPatternClassifier> classifier_;
+    const std::chrono::steady_clock::time_point t_start_ = std::chrono::steady_clock::now();
+    double wall_before_ = 0;          // wall time of the earlier sessions of a resumed run
+    double last_checkpoint_wall_ = 0;
+    // the run's own variables, carried from one record interval to the next
+    Phase phase_ = Phase::filling;
+    double wall_top_ = 0;
+    long lost_ = 0, next_progress_ = 0, vtk_next_step_ = 0;
+    double ke_ = 0;
+    double t_open_ = 0;
+    long next_frame_ = 0;
+    double mass_out_ = 0;
+    long grains_out_ = 0;
+    double last_out_time_ = 0;
+};
+
+std::ifstream open_checkpoint(const std::string& file) {
+    std::ifstream is(file, std::ios::binary);
+    if (!is) throw std::runtime_error("checkpoint '" + file + "': cannot open it (" + std::strerror(errno) + ")");
+    return is;
+}
+
+SiloCaseSettings settings_of(std::istream& is, const std::string& file) {
+    StateReader r(is, "checkpoint '" + file + "'");
+    const std::string tag = read_tag(r);
+    if (tag != kCheckpointTag)
+        r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + kCheckpointTag + ")");
+    return read_settings(r);
+}
+
+}  // namespace
+
+SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress) {
+    SiloRun run(s, progress);
+    run.generate();
+    return run.run();
+}
+
+SiloCaseSettings read_checkpoint_settings(const std::string& file) {
+    std::ifstream is = open_checkpoint(file);
+    return settings_of(is, file);
+}
+
+SiloCaseResult resume_silo_case(const std::string& file, int threads, double checkpoint_interval,
+                                const std::function<void(const SiloProgress&)>& progress) {
+    SiloCaseSettings s = read_checkpoint_settings(file);
+    s.threads = threads;
+    s.checkpoint_file = file;
+    s.checkpoint_interval = checkpoint_interval;
+    SiloRun run(s, progress);
+    std::ifstream is = open_checkpoint(file);
+    run.load(is, "checkpoint '" + file + "'");
+    return run.run();
 }
 
 }  // namespace demcal::kernel::silo

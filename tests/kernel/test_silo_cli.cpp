@@ -1,9 +1,14 @@
 // demcal silo end to end: bad input exits 2 naming the field and the value, before anything is written; a tiny run
-// writes discharge.csv and summary.json. Needs the demcal binary (built with the project; skipped with a warning if
-// it is missing, since test_kernel does not link it).
+// writes discharge.csv and summary.json; a run killed with -9 and resumed from its checkpoint writes the same
+// discharge.csv as an uninterrupted one. Needs the demcal binary (built with the project: CI builds everything).
 #include <catch2/catch.hpp>
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <cstdlib>
 #include <filesystem>
@@ -31,13 +36,22 @@ Run demcal(const std::string& args, const fs::path& dir) {
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
 }
 
+std::string read_file(const fs::path& file) {
+    std::ifstream f(file, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+void require_demcal() {
+    INFO("the demcal binary is built with the project (cmake --build build); test_kernel runs it");
+    REQUIRE(fs::exists(DEMCAL_BINARY));
+}
+
 }  // namespace
 
 TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[silo][cli]") {
-    if (!fs::exists(DEMCAL_BINARY)) {
-        WARN("demcal not built: " << DEMCAL_BINARY);
-        return;
-    }
+    require_demcal();
     const fs::path dir = fs::temp_directory_path() / "demcal_test_silo_cli_bad";
     fs::remove_all(dir);
     const fs::path out = dir / "never";
@@ -68,10 +82,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
 }
 
 TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[silo][cli]") {
-    if (!fs::exists(DEMCAL_BINARY)) {
-        WARN("demcal not built: " << DEMCAL_BINARY);
-        return;
-    }
+    require_demcal();
     const fs::path dir = fs::temp_directory_path() / "demcal_test_silo_cli_run";
     fs::remove_all(dir);
     const Run r = demcal("--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
@@ -87,5 +98,64 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     s << f.rdbuf();
     CHECK_THAT(s.str(), Catch::Matchers::Contains("\"wall_to_axis_velocity_ratio\""));
     CHECK_THAT(s.str(), Catch::Matchers::Contains("\"grains\": 300"));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal silo: a run killed with -9 resumes from its checkpoint to the uninterrupted result", "[silo][cli]") {
+    require_demcal();
+    const fs::path dir = fs::temp_directory_path() / ("demcal_test_silo_cli_resume_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const std::string case_args = "--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
+                                  "/examples/silo/reduced_conical_70deg.json' --theta 45 --particles 600 "
+                                  "--stiffness-scale 0.001 --fill-time 0.3 --max-time 0.4 --no-plots ";
+    const Run whole = demcal(case_args + "--threads 1 --no-checkpoint --out '" + (dir / "whole").string() + "'", dir);
+    INFO(whole.err);
+    REQUIRE(whole.rc == 0);
+
+    // the same run, checkpointing every 0.1 s of wall time, killed with -9 once its first checkpoint is written
+    const fs::path out = dir / "killed", ckpt = out / "checkpoint.bin";
+    const std::string cmd = std::string("exec '") + DEMCAL_BINARY + "' silo " + case_args +
+                            "--threads 1 --checkpoint-every 0.1 --out '" + out.string() + "' > '" +
+                            (dir / "killed.log").string() + "' 2>&1";
+    const pid_t pid = ::fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) {
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int status = 0;
+    bool finished = false;
+    while (!fs::exists(ckpt) && !finished) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        finished = ::waitpid(pid, &status, WNOHANG) == pid;
+    }
+    if (!finished) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+    }
+    INFO(read_file(dir / "killed.log"));
+    REQUIRE_FALSE(finished);  // killed mid-run (the run takes seconds, the first checkpoint comes after 0.1 s)
+    REQUIRE(fs::exists(ckpt));
+    CHECK_FALSE(fs::exists(out / "summary.json"));
+
+    // a new run into that directory would overwrite the checkpoint: refused
+    const Run again = demcal(case_args + "--out '" + out.string() + "'", dir);
+    CHECK(again.rc == 2);
+    CHECK_THAT(again.err, Catch::Matchers::Contains("holds the checkpoint of an unfinished run"));
+    // a resumed run keeps its stored settings
+    const Run mixed = demcal("--resume '" + out.string() + "' --theta 30", dir);
+    CHECK(mixed.rc == 2);
+    CHECK_THAT(mixed.err, Catch::Matchers::Contains("--theta cannot be combined with --resume"));
+
+    const Run resumed = demcal("--resume '" + out.string() + "' --threads 2", dir);
+    INFO(resumed.err);
+    REQUIRE(resumed.rc == 0);
+    CHECK(read_file(out / "discharge.csv") == read_file(dir / "whole" / "discharge.csv"));
+    const std::string summary = read_file(out / "summary.json");
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 2"));
+    CHECK_FALSE(fs::exists(ckpt));  // removed once the outputs are written
+    const Run finished_run = demcal("--resume '" + out.string() + "'", dir);
+    CHECK(finished_run.rc == 2);
+    CHECK_THAT(finished_run.err, Catch::Matchers::Contains("that run has finished"));
     fs::remove_all(dir);
 }
