@@ -422,9 +422,19 @@ private:
 
     // At the end of a record interval, once every check of the interval is done: the state is then the one the
     // next interval starts from, which is what a resumed run needs.
+    // A checkpoint that cannot be written (disk full, directory removed) does not stop the run: the previous one
+    // stays valid, the failure is reported and the next interval tries again.
     void maybe_checkpoint() {
         if (s_.checkpoint_file.empty() || wall() - last_checkpoint_wall_ < s_.checkpoint_interval) return;
-        save(s_.checkpoint_file);
+        try {
+            save(s_.checkpoint_file);
+        } catch (const std::runtime_error& e) {
+            --r_.checkpoints;
+            last_checkpoint_wall_ = wall();
+            std::error_code ec;
+            std::filesystem::remove(s_.checkpoint_file + ".tmp", ec);
+            report("checkpoint", std::string("NOT written, the run goes on: ") + e.what());
+        }
     }
 
     void maybe_vtk(bool force = false) {

@@ -205,3 +205,21 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
     }
     std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("silo case: a checkpoint that cannot be written is reported and the run goes on", "[silo][checkpoint]") {
+    SiloCaseSettings s = reduced_case(45);
+    s.particles = 300;
+    s.fill_time_max = 0.3;
+    s.max_time = 0.1;
+    s.checkpoint_file = "/nonexistent-demcal-dir/checkpoint.bin";
+    s.checkpoint_interval = 0;
+    long failures = 0;
+    const SiloCaseResult r = run_silo_case(s, [&](const SiloProgress& p) {
+        if (p.phase == "checkpoint" && p.note.find("NOT written") != std::string::npos &&
+            p.note.find("/nonexistent-demcal-dir/checkpoint.bin") != std::string::npos)
+            ++failures;
+    });
+    CHECK(failures > 10);
+    CHECK(r.checkpoints == 0);
+    CHECK(r.grains_discharged > 0);
+}
