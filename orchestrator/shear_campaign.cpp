@@ -66,6 +66,8 @@ std::string campaign_name(const ShearCampaignSpec& spec) {
 
 namespace {
 
+constexpr const char* kWrapperName = "run_clean.py";  // yade_scripts/run_clean.py, beside the default template
+
 struct PlannedRun {
     std::string hash;
     nlohmann::json params;
@@ -97,11 +99,13 @@ std::vector<PlannedRun> plan_runs(const ShearCampaignSpec& spec, const std::stri
     return plan;
 }
 
-// The run directory holds everything needed to repeat the run by hand: `cd DIR && yade -n -x shear_box.py`.
-void write_run_directory(const PlannedRun& r, const std::string& template_text) {
+// The run directory holds everything needed to repeat the run by hand: `cd DIR && yade -n -x shear_box.py`; the
+// orchestrator runs it through run_clean.py, which removes the temporary directory YADE leaves in /tmp.
+void write_run_directory(const PlannedRun& r, const std::string& template_text, const std::string& wrapper_text) {
     fs::create_directories(r.dir);
-    const fs::path script = r.dir / "shear_box.py", params = r.dir / "params.json";
+    const fs::path script = r.dir / "shear_box.py", params = r.dir / "params.json", wrapper = r.dir / kWrapperName;
     if (!fs::exists(script) || read_text_file(script) != template_text) write_text_file_atomically(script, template_text);
+    if (!fs::exists(wrapper) || read_text_file(wrapper) != wrapper_text) write_text_file_atomically(wrapper, wrapper_text);
     const std::string p = r.params.dump(2) + "\n";
     if (!fs::exists(params) || read_text_file(params) != p) write_text_file_atomically(params, p);
 }
@@ -196,6 +200,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     const ShearCampaignSpec spec = resolved(spec_in);
     find_yade(options_.yade);
     const std::string template_text = read_text_file(spec.template_path);
+    const std::string wrapper_text = read_text_file(default_shear_template().parent_path() / kWrapperName);
     const auto plan = plan_runs(spec, template_text, dir_);
 
     ShearCampaignOutcome out;
@@ -206,7 +211,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     for (const auto& r : plan) {
         if (!seen.insert(r.hash).second) continue;  // the same run twice in a plan (repeated stress) runs once
         by_hash[r.hash] = &r;
-        write_run_directory(r, template_text);
+        write_run_directory(r, template_text, wrapper_text);
         RunRecord rec = store_->ensure_run(out.campaign.id, r.hash, r.params, r.dir, r.label);
         if (options_.force && rec.state != RunState::pending) {
             store_->reset_to_pending(r.hash, "forced recomputation");
@@ -301,7 +306,8 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         const PlannedRun& r = *by_hash.at(h);
         fs::remove(r.dir / "result.json");  // a result must come from this attempt
         return Job{h, r.dir,
-                   {find_yade(options_.yade).string(), "-n", "-j1", "-x", "shear_box.py", "params.json", "result.json"},
+                   {find_yade(options_.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py", "params.json",
+                    "result.json"},
                    options_.timeout_s};
     };
 

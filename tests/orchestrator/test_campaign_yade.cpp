@@ -47,6 +47,14 @@ TEST_CASE("a tiny YADE shear campaign gives positive peaks and a failure line, a
         // The run directory repeats by hand: the generated script and its parameters are there.
         CHECK(fs::exists(r.run_dir / "shear_box.py"));
         CHECK(nlohmann::json::parse(test::read_file(r.run_dir / "params.json")) == r.params);
+        // YADE's own /tmp/yade-XXXXXX of this run is gone (run_clean.py): a campaign leaves nothing in /tmp
+        const std::string out = test::read_file(r.run_dir / "stdout.log");
+        const std::string mark = "run_clean: removed YADE's temporary directory ";
+        const auto at = out.find(mark);
+        REQUIRE(at != std::string::npos);
+        const std::string tmp = out.substr(at + mark.size(), out.find('\n', at) - at - mark.size());
+        CHECK(tmp.rfind("/tmp/yade-", 0) == 0);
+        CHECK_FALSE(fs::exists(tmp));
     }
     const fs::path json_path = test::find_file(dir, "failure_line_", ".json");
     REQUIRE_FALSE(json_path.empty());
