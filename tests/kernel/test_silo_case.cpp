@@ -44,6 +44,18 @@ double beverloo(const SiloCaseSettings& s, double bulk_density) {
     return s.geometry.half_angle_deg < 45 ? w * std::pow(std::tan(th), -0.35) : w;
 }
 
+// 600 grains in a 30 deg wedge hopper (slot 30 mm x 30 mm deep, 60 mm wide, 100 mm body): about a second.
+SiloCaseSettings small_rectangular_case() {
+    SiloCaseSettings s;
+    s.geometry = SiloGeometry::rectangular(30, 0.03, 0.03, 0.06, 0.1);
+    s.particles = 600;
+    s.materials.stiffness_scale = 1e-3;
+    s.fill_time_max = 0.4;
+    s.max_time = 0.3;
+    s.threads = 1;
+    return s;
+}
+
 void check_common(const SiloCaseSettings& s, const SiloCaseResult& r) {
     INFO("rate " << r.fit.rate << " +/- " << r.fit.rate_se << " kg/s, R^2 " << r.fit.r_squared << ", flow "
                  << to_string(r.flow.pattern) << " ratio " << r.flow.ratio << ", " << r.stop_reason << ", wall "
@@ -109,13 +121,7 @@ TEST_CASE("silo case: bad settings name the field and the value", "[silo]") {
 }
 
 TEST_CASE("silo case: a small rectangular hopper fills without losing grains and discharges", "[silo]") {
-    SiloCaseSettings s;
-    s.geometry = SiloGeometry::rectangular(30, 0.03, 0.03, 0.06, 0.1);
-    s.particles = 600;
-    s.materials.stiffness_scale = 1e-3;
-    s.fill_time_max = 0.4;
-    s.max_time = 0.3;
-    s.threads = 1;
+    SiloCaseSettings s = small_rectangular_case();
     const auto r = run_silo_case(s);
     CHECK(r.grains == 600);
     CHECK(r.fill_at_rest);
@@ -142,13 +148,7 @@ struct SimulatedCrash {};
 
 TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninterrupted result bit for bit",
           "[silo][checkpoint]") {
-    SiloCaseSettings s;
-    s.geometry = SiloGeometry::rectangular(30, 0.03, 0.03, 0.06, 0.1);
-    s.particles = 600;
-    s.materials.stiffness_scale = 1e-3;
-    s.fill_time_max = 0.4;
-    s.max_time = 0.3;
-    s.threads = 1;
+    SiloCaseSettings s = small_rectangular_case();
     const SiloCaseResult whole = run_silo_case(s);
     REQUIRE(whole.flow.frames > 0);
 
