@@ -199,7 +199,6 @@ class BasicSimulation {
   std::vector<PairCoeffs> coeffs_;          // nm * nm (built in prepare)
   int nm_coeffs_ = 0;
   std::vector<Wall> walls_;
-  std::vector<Vec3> wall_force_;
   std::vector<ClumpTemplate> templates_;
 
   // per sphere (structure of arrays)

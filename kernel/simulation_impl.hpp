@@ -128,7 +128,6 @@ template <class Law>
 int BasicSimulation<Law>::add_wall(const Wall& w) {
   if (w.material < 0 || w.material >= int(materials_.size())) throw std::invalid_argument("add_wall: unknown material");
   walls_.push_back(w);
-  wall_force_.push_back(Vec3::Zero());
   nl_.invalidate();  // the wall candidates are found at the neighbour build
   prepared_ = false;
   forces_valid_ = false;
@@ -143,7 +142,14 @@ void BasicSimulation<Law>::set_wall_enabled(int id, bool enabled) {
 
 template <class Law>
 Vec3 BasicSimulation<Law>::wall_force(int id) const {
-  return wall_force_.at(id);
+  // Summed when asked, in sphere order, from the forces each sphere keeps per wall contact: a serial pass over every
+  // sphere in each step would cost every step, for a value most runs never read.
+  if (id < 0 || id >= int(walls_.size())) throw std::out_of_range("wall_force: no wall " + std::to_string(id));
+  Vec3 f = Vec3::Zero();
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    for (int k = 0; k < kWallSlots; ++k)
+      if (wall_slot_id_[i * kWallSlots + k] == id) f -= wall_slot_f_[i * kWallSlots + k];
+  return f;
 }
 
 template <class Law>
@@ -570,14 +576,6 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
       cT_[c] = T;
     }
   }
-  // wall forces (serial, fixed order)
-  for (int wdx = 0; wdx < nw; ++wdx) wall_force_[wdx].setZero();
-  if (nw > 0)
-    for (std::int64_t i = 0; i < n; ++i)
-      for (int k = 0; k < kWallSlots; ++k) {
-        const std::int32_t id = wall_slot_id_[std::size_t(i) * kWallSlots + k];
-        if (id >= 0) wall_force_[id] -= wall_slot_f_[std::size_t(i) * kWallSlots + k];
-      }
 }
 
 template <class Law>
@@ -838,12 +836,11 @@ std::vector<double> BasicSimulation<Law>::configuration_numbers() const {
 template <class Law>
 void BasicSimulation<Law>::save_state(std::ostream& os) const {
   StateWriter w(os);
-  w.text("demcal-kernel-state/1");
+  w.text("demcal-kernel-state/2");
   w.array(configuration_numbers());
   std::vector<char> enabled;
   for (const Wall& wall : walls_) enabled.push_back(wall.enabled);
   w.array(enabled);
-  w.array(wall_force_);
   // the for_each lists only hand out references; nothing is modified
   auto* self = const_cast<BasicSimulation*>(this);
   self->for_each_sphere_array([&](auto& a, int) { w.array(a); });
@@ -862,8 +859,10 @@ template <class Law>
 void BasicSimulation<Law>::load_state(std::istream& is, const std::string& source) {
   StateReader r(is, source);
   const std::string tag = r.text("format tag");
-  if (tag != "demcal-kernel-state/1")
-    r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a demcal kernel state (demcal-kernel-state/1)");
+  // version 1 also stored the force on each wall (now summed when asked): read and dropped
+  const bool v1 = tag == "demcal-kernel-state/1";
+  if (tag != "demcal-kernel-state/2" && !v1)
+    r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a demcal kernel state (demcal-kernel-state/1 or /2)");
   std::vector<double> saved;
   r.array(saved, "configuration");
   const std::vector<double> now = configuration_numbers();
@@ -875,8 +874,11 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   }
   std::vector<char> enabled;
   r.array(enabled, "wall switches");
-  r.array(wall_force_, "wall forces");
-  if (enabled.size() != walls_.size() || wall_force_.size() != walls_.size()) r.fail("walls", "wrong count");
+  if (v1) {
+    std::vector<Vec3> dropped;
+    r.array(dropped, "wall forces");
+  }
+  if (enabled.size() != walls_.size()) r.fail("walls", "wrong count");
   for (std::size_t k = 0; k < walls_.size(); ++k) walls_[k].enabled = enabled[k] != 0;
   for_each_sphere_array([&](auto& a, int) { r.array(a, "sphere arrays"); });
   for_each_clump_array([&](auto& a) { r.array(a, "clump arrays"); });
