@@ -162,8 +162,8 @@ void plot_parameter(const fs::path& dir, const ParameterSensitivity& p, const st
         }
     }
     std::ostringstream g;
-    g << "set multiplot layout 1,2 title 'Sensitivity to " << p.name << " (error bars: 1 standard error)'\n"
-      << "set grid\nset xlabel '" << p.name << "'\nset key bottom right\n"
+    g << "set multiplot layout 1,2 title 'Sensitivity to " << p.name << " (error bars: 1 standard error)' noenhanced\n"
+      << "set grid\nset xlabel '" << p.name << "' noenhanced\nset key bottom right\n"
       << "set ylabel 'mu_b [-]'\nset title 'internal friction: " << analytics::to_string(p.mu_b.shape) << "'\n"
       << "plot " << gnuplot_quote(data) << " using 1:2:3 with yerrorbars pt 7 lc rgb '#08519c' title 'simulated', "
       << gnuplot_quote(fit) << " using 1:2 with lines lw 2 lc rgb '#08519c' title 'fit'\n"

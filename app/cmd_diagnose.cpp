@@ -126,7 +126,7 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
         const std::string title = which == 0 ? "before" : "after";
         std::ostringstream g;
         g << "set multiplot layout 1,2 title '" << r.model << " residuals " << title
-          << (which == 1 ? " (" + std::to_string(r.effects.size()) + " effect(s) added)" : std::string()) << "'\n"
+          << (which == 1 ? " (" + std::to_string(r.effects.size()) + " effect(s) added)" : std::string()) << "' noenhanced\n"
           << "set grid\nset ylabel '" << unit << "'\nunset key\nset title noenhanced\n"
           << "set xlabel 'fitted " << r.response << "' noenhanced\n"
           << "plot " << gnuplot_quote(dat) << " using " << fitted << ":" << col << " with points pt 7 ps 0.8, 0 lt -1\n"
