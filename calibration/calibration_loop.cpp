@@ -217,6 +217,7 @@ public:
     const std::vector<ControlParameter>& controls() const { return controls_; }
     const CalibrationOptions& options() const { return options_; }
     CalibrationResult& result() { return result_; }
+    const CalibrationResult& result() const { return result_; }
 
 private:
     nlohmann::json start_;
@@ -375,16 +376,36 @@ std::string misses_at(const Search& s, const CalibrationIteration& it, const std
         const auto& target = s.targets()[t];
         const double v = target.quantity == "mu_b" ? it.mu_b : it.tau_c;
         if (std::fabs(v - target.value) <= target.acceptance(s.options().tolerance)) continue;
-        text += (text.empty() ? "" : "; ") + target.quantity + " = " + num(v) + " there, target " + num(target.value) +
+        text += (text.empty() ? "" : "; ") + target.quantity + " = " + num(v) + ", target " + num(target.value) +
                 " +/- " + num(target.acceptance(s.options().tolerance));
     }
     return text;
 }
 
+// The best evaluation so far and what it misses, for messages.
+std::string best_so_far(const Search& s, const std::vector<std::size_t>& targets) {
+    const auto& r = s.result();
+    return "best so far, evaluation #" + std::to_string(r.best + 1) + ": " + misses_at(s, r.iterations[r.best], targets);
+}
+
+// True when every target lies inside the simulated line's own interval at evaluation k: there the simulation cannot
+// tell the target from what it gave, so a bound reached there is noise, not proof that the target is out of reach.
+bool target_within_noise_at(const Search& s, std::size_t k, const std::vector<std::size_t>& targets) {
+    const auto& it = s.result().iterations[k];
+    for (std::size_t t : targets) {
+        const auto& target = s.targets()[t];
+        const double v = target.quantity == "mu_b" ? it.mu_b : it.tau_c;
+        const double hw = target.quantity == "mu_b" ? it.mu_b_half_width : it.tau_c_half_width;
+        if (!(std::fabs(v - target.value) <= hw)) return false;
+    }
+    return true;
+}
+
 // Non-empty (the bounds, described) when the model's best point still misses a target, sits on bounds, and a point
-// with the same controls on the same bounds has been simulated already.
+// with the same controls on the same bounds has been simulated already (its index in `simulated`).
 std::string pinned_bound_simulated(const Search& s, const SurrogateModel& model, const std::vector<double>& proposal,
-                                   const std::vector<std::size_t>& controls, const std::vector<std::size_t>& targets) {
+                                   const std::vector<std::size_t>& controls, const std::vector<std::size_t>& targets,
+                                   std::size_t& simulated) {
     const auto predicted = model.predict(proposal);
     bool misses = false;
     for (std::size_t t = 0; t < targets.size(); ++t) {
@@ -395,10 +416,13 @@ std::string pinned_bound_simulated(const Search& s, const SurrogateModel& model,
     for (std::size_t j : controls)
         if (proposal[j] <= same_point || proposal[j] >= 1 - same_point) on_bound.push_back(j);
     if (!misses || on_bound.empty()) return "";
-    for (const auto& p : s.points()) {
+    for (std::size_t k = 0; k < s.points().size(); ++k) {
         bool same = true;
-        for (std::size_t j : on_bound) same = same && std::fabs(p[j] - proposal[j]) < same_point;
-        if (same) return bounds_at(s, proposal, on_bound);
+        for (std::size_t j : on_bound) same = same && std::fabs(s.points()[k][j] - proposal[j]) < same_point;
+        if (same) {
+            simulated = k;
+            return bounds_at(s, proposal, on_bound);
+        }
     }
     return "";
 }
@@ -433,33 +457,40 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
         if (repeats) {
             const std::string where = bounds_at(s, proposal, controls);
             auto& r = s.result();
-            const auto& best = r.iterations[r.best];
             if (!where.empty()) {
                 r.status = CalibrationStatus::unreachable;
-                r.message = "target out of reach within the bounds: " + where + " (" + misses_at(s, best, targets) +
+                r.message = "target out of reach within the bounds: " + where + " (" + best_so_far(s, targets) +
                             "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
             } else {
                 r.status = CalibrationStatus::not_converged;
-                r.message = "the search stalled at an already simulated point (" + misses_at(s, best, targets) +
+                r.message = "the search stalled at an already simulated point (" + best_so_far(s, targets) +
                             "); the responses may be too noisy for the tolerance";
             }
             return false;
         }
         // The model finds no point that meets the targets and wants a bound that has already been simulated: the
         // simulations confirmed the model there, so more of them cannot help.
-        if (const auto pinned = pinned_bound_simulated(s, model, proposal, controls, targets); !pinned.empty()) {
+        std::size_t at_bound = 0;
+        if (const auto pinned = pinned_bound_simulated(s, model, proposal, controls, targets, at_bound);
+            !pinned.empty()) {
             auto& r = s.result();
-            r.status = CalibrationStatus::unreachable;
-            r.message = "target out of reach within the bounds: " + pinned + " (" +
-                        misses_at(s, r.iterations[r.best], targets) +
-                        "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
+            if (target_within_noise_at(s, at_bound, targets)) {
+                r.status = CalibrationStatus::not_converged;
+                r.message = "the model asks for " + pinned + ", simulated already (evaluation #" +
+                            std::to_string(at_bound + 1) + "), where the target lies inside the simulated line's own "
+                            "interval: the responses are too noisy to tell whether the target is in reach (" +
+                            best_so_far(s, targets) + "); more packings per stress (--replicates) or a wider --tol";
+            } else {
+                r.status = CalibrationStatus::unreachable;
+                r.message = "target out of reach within the bounds: " + pinned + " (" + best_so_far(s, targets) +
+                            "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
+            }
             return false;
         }
         if (!s.budget_left()) {
             s.result().status = CalibrationStatus::not_converged;
             s.result().message = "no match within " + std::to_string(s.options().max_evaluations) +
-                                 " failure-line evaluations (--max-evaluations); best: " +
-                                 misses_at(s, s.result().iterations[s.result().best], targets);
+                                 " failure-line evaluations (--max-evaluations); " + best_so_far(s, targets);
             return false;
         }
         s.evaluate_at(proposal, phase);
