@@ -401,6 +401,14 @@ bool target_within_noise_at(const Search& s, std::size_t k, const std::vector<st
     return true;
 }
 
+std::string noise_at_bound_message(const Search& s, const std::string& where, std::size_t k,
+                                   const std::vector<std::size_t>& targets) {
+    return "the model asks for " + where + ", simulated already (evaluation #" + std::to_string(k + 1) +
+           "), where the target lies inside the simulated line's own interval: the responses are too noisy to tell "
+           "whether the target is in reach (" + best_so_far(s, targets) +
+           "); more packings per stress (--replicates) or a wider --tol";
+}
+
 // Non-empty (the bounds, described) when the model's best point still misses a target, sits on bounds, and a point
 // with the same controls on the same bounds has been simulated already (its index in `simulated`).
 std::string pinned_bound_simulated(const Search& s, const SurrogateModel& model, const std::vector<double>& proposal,
@@ -449,15 +457,19 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
     while (!accepted_for(s, s.result().iterations[k], targets)) {
         const auto proposal = s.snapped(model.propose());
         bool repeats = false;
-        for (const auto& p : s.points()) {
+        std::size_t repeated = 0;
+        for (std::size_t q = 0; q < s.points().size() && !repeats; ++q) {
             double d = 0;
-            for (std::size_t j : controls) d = std::max(d, std::fabs(p[j] - proposal[j]));
-            repeats = repeats || d < same_point;
+            for (std::size_t j : controls) d = std::max(d, std::fabs(s.points()[q][j] - proposal[j]));
+            if (d < same_point) repeats = true, repeated = q;
         }
         if (repeats) {
             const std::string where = bounds_at(s, proposal, controls);
             auto& r = s.result();
-            if (!where.empty()) {
+            if (!where.empty() && target_within_noise_at(s, repeated, targets)) {
+                r.status = CalibrationStatus::not_converged;
+                r.message = noise_at_bound_message(s, where, repeated, targets);
+            } else if (!where.empty()) {
                 r.status = CalibrationStatus::unreachable;
                 r.message = "target out of reach within the bounds: " + where + " (" + best_so_far(s, targets) +
                             "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
@@ -476,10 +488,7 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
             auto& r = s.result();
             if (target_within_noise_at(s, at_bound, targets)) {
                 r.status = CalibrationStatus::not_converged;
-                r.message = "the model asks for " + pinned + ", simulated already (evaluation #" +
-                            std::to_string(at_bound + 1) + "), where the target lies inside the simulated line's own "
-                            "interval: the responses are too noisy to tell whether the target is in reach (" +
-                            best_so_far(s, targets) + "); more packings per stress (--replicates) or a wider --tol";
+                r.message = noise_at_bound_message(s, pinned, at_bound, targets);
             } else {
                 r.status = CalibrationStatus::unreachable;
                 r.message = "target out of reach within the bounds: " + pinned + " (" + best_so_far(s, targets) +
