@@ -265,8 +265,6 @@ SiloCaseSettings read_settings(StateReader& r) {
     return s;
 }
 
-std::string read_tag(StateReader& r) { return r.text("format tag"); }
-
 // One run of the case: generation, filling, opening, discharge; every variable that carries over from one record
 // interval to the next is a member, so that a checkpoint can hold the whole run.
 class SiloRun {
@@ -355,11 +353,10 @@ public:
         report("checkpoint", note.str());
     }
 
-    // Restores everything save() wrote; the settings were read already (they built this object).
+    // Restores everything save() wrote after the settings, which the caller read from the same stream (they built
+    // this object).
     void load(std::istream& is, const std::string& source) {
         StateReader r(is, source);
-        read_tag(r);
-        read_settings(r);
         r.value(phase_, "phase"); r.value(wall_top_, "wall top"); r.value(plate_, "plate");
         r.value(lost_, "lost grains"); r.value(next_progress_, "progress step"); r.value(vtk_next_step_, "vtk step");
         r.value(ke_, "kinetic energy"); r.value(t_open_, "opening time"); r.value(next_frame_, "frame step");
@@ -614,7 +611,7 @@ std::ifstream open_checkpoint(const std::string& file) {
 
 SiloCaseSettings settings_of(std::istream& is, const std::string& file) {
     StateReader r(is, "checkpoint '" + file + "'");
-    const std::string tag = read_tag(r);
+    const std::string tag = r.text("format tag");
     if (tag != kCheckpointTag)
         r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + kCheckpointTag + ")");
     return read_settings(r);
@@ -635,12 +632,12 @@ SiloCaseSettings read_checkpoint_settings(const std::string& file) {
 
 SiloCaseResult resume_silo_case(const std::string& file, int threads, double checkpoint_interval,
                                 const std::function<void(const SiloProgress&)>& progress) {
-    SiloCaseSettings s = read_checkpoint_settings(file);
+    std::ifstream is = open_checkpoint(file);
+    SiloCaseSettings s = settings_of(is, file);
     s.threads = threads;
     s.checkpoint_file = file;
     s.checkpoint_interval = checkpoint_interval;
     SiloRun run(s, progress);
-    std::ifstream is = open_checkpoint(file);
     run.load(is, "checkpoint '" + file + "'");
     return run.run();
 }

@@ -33,6 +33,19 @@ bool within(double value, const MacroTarget& t, double tolerance) {
     return std::fabs(value - t.value) <= t.acceptance(tolerance);
 }
 
+// mu_b = 0.95 with tau_c = 900 Pa lies beyond friction's upper bound: the study runs on the noiseless box, the
+// calibration's failure lines come from `box`.
+CalibrationResult calibrate_unreachable_target(test::SyntheticShearBox& box) {
+    test::SyntheticShearBox clean;
+    const auto base = test::synthetic_base_material();
+    const auto study = run_sensitivity_study(base, clean.evaluator(), study_options());
+    const std::vector<MacroTarget> targets{{"mu_b", 0.95, std::nullopt}, {"tau_c", 900, std::nullopt}};
+    const auto controls = choose_controls(study, targets, 0.02);
+    CalibrationOptions options;
+    options.accept_simulated_interval = false;
+    return calibrate(base, targets, controls, &study, box.evaluator(), options);
+}
+
 }  // namespace
 
 TEST_CASE("the sensitivity study finds the shapes the synthetic box was built with", "[calibration]") {
@@ -120,13 +133,7 @@ TEST_CASE("the loop recovers a hidden material's failure line in a few evaluatio
 
 TEST_CASE("an unreachable target ends with the bound that stops it", "[calibration]") {
     test::SyntheticShearBox box;
-    const auto base = test::synthetic_base_material();
-    const auto study = run_sensitivity_study(base, box.evaluator(), study_options());
-    const std::vector<MacroTarget> targets{{"mu_b", 0.95, std::nullopt}, {"tau_c", 900, std::nullopt}};
-    const auto controls = choose_controls(study, targets, 0.02);
-    CalibrationOptions options;
-    options.accept_simulated_interval = false;
-    const auto result = calibrate(base, targets, controls, &study, box.evaluator(), options);
+    const auto result = calibrate_unreachable_target(box);
     INFO(result.message);
     CHECK(result.status == CalibrationStatus::unreachable);
     CHECK(result.message.find("friction_coefficient at its upper bound 0.75") != std::string::npos);
@@ -196,16 +203,9 @@ TEST_CASE("a bound reached where the simulated interval still holds the target i
           "[calibration]") {
     // The unreachable target above, but every failure line is so noisy (8 kPa per run) that the line at the bound
     // cannot tell the target from what it gave: the loop must not claim the target is out of reach.
-    test::SyntheticShearBox clean;
-    const auto base = test::synthetic_base_material();
-    const auto study = run_sensitivity_study(base, clean.evaluator(), study_options());
-    const std::vector<MacroTarget> targets{{"mu_b", 0.95, std::nullopt}, {"tau_c", 900, std::nullopt}};
-    const auto controls = choose_controls(study, targets, 0.02);
     test::SyntheticShearBox noisy;
     noisy.noise_sd = 8000.0;
-    CalibrationOptions options;
-    options.accept_simulated_interval = false;
-    const auto result = calibrate(base, targets, controls, &study, noisy.evaluator(), options);
+    const auto result = calibrate_unreachable_target(noisy);
     INFO(result.message);
     CHECK(result.status == CalibrationStatus::not_converged);
     CHECK(result.message.find("too noisy to tell whether the target is in reach") != std::string::npos);
