@@ -161,9 +161,12 @@ void plot_parameter(const fs::path& dir, const ParameterSensitivity& p, const st
             f << x << " " << p.mu_b.value(x) << " " << p.tau_c.value(x) << "\n";
         }
     }
+    // 5 % of the range on each side, so that the end levels' error bars do not sit on the frame
+    const double pad = 0.05 * (p.high() - p.low());
     std::ostringstream g;
     g << "set multiplot layout 1,2 title 'Sensitivity to " << p.name << " (error bars: 1 standard error)' noenhanced\n"
       << "set grid\nset xlabel '" << p.name << "' noenhanced\nset key bottom right\n"
+      << "set xrange [" << p.low() - pad << ":" << p.high() + pad << "]\n"
       << "set ylabel 'mu_b [-]'\nset title 'internal friction: " << analytics::to_string(p.mu_b.shape) << "'\n"
       << "plot " << gnuplot_quote(data) << " using 1:2:3 with yerrorbars pt 7 lc rgb '#08519c' title 'simulated', "
       << gnuplot_quote(fit) << " using 1:2 with lines lw 2 lc rgb '#08519c' title 'fit'\n"

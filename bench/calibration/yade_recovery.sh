@@ -28,7 +28,16 @@ import json,glob
 j=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['peak_failure_line']
 print('mu_b=%.6g,tau_c=%.6g' % (j['mu_b'], j['tau_c_Pa']))")
 echo "target: $target"
-common=(--target "$target" --start "$start" "${strict[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
+# MEASURED=1: pass the target's runs as a measured line (SIGMA:TAU per run), so that the loop accepts a line inside the
+# target's own confidence interval or the tolerance, whichever is wider (the issue's criterion); else the two numbers.
+target_option=(--target "$target")
+if [[ ${MEASURED:-0} == 1 ]]; then
+  target_option=(--measured "$(python3 -c "
+import json,glob
+runs=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['runs']
+print(','.join('%.9g:%.9g' % (r['label']['normal_stress'], r['peak_shear_stress']) for r in runs if r['state']=='done'))")")
+fi
+common=("${target_option[@]}" --start "$start" "${strict[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
         "${template[@]}" --params "$params" --levels "$levels" --campaign "$dir/loop")
 $demcal calibrate "${common[@]}" --max-evaluations 7 | tee "$dir/surrogate.log" || true
 # The coordinate baseline costs tens of failure lines: run it with COORDINATE=1.
