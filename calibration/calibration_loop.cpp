@@ -168,18 +168,23 @@ public:
         it.simulations_run = ev.simulations_run;
         it.simulations_reused = ev.simulations_reused;
         it.cpu_s = ev.cpu_s;
-        bool all_tolerance = true, all_either = true;
+        // tolerance alone, or widened to a measured target's own interval, or (unless strict) the simulated interval
+        bool all_tolerance = true, all_acceptance = true, all_either = true;
         it.mismatch = 0;
         for (const auto& t : targets_) {
             const double off = std::fabs(macro_value(line, t.quantity) - t.value);
             it.mismatch = std::max(it.mismatch, off / t.acceptance(options_.tolerance));
-            const bool by_tolerance = off <= t.acceptance(options_.tolerance);
+            const bool by_acceptance = off <= t.acceptance(options_.tolerance);
             const bool by_interval = options_.accept_simulated_interval && off <= macro_half_width(line, t.quantity);
-            all_tolerance = all_tolerance && by_tolerance;
-            all_either = all_either && (by_tolerance || by_interval);
+            all_tolerance = all_tolerance && off <= options_.tolerance * std::fabs(t.value);
+            all_acceptance = all_acceptance && by_acceptance;
+            all_either = all_either && (by_acceptance || by_interval);
         }
         it.accepted = all_either;
-        it.accepted_by = all_tolerance ? "tolerance" : (all_either ? "simulated interval" : "");
+        it.accepted_by = all_tolerance    ? "tolerance"
+                         : all_acceptance ? "target's interval"
+                         : all_either     ? "simulated interval"
+                                          : "";
         result_.iterations.push_back(it);
         points_.push_back(z);
         values_.push_back(observed(line));

@@ -54,7 +54,7 @@ struct CalibrationIteration {
     double mu_b = 0, mu_b_half_width = 0, tau_c = 0, tau_c_half_width = 0;
     double mismatch = 0;                    // max over targets of |simulated - target| / acceptance (<= 1: reached)
     bool accepted = false;
-    std::string accepted_by;                // "tolerance", "simulated interval" or both
+    std::string accepted_by;                // "tolerance", "target's interval" (a measured target's own interval, wider than the tolerance), "simulated interval"
     int simulations_run = 0, simulations_reused = 0;
     double cpu_s = 0;
     nlohmann::json to_json() const;

@@ -40,7 +40,13 @@ fi
 common=("${target_option[@]}" --start "$start" "${strict[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
         "${template[@]}" --params "$params" --levels "$levels" --campaign "$dir/loop")
 $demcal calibrate "${common[@]}" --max-evaluations 7 | tee "$dir/surrogate.log" || true
-# The coordinate baseline costs tens of failure lines: run it with COORDINATE=1.
+# The baselines cost tens of failure lines: run them with COORDINATE=1 and/or GRID=1 (GRID_POINTS per parameter over
+# the same bounds; 5 puts the grid on the study's levels, so the study's lines are reused but still counted).
+if [[ ${GRID:-0} == 1 ]]; then
+  points=${GRID_POINTS:-5}
+  $demcal calibrate "${common[@]}" --method grid --grid-points "$points" --max-evaluations $((points * points)) \
+    | tee "$dir/grid.log" || true
+fi
 if [[ ${COORDINATE:-0} == 1 ]]; then
   $demcal calibrate "${common[@]}" --method coordinate --max-evaluations 40 | tee "$dir/coordinate.log" || true
 fi

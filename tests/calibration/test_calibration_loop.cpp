@@ -236,3 +236,26 @@ TEST_CASE("an acceptance that rests only on a wide simulated interval says so", 
     const auto strict = calibrate(base, targets, controls, nullptr, box.evaluator(), options);
     CHECK(strict.status != CalibrationStatus::converged);
 }
+
+TEST_CASE("a measured target's own interval widens the acceptance, and the result says which rule accepted", "[calibration]") {
+    // The start's line, 5 % off a target whose measured interval is +/- 10 %: outside the 2 % tolerance, inside the
+    // target's interval; with --strict the simulated interval plays no part.
+    test::SyntheticShearBox box;
+    const auto base = test::synthetic_base_material();
+    const double mu_b = box(base).peak->mu_b;
+    const std::vector<ControlParameter> controls{{"friction_coefficient", 0.25, 0.75}};
+    CalibrationOptions options;
+    options.method = SearchMethod::coordinate;
+    options.accept_simulated_interval = false;
+    options.max_evaluations = 1;
+    const std::vector<MacroTarget> wide{{"mu_b", mu_b * 1.05, mu_b * 0.10}};
+    const auto accepted = calibrate(base, wide, controls, nullptr, box.evaluator(), options);
+    INFO(accepted.message);
+    REQUIRE(accepted.status == CalibrationStatus::converged);
+    CHECK(accepted.iterations[0].accepted_by == "target's interval");
+    CHECK(accepted.message.find("(target's interval)") != std::string::npos);
+    const std::vector<MacroTarget> narrow{{"mu_b", mu_b * 1.05, mu_b * 0.01}};  // the 2 % tolerance rules
+    CHECK(calibrate(base, narrow, controls, nullptr, box.evaluator(), options).status != CalibrationStatus::converged);
+    const std::vector<MacroTarget> close{{"mu_b", mu_b * 1.01, mu_b * 0.10}};
+    CHECK(calibrate(base, close, controls, nullptr, box.evaluator(), options).iterations[0].accepted_by == "tolerance");
+}
