@@ -286,7 +286,7 @@ void add_calibrate(CLI::App& app) {
     cmd->add_flag("--strict", o->strict, "stop on the tolerance only, not when a target is inside the simulated interval");
     cmd->add_option("--max-evaluations", o->max_evaluations, "failure lines at most (start included)")->capture_default_str();
     cmd->add_option("--grid-points", o->grid_points, "points per parameter (grid method)")->capture_default_str();
-    cmd->add_option("--output,-o", o->output, "calibrated material JSON (default CAMPAIGN/calibrated_material.json)");
+    cmd->add_option("--output,-o", o->output, "calibrated material JSON (default CAMPAIGN/calibrated_material.json; calibrated_material_<method>.json for the baselines)");
     cmd->add_option("--params", o->study.params, "study: parameters to vary")->delimiter(',');
     cmd->add_option("--levels", o->study.levels, "study: values per parameter")->capture_default_str();
     cmd->add_option("--span", o->study.span, "study: base * (1 -+ span)")->capture_default_str();
@@ -345,7 +345,9 @@ void add_calibrate(CLI::App& app) {
         std::cout << " (" << o->method << (o->sequential ? ", slope first" : "") << ")" << std::endl;
 
         const fs::path log_path = dir / ("calibration_log_" + o->method + ".jsonl");
-        std::ofstream log(log_path, std::ios::app);
+        // Rewritten by every invocation, like calibration_<method>.json: a resumed calibration replays its finished
+        // evaluations from the store, so the log still holds all of them once, in order (appending repeated them).
+        std::ofstream log(log_path, std::ios::trunc);
         const auto result = calibrate(start, targets, controls, &study, session.evaluate, options,
                                       [&](const CalibrationIteration& it) {
                                           std::ostringstream line;  // own stream: cout's format stays as it was
@@ -368,7 +370,10 @@ void add_calibrate(CLI::App& app) {
                                   {"simulations_reused", study.simulations_reused},
                                   {"cpu_s", study.cpu_s}};
         orchestrator::write_text_file_atomically(dir / ("calibration_" + o->method + ".json"), summary.dump(2) + "\n");
-        const fs::path out = o->output.empty() ? dir / "calibrated_material.json" : fs::path(o->output);
+        // a baseline run over the same campaign must not overwrite the loop's material
+        const std::string default_name =
+            o->method == "surrogate" ? "calibrated_material.json" : "calibrated_material_" + o->method + ".json";
+        const fs::path out = o->output.empty() ? dir / default_name : fs::path(o->output);
         nlohmann::json material = result.material;
         material["description"] = "calibrated by demcal calibrate (" + to_string(result.status) + "): " + result.message;
         orchestrator::write_text_file_atomically(out, material.dump(1) + "\n");
