@@ -375,11 +375,19 @@ std::string bounds_at(const Search& s, const std::vector<double>& z, const std::
     return text;
 }
 
+// An evaluation's simulated value and interval half-width of a macro quantity ("mu_b" or "tau_c").
+double value_at(const CalibrationIteration& it, const std::string& quantity) {
+    return quantity == "mu_b" ? it.mu_b : it.tau_c;
+}
+double half_width_at(const CalibrationIteration& it, const std::string& quantity) {
+    return quantity == "mu_b" ? it.mu_b_half_width : it.tau_c_half_width;
+}
+
 std::string misses_at(const Search& s, const CalibrationIteration& it, const std::vector<std::size_t>& targets) {
     std::string text;
     for (std::size_t t : targets) {
         const auto& target = s.targets()[t];
-        const double v = target.quantity == "mu_b" ? it.mu_b : it.tau_c;
+        const double v = value_at(it, target.quantity);
         if (std::fabs(v - target.value) <= target.acceptance(s.options().tolerance)) continue;
         text += (text.empty() ? "" : "; ") + target.quantity + " = " + num(v) + ", target " + num(target.value) +
                 " +/- " + num(target.acceptance(s.options().tolerance));
@@ -399,19 +407,27 @@ bool target_within_noise_at(const Search& s, std::size_t k, const std::vector<st
     const auto& it = s.result().iterations[k];
     for (std::size_t t : targets) {
         const auto& target = s.targets()[t];
-        const double v = target.quantity == "mu_b" ? it.mu_b : it.tau_c;
-        const double hw = target.quantity == "mu_b" ? it.mu_b_half_width : it.tau_c_half_width;
+        const double v = value_at(it, target.quantity), hw = half_width_at(it, target.quantity);
         if (!(std::fabs(v - target.value) <= hw)) return false;
     }
     return true;
 }
 
-std::string noise_at_bound_message(const Search& s, const std::string& where, std::size_t k,
-                                   const std::vector<std::size_t>& targets) {
-    return "the model asks for " + where + ", simulated already (evaluation #" + std::to_string(k + 1) +
-           "), where the target lies inside the simulated line's own interval: the responses are too noisy to tell "
-           "whether the target is in reach (" + best_so_far(s, targets) +
-           "); more packings per stress (--replicates) or a wider --tol";
+// Ends the search at `where`, a bound simulated already at evaluation k: unreachable, unless the target lies inside
+// that line's own interval (then the bound may have been reached by noise).
+void end_at_simulated_bound(Search& s, const std::string& where, std::size_t k, const std::vector<std::size_t>& targets) {
+    auto& r = s.result();
+    if (target_within_noise_at(s, k, targets)) {
+        r.status = CalibrationStatus::not_converged;
+        r.message = "the model asks for " + where + ", simulated already (evaluation #" + std::to_string(k + 1) +
+                    "), where the target lies inside the simulated line's own interval: the responses are too noisy "
+                    "to tell whether the target is in reach (" + best_so_far(s, targets) +
+                    "); more packings per stress (--replicates) or a wider --tol";
+    } else {
+        r.status = CalibrationStatus::unreachable;
+        r.message = "target out of reach within the bounds: " + where + " (" + best_so_far(s, targets) +
+                    "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
+    }
 }
 
 // Non-empty (the bounds, described) when the model's best point still misses a target, sits on bounds, and a point
@@ -443,8 +459,7 @@ std::string pinned_bound_simulated(const Search& s, const SurrogateModel& model,
 bool accepted_for(const Search& s, const CalibrationIteration& it, const std::vector<std::size_t>& targets) {
     for (std::size_t t : targets) {
         const auto& target = s.targets()[t];
-        const double v = target.quantity == "mu_b" ? it.mu_b : it.tau_c;
-        const double hw = target.quantity == "mu_b" ? it.mu_b_half_width : it.tau_c_half_width;
+        const double v = value_at(it, target.quantity), hw = half_width_at(it, target.quantity);
         const double off = std::fabs(v - target.value);
         if (off > target.acceptance(s.options().tolerance) && !(s.options().accept_simulated_interval && off <= hw))
             return false;
@@ -471,13 +486,8 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
         if (repeats) {
             const std::string where = bounds_at(s, proposal, controls);
             auto& r = s.result();
-            if (!where.empty() && target_within_noise_at(s, repeated, targets)) {
-                r.status = CalibrationStatus::not_converged;
-                r.message = noise_at_bound_message(s, where, repeated, targets);
-            } else if (!where.empty()) {
-                r.status = CalibrationStatus::unreachable;
-                r.message = "target out of reach within the bounds: " + where + " (" + best_so_far(s, targets) +
-                            "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
+            if (!where.empty()) {
+                end_at_simulated_bound(s, where, repeated, targets);
             } else {
                 r.status = CalibrationStatus::not_converged;
                 r.message = "the search stalled at an already simulated point (" + best_so_far(s, targets) +
@@ -490,15 +500,7 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
         std::size_t at_bound = 0;
         if (const auto pinned = pinned_bound_simulated(s, model, proposal, controls, targets, at_bound);
             !pinned.empty()) {
-            auto& r = s.result();
-            if (target_within_noise_at(s, at_bound, targets)) {
-                r.status = CalibrationStatus::not_converged;
-                r.message = noise_at_bound_message(s, pinned, at_bound, targets);
-            } else {
-                r.status = CalibrationStatus::unreachable;
-                r.message = "target out of reach within the bounds: " + pinned + " (" + best_so_far(s, targets) +
-                            "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
-            }
+            end_at_simulated_bound(s, pinned, at_bound, targets);
             return false;
         }
         if (!s.budget_left()) {
