@@ -49,8 +49,12 @@ struct SiloCli {
     bool no_plots = false;
     double checkpoint_every = 900;
     bool no_checkpoint = false;
+    double wall_limit = 0;
     std::string resume;
 };
+
+// Exit status of a run stopped at --wall-limit (EX_TEMPFAIL): not finished, resume it. A job script can loop on it.
+constexpr int kExitSuspended = 75;
 
 constexpr const char* kCheckpointName = "checkpoint.bin";
 
@@ -219,7 +223,7 @@ void write_plots(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::S
 void print_progress(const ks::SiloProgress& p) {
     std::cout << "[" << std::setw(7) << duration_text(p.wall_s) << "] " << std::left << std::setw(10) << p.phase
               << std::right << " t = " << fixed(p.time, 3) << " s";
-    if (p.phase == "discharge" || p.phase == "done")
+    if (p.phase == "discharge" || p.phase == "done" || (p.phase == "suspended" && p.discharge_time > 0))
         std::cout << " (" << fixed(p.discharge_time, 3) << " s open)  discharged " << p.grains_discharged
                   << " grains, " << fixed(p.discharged_mass * 1e3, 1) << " g; " << p.grains_in_silo
                   << " in the silo";
@@ -229,6 +233,7 @@ void print_progress(const ks::SiloProgress& p) {
         ke << std::setprecision(3) << p.kinetic_energy_per_grain;
         std::cout << "  " << p.grains_in_silo << " grains, kinetic energy " << ke.str() << " J/grain";
     }
+    if (p.step_ms > 0) std::cout << "  [" << fixed(p.step_ms, 1) << " ms/step, " << fixed(p.cores_busy, 2) << " cores]";
     if (!p.note.empty()) std::cout << "  " << p.note;
     std::cout << std::endl;
 }
@@ -244,6 +249,8 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         throw UserError("out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
                         " to start over");
+    if (o.no_checkpoint && o.wall_limit > 0)
+        throw UserError("--wall-limit " + fixed(o.wall_limit, 0) + " needs the checkpoint that --no-checkpoint turns off");
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
@@ -255,6 +262,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         s.checkpoint_file = (dir / kCheckpointName).string();
         s.checkpoint_interval = o.checkpoint_every;
     }
+    s.wall_limit = o.wall_limit;
     std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
               << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string();
     if (!s.checkpoint_file.empty())
@@ -269,9 +277,10 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     for (const auto* opt : sub.get_options()) {
         const std::string name = opt->get_name();
         if (opt->count() > 0 && name != "--resume" && name != "--threads" && name != "--checkpoint-every" &&
-            name != "--no-plots")
+            name != "--wall-limit" && name != "--no-plots")
             throw UserError(name + " cannot be combined with --resume: a resumed run keeps the settings stored in "
-                                   "its checkpoint (only --threads, --checkpoint-every and --no-plots apply)");
+                                   "its checkpoint (only --threads, --checkpoint-every, --wall-limit and --no-plots "
+                                   "apply)");
     }
     const fs::path dir(o.resume);
     const fs::path file = dir / kCheckpointName;
@@ -290,14 +299,32 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     }
     s.threads = threads;
     s.checkpoint_file = file.string();  // removed once the outputs are written
+    s.wall_limit = o.wall_limit;
     std::cout << "demcal silo --resume: " << s.geometry.describe() << "\n  " << threads << " thread(s), seed "
               << s.seed << ", stiffness scale " << s.materials.stiffness_scale << ", checkpoint " << file.string()
               << std::endl;
-    write_outputs(dir, s, ks::resume_silo_case(file.string(), threads, o.checkpoint_every, print_progress), o.no_plots);
+    write_outputs(dir, s,
+                  ks::resume_silo_case(file.string(), {threads, o.checkpoint_every, o.wall_limit}, print_progress),
+                  o.no_plots);
+}
+
+// CPU time with the sessions it covers, e.g. "21.3 h CPU" or "12.0 h CPU (the last 3 of 5 sessions)".
+std::string cpu_text(const ks::SiloCaseResult& r) {
+    std::string t = duration_text(r.cpu_s) + " CPU";
+    if (r.cpu_sessions < r.sessions)
+        t += " (the last " + std::to_string(r.cpu_sessions) + " of " + std::to_string(r.sessions) + " sessions)";
+    return t;
 }
 
 void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
-
+    if (r.suspended) {  // nothing final to write: the checkpoint holds the run
+        std::cout << "\nsuspended: " << r.stop_reason << " at t = " << fixed(r.discharge_time, 3) << " s after the opening ("
+                  << r.steps << " steps, " << r.grains_discharged << " grains discharged); checkpoint "
+                  << r.checkpoints << " written to " << s.checkpoint_file << "\nwall time so far "
+                  << duration_text(r.wall_s) << ", " << cpu_text(r) << "; continue with `demcal silo --resume "
+                  << dir.string() << "`" << std::endl;
+        throw CLI::RuntimeError(kExitSuspended);
+    }
     ks::write_discharge_csv(dir / "discharge.csv", r.discharge);
     nlohmann::json j;
     j["geometry"] = geometry_json(s.geometry);
@@ -351,6 +378,11 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     j["time_step_s"] = r.time_step;
     j["wall_s"] = r.wall_s;
     j["sessions"] = r.sessions;
+    j["cpu_s"] = r.cpu_s;
+    j["cpu_sessions"] = r.cpu_sessions;
+    j["time_note"] = "wall_s: every session's wall-clock time, pauses and waits for busy cores included; cpu_s: the "
+                     "process's CPU time over all its threads, in the last cpu_sessions sessions (checkpoints before "
+                     "format 2 did not record it)";
     j["checkpoints"] = r.checkpoints;
     j["settings"] = {{"threads", s.threads},
                      {"seed", s.seed},
@@ -403,6 +435,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     std::cout << r.steps << " steps of " << std::setprecision(3) << r.time_step << " s, wall time "
               << duration_text(r.wall_s);
     if (r.sessions > 1) std::cout << " over " << r.sessions << " sessions (resumed from checkpoints)";
+    std::cout << ", " << cpu_text(r);
     std::cout << "\nwrote " << (dir / "summary.json").string() << ", "
               << (dir / "discharge.csv").string() << (no_plots ? "" : ", section.png, discharge.png") << "\n";
 }
@@ -456,6 +489,12 @@ void add_silo_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     sub->add_flag("--no-checkpoint", o->no_checkpoint, "write no checkpoint");
+    sub->add_option("--wall-limit", o->wall_limit,
+                    "stop after this many wall-clock seconds of this session (0: none), at the end of a record "
+                    "interval, with a checkpoint written; exit status 75: not finished, continue with --resume "
+                    "(a batch system's time limit)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     sub->add_option("--resume", o->resume,
                     "continue the interrupted run whose output directory (and checkpoint.bin) is DIR, bit for bit, "
                     "with the settings stored in its checkpoint");

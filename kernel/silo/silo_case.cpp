@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -188,13 +189,25 @@ void validate(const SiloCaseSettings& s) {
     if (!(s.record_interval > 0)) reject_setting("record_interval", s.record_interval, "must be > 0 s");
     if (!(s.checkpoint_interval >= 0) || !std::isfinite(s.checkpoint_interval))
         reject_setting("checkpoint_interval", s.checkpoint_interval, "must be >= 0 s (0: every record interval)");
+    if (!(s.wall_limit >= 0) || !std::isfinite(s.wall_limit))
+        reject_setting("wall_limit", s.wall_limit, "must be >= 0 s (0: none)");
+    if (s.wall_limit > 0 && s.checkpoint_file.empty())
+        reject_setting("wall_limit", s.wall_limit, "needs a checkpoint file: a run stopped at the limit resumes from it");
     if (!(s.steady_lower >= 0 && s.steady_lower < s.steady_upper && s.steady_upper <= 1))
         reject_setting("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
 }
 
 namespace {
 
-constexpr const char* kCheckpointTag = "demcal-silo-checkpoint/1";
+// Version 2 adds the CPU time; version 1 checkpoints are still read (their sessions' CPU time is not counted).
+constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
+constexpr int kCheckpointVersion = 2;
+
+double process_cpu_seconds() {
+    timespec ts{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 // Every setting that shapes the run, named once: the checkpoint stores the settings through this list.
 template <class S, class F>
@@ -282,6 +295,7 @@ public:
         sim_.set_pair(wheat_, steel_, to_kernel(s_.materials.wheat_steel));
         grain_ = sim_.add_clump_template(tmpl_);
         r_.grain_mass = tmpl_.mass;
+        r_.cpu_sessions = 1;  // a resumed run reads the count from its checkpoint
     }
 
     // A new run: random sequential addition slab by slab (3 mm slabs, 30 attempts per grain volume).
@@ -307,10 +321,10 @@ public:
 
     SiloCaseResult run() {
         if (phase_ == Phase::filling) {
-            fill();
+            if (!fill()) return suspend();
             open();
         }
-        discharge();
+        if (!discharge()) return suspend();
         finish();
         return r_;
     }
@@ -323,7 +337,7 @@ public:
             std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
             if (!os) throw std::runtime_error("checkpoint '" + tmp + "': cannot open for writing");
             StateWriter w(os);
-            w.text(kCheckpointTag);
+            w.text(kCheckpointTagPrefix + std::to_string(kCheckpointVersion));
             write_settings(w, s_);
             w.value(phase_); w.value(wall_top_); w.value(plate_);
             w.value(lost_); w.value(next_progress_); w.value(vtk_next_step_); w.value(ke_);
@@ -333,6 +347,7 @@ public:
             w.value(r_.fill_kinetic_energy); w.value(r_.fill_height); w.value(r_.bulk_density); w.value(r_.filled_mass);
             w.value(r_.fill_steps); w.value(r_.fill_wall_s); w.value(r_.sessions); w.value(r_.checkpoints);
             w.value(r_.vtk_files);
+            w.value(cpu()); w.value(r_.cpu_sessions);
             w.array(r_.discharge);
             const bool open = phase_ == Phase::discharge;
             if (open) {
@@ -355,7 +370,7 @@ public:
 
     // Restores everything save() wrote after the settings, which the caller read from the same stream (they built
     // this object).
-    void load(std::istream& is, const std::string& source) {
+    void load(std::istream& is, const std::string& source, int version) {
         StateReader r(is, source);
         r.value(phase_, "phase"); r.value(wall_top_, "wall top"); r.value(plate_, "plate");
         r.value(lost_, "lost grains"); r.value(next_progress_, "progress step"); r.value(vtk_next_step_, "vtk step");
@@ -368,6 +383,11 @@ public:
         r.value(r_.filled_mass, "filled mass"); r.value(r_.fill_steps, "fill steps");
         r.value(r_.fill_wall_s, "fill wall time"); r.value(r_.sessions, "sessions");
         r.value(r_.checkpoints, "checkpoints"); r.value(r_.vtk_files, "vtk files");
+        r_.cpu_sessions = 0;
+        if (version >= 2) {
+            r.value(cpu_before_, "cpu time");
+            r.value(r_.cpu_sessions, "cpu sessions");
+        }
         r.array(r_.discharge, "discharge record");
         if (phase_ != Phase::filling && phase_ != Phase::discharge) r.fail("phase", "unknown value");
         plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_);
@@ -378,6 +398,7 @@ public:
         }
         sim_.load_state(is, source);
         ++r_.sessions;
+        ++r_.cpu_sessions;
         last_checkpoint_wall_ = wall();
         std::ostringstream note;
         note << "resumed from " << source << " (session " << r_.sessions << ", checkpoint " << r_.checkpoints << ")";
@@ -387,9 +408,12 @@ public:
 private:
     enum class Phase : std::int32_t { filling = 0, discharge = 1 };
 
-    double wall() const {
-        return wall_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start_).count();
+    double session_wall() const {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start_).count();
     }
+    double wall() const { return wall_before_ + session_wall(); }
+    double cpu() const { return cpu_before_ + process_cpu_seconds() - cpu_start_; }
+    bool wall_limit_reached() const { return s_.wall_limit > 0 && session_wall() >= s_.wall_limit; }
     long progress_every() const { return std::max(1L, std::lround(s_.progress_interval / r_.time_step)); }
     long chunk() const { return std::max(1L, std::lround(s_.record_interval / r_.time_step)); }
     bool is_below_outlet(const BodyState& b) const { return b.position.z() < -s_.removal_depth; }
@@ -413,6 +437,17 @@ private:
         pr_.grains_discharged = grains_out_;
         pr_.discharged_mass = mass_out_;
         pr_.wall_s = wall();
+        pr_.step_ms = pr_.cores_busy = 0;
+        if (phase == "filling" || phase == "discharge") {  // the cost of the steps since the previous such report
+            const double w = session_wall(), c = process_cpu_seconds();
+            if (last_report_step_ >= 0 && pr_.step > last_report_step_ && w > last_report_wall_) {
+                pr_.step_ms = 1e3 * (w - last_report_wall_) / double(pr_.step - last_report_step_);
+                pr_.cores_busy = (c - last_report_cpu_) / (w - last_report_wall_);
+            }
+            last_report_step_ = pr_.step;
+            last_report_wall_ = w;
+            last_report_cpu_ = c;
+        }
         pr_.note = note;
         progress_(pr_);
     }
@@ -452,8 +487,9 @@ private:
         vtk_next_step_ = sim_.steps_done() + std::max(1L, std::lround(s_.vtk_interval / r_.time_step));
     }
 
-    // Filling against the closed plate until the grains are at rest (or the time limit).
-    void fill() {
+    // Filling against the closed plate until the grains are at rest (or the time limit). False: stopped at the
+    // session's wall limit.
+    bool fill() {
         const double rest_energy = s_.rest_energy_factor * tmpl_.mass * s_.gravity * wheat_length;
         auto below = [this](const BodyState& b) { return is_below_outlet(b); };
         while (true) {
@@ -471,6 +507,7 @@ private:
                 break;
             }
             if (sim_.time() >= s_.fill_time_max) break;
+            if (wall_limit_reached()) return false;
             maybe_checkpoint();
         }
         r_.fill_time = sim_.time();
@@ -493,6 +530,7 @@ private:
              << " m, bulk density " << r_.bulk_density << " kg/m^3";
         if (lost_) note << ", " << lost_ << " grains lost through the closed outlet";
         report("filled", note.str());
+        return true;
     }
 
     void make_discharge_recorders() {
@@ -510,7 +548,8 @@ private:
         phase_ = Phase::discharge;
     }
 
-    void discharge() {
+    // False: stopped at the session's wall limit.
+    bool discharge() {
         const long frame_every = std::max(1L, std::lround(s_.frame_interval / r_.time_step));
         const double stall_time = 0.5;  // no grain discharged for this long with grains left: the flow has stopped
         auto below = [this](const BodyState& b) { return is_below_outlet(b); };
@@ -561,8 +600,31 @@ private:
                 r_.stop_reason = "time limit " + setting_text(s_.max_time) + " s";
                 break;
             }
+            if (wall_limit_reached()) return false;
             maybe_checkpoint();
         }
+        return true;
+    }
+
+    // At the session's wall limit: the checkpoint (it must be written: without it the session's work is lost, which
+    // is reported as an error) and the state reached, marked suspended.
+    SiloCaseResult suspend() {
+        try {
+            save(s_.checkpoint_file);
+        } catch (const std::runtime_error& e) {
+            throw std::runtime_error(std::string("at the wall limit: ") + e.what() + " (the previous checkpoint, " +
+                                     std::to_string(r_.checkpoints - 1) + ", is the one to resume from)");
+        }
+        r_.suspended = true;
+        r_.stop_reason = "wall limit of the session (" + setting_text(s_.wall_limit) + " s) reached";
+        r_.steps = sim_.steps_done();
+        r_.grains_discharged = grains_out_;
+        r_.grains_in_silo = long(sim_.num_bodies());
+        r_.discharge_time = phase_ == Phase::discharge ? sim_.time() - t_open_ : 0;
+        r_.wall_s = wall();
+        r_.cpu_s = cpu();
+        report("suspended", r_.stop_reason);
+        return r_;
     }
 
     void finish() {
@@ -577,6 +639,7 @@ private:
         r_.fit = fit_discharge_rate(samples, mass_out_, s_.steady_lower, s_.steady_upper);
         r_.flow = classifier_->result(s_.steady_lower * mass_out_, s_.steady_upper * mass_out_);
         r_.wall_s = wall();
+        r_.cpu_s = cpu();
         report("done", r_.stop_reason);
     }
 
@@ -590,6 +653,10 @@ private:
     std::unique_ptr<FlowPatternClassifier> classifier_;
     const std::chrono::steady_clock::time_point t_start_ = std::chrono::steady_clock::now();
     double wall_before_ = 0;          // wall time of the earlier sessions of a resumed run
+    const double cpu_start_ = process_cpu_seconds();
+    double cpu_before_ = 0;           // CPU time of the earlier sessions that counted it
+    long last_report_step_ = -1;      // the previous progress report of this session that measured the step cost
+    double last_report_wall_ = 0, last_report_cpu_ = 0;
     double last_checkpoint_wall_ = 0;
     // the run's own variables, carried from one record interval to the next
     Phase phase_ = Phase::filling;
@@ -609,11 +676,19 @@ std::ifstream open_checkpoint(const std::string& file) {
     return is;
 }
 
-SiloCaseSettings settings_of(std::istream& is, const std::string& file) {
+// Reads the format tag and the settings; `version` receives the format version.
+SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& version) {
     StateReader r(is, "checkpoint '" + file + "'");
     const std::string tag = r.text("format tag");
-    if (tag != kCheckpointTag)
-        r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + kCheckpointTag + ")");
+    const std::string prefix = kCheckpointTagPrefix;
+    version = 0;
+    if (tag.rfind(prefix, 0) == 0) {
+        const std::string v = tag.substr(prefix.size());
+        if (v == "1" || v == "2") version = std::stoi(v);
+    }
+    if (version == 0)
+        r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + prefix + "1 or " + prefix +
+                                 std::to_string(kCheckpointVersion) + ")");
     return read_settings(r);
 }
 
@@ -627,18 +702,21 @@ SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void
 
 SiloCaseSettings read_checkpoint_settings(const std::string& file) {
     std::ifstream is = open_checkpoint(file);
-    return settings_of(is, file);
+    int version = 0;
+    return settings_of(is, file, version);
 }
 
-SiloCaseResult resume_silo_case(const std::string& file, int threads, double checkpoint_interval,
+SiloCaseResult resume_silo_case(const std::string& file, const SiloSession& session,
                                 const std::function<void(const SiloProgress&)>& progress) {
     std::ifstream is = open_checkpoint(file);
-    SiloCaseSettings s = settings_of(is, file);
-    s.threads = threads;
+    int version = 0;
+    SiloCaseSettings s = settings_of(is, file, version);
+    s.threads = session.threads;
     s.checkpoint_file = file;
-    s.checkpoint_interval = checkpoint_interval;
+    s.checkpoint_interval = session.checkpoint_interval;
+    s.wall_limit = session.wall_limit;
     SiloRun run(s, progress);
-    run.load(is, "checkpoint '" + file + "'");
+    run.load(is, "checkpoint '" + file + "'", version);
     return run.run();
 }
 

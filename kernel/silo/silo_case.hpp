@@ -54,16 +54,20 @@ struct SiloCaseSettings {
     // crash, a kill or the end of a session. Empty: no checkpoints. 0 s: after every record interval (tests).
     std::string checkpoint_file;
     double checkpoint_interval = 900;  // [s] wall clock
+    // Wall-clock limit of this session [s] (0: none): once it is reached, at the end of a record interval, the run
+    // writes its checkpoint and returns suspended, to be resumed later (a batch system's time limit, a machine lent
+    // for a few hours). Needs a checkpoint file. Not stored: each session sets its own.
+    double wall_limit = 0;
 };
 // A new setting that changes the run must also be listed in for_each_setting (silo_case.cpp): the checkpoint stores
-// the settings through that list. threads, checkpoint_file and checkpoint_interval are not stored: a resumed run
-// takes them from its caller.
+// the settings through that list. threads, checkpoint_file, checkpoint_interval and wall_limit are not stored: a
+// resumed run takes them from its caller.
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions).
 void validate(const SiloCaseSettings& s);
 
 struct SiloProgress {
-    std::string phase;          // "generated", "resumed", "filling", "filled", "discharge", "checkpoint", "done"
+    std::string phase;  // "generated", "resumed", "filling", "filled", "discharge", "checkpoint", "suspended", "done"
     double time = 0;            // simulated time since the start [s]
     double discharge_time = 0;  // since the opening [s]
     long step = 0;
@@ -72,6 +76,11 @@ struct SiloProgress {
     double discharged_mass = 0;
     double kinetic_energy_per_grain = 0;  // [J]
     double wall_s = 0;
+    // Cost of the steps since the previous "filling" or "discharge" report of this session (0 when there is none):
+    // wall-clock milliseconds per step, and the process's CPU time over that wall time (the cores it kept busy: below
+    // the thread count when other work shared the machine or the run was paused).
+    double step_ms = 0;
+    double cores_busy = 0;
     std::string note;
 };
 
@@ -98,6 +107,12 @@ struct SiloCaseResult {
     std::shared_ptr<SectionField> section;
     double wall_s = 0, fill_wall_s = 0;  // wall-clock time of the whole run (every session of it) [s]
     int sessions = 1;                    // 1 + the number of times the run was resumed from its checkpoint
+    // CPU time of the process, every thread, summed over the sessions that counted it [s]: the last cpu_sessions
+    // (checkpoints older than this field did not record it). Unlike wall_s it excludes the time the run was paused
+    // or waited for cores other work held.
+    double cpu_s = 0;
+    int cpu_sessions = 0;
+    bool suspended = false;              // stopped at SiloCaseSettings::wall_limit: resume it from its checkpoint
     long checkpoints = 0;                // written over the whole run
     long vtk_files = 0;
 };
@@ -109,10 +124,17 @@ SiloCaseResult run_silo_case(const SiloCaseSettings& s,
 // std::runtime_error naming the file when it cannot be read or is not a silo checkpoint.
 SiloCaseSettings read_checkpoint_settings(const std::string& checkpoint_file);
 
-// Continues the run saved in checkpoint_file (the settings stored in it) with `threads` threads, checkpointing to
-// the same file every checkpoint_interval seconds; the result is the one the uninterrupted run gives, bit for bit,
-// with the wall time of every session added up.
-SiloCaseResult resume_silo_case(const std::string& checkpoint_file, int threads, double checkpoint_interval = 900,
+// What a resumed session sets for itself (the rest comes from the checkpoint): see the fields of the same names in
+// SiloCaseSettings.
+struct SiloSession {
+    int threads = 1;
+    double checkpoint_interval = 900;  // [s] wall clock
+    double wall_limit = 0;             // [s] wall clock of this session; 0: none
+};
+
+// Continues the run saved in checkpoint_file (the settings stored in it), checkpointing to the same file; the result
+// is the one the uninterrupted run gives, bit for bit, with the wall (and CPU) time of every session added up.
+SiloCaseResult resume_silo_case(const std::string& checkpoint_file, const SiloSession& session,
                                 const std::function<void(const SiloProgress&)>& progress = {});
 
 }  // namespace demcal::kernel::silo

@@ -118,6 +118,10 @@ TEST_CASE("silo case: bad settings name the field and the value", "[silo]") {
     s = reduced_case(30);
     s.materials.stiffness_scale = 0;
     CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("stiffness_scale = 0"));
+    s = reduced_case(30);
+    s.wall_limit = 3600;  // without a checkpoint to resume from, the session's work would be lost at the limit
+    CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("wall_limit = 3600") &&
+                                       Catch::Matchers::Contains("checkpoint"));
 }
 
 TEST_CASE("silo case: a small rectangular hopper fills without losing grains and discharges", "[silo]") {
@@ -165,14 +169,27 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
                     SimulatedCrash);
     CHECK(read_checkpoint_settings(s.checkpoint_file).particles == 600);
     // second session, two threads: dies at the first checkpoint 0.1 s after the opening
-    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, 2, 0,
+    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0},
                                      [&](const SiloProgress& p) {
                                          if (p.phase == "checkpoint" && p.discharge_time > 0.1) throw SimulatedCrash{};
                                      }),
                     SimulatedCrash);
-    // third session: to the end
-    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, 1, 0);
-    CHECK(resumed.sessions == 3);
+    // third session: stops itself at its wall limit (reached within the first record interval), checkpoint written
+    long steps_reported = 0;
+    const SiloCaseResult suspended =
+        resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 1e6, .wall_limit = 1e-6},
+                         [&](const SiloProgress& p) { steps_reported = p.step; });
+    CHECK(suspended.suspended);
+    CHECK(suspended.steps == steps_reported);
+    CHECK(suspended.steps < whole.steps);
+    CHECK_THAT(suspended.stop_reason, Catch::Matchers::Contains("wall limit"));
+    CHECK(std::filesystem::exists(s.checkpoint_file));
+    // fourth session: to the end
+    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0});
+    CHECK_FALSE(resumed.suspended);
+    CHECK(resumed.sessions == 4);
+    CHECK(resumed.cpu_sessions == 4);
+    CHECK(resumed.cpu_s > 0);
     CHECK(resumed.checkpoints > 10);
     REQUIRE(resumed.discharge.size() == whole.discharge.size());
     bool same_record = true;
@@ -199,7 +216,7 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
     SECTION("a file that is not a checkpoint is refused, naming it") {
         const auto bad = dir / "not-a-checkpoint.bin";
         std::ofstream(bad) << "hello";
-        CHECK_THROWS_WITH(resume_silo_case(bad.string(), 1), Catch::Matchers::Contains("not-a-checkpoint.bin"));
+        CHECK_THROWS_WITH(resume_silo_case(bad.string(), {}), Catch::Matchers::Contains("not-a-checkpoint.bin"));
         CHECK_THROWS_WITH(read_checkpoint_settings((dir / "missing.bin").string()),
                           Catch::Matchers::Contains("missing.bin"));
     }

@@ -67,6 +67,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --stiffness-scale -1", "stiffness_scale = -1"},
                           Case{"--theta 30 --stop-fraction 2", "stop_fraction = 2"},
                           Case{"--theta 30 --b 0.05", "--b applies to a rectangular hopper"},
+                          Case{"--theta 30 --wall-limit 60 --no-checkpoint", "--wall-limit 60 needs the checkpoint"},
                           Case{"", "theta: missing"}}) {
         INFO(c.args);
         const Run r = demcal(c.args + " --out '" + out.string() + "'", dir);
@@ -147,12 +148,20 @@ TEST_CASE("demcal silo: a run killed with -9 resumes from its checkpoint to the 
     CHECK(mixed.rc == 2);
     CHECK_THAT(mixed.err, Catch::Matchers::Contains("--theta cannot be combined with --resume"));
 
+    // a session with a wall limit stops itself after one record interval: exit 75, checkpoint kept, no outputs
+    const Run limited = demcal("--resume '" + out.string() + "' --threads 1 --wall-limit 0.001", dir);
+    CHECK(limited.rc == 75);
+    CHECK(fs::exists(ckpt));
+    CHECK_FALSE(fs::exists(out / "summary.json"));
+    CHECK_THAT(read_file(dir / "out.log"), Catch::Matchers::Contains("suspended: wall limit"));
+
     const Run resumed = demcal("--resume '" + out.string() + "' --threads 2", dir);
     INFO(resumed.err);
     REQUIRE(resumed.rc == 0);
     CHECK(read_file(out / "discharge.csv") == read_file(dir / "whole" / "discharge.csv"));
     const std::string summary = read_file(out / "summary.json");
-    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 2"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 3"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 3"));
     CHECK_FALSE(fs::exists(ckpt));  // removed once the outputs are written
     const Run finished_run = demcal("--resume '" + out.string() + "'", dir);
     CHECK(finished_run.rc == 2);
