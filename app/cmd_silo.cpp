@@ -233,7 +233,11 @@ void print_progress(const ks::SiloProgress& p) {
         ke << std::setprecision(3) << p.kinetic_energy_per_grain;
         std::cout << "  " << p.grains_in_silo << " grains, kinetic energy " << ke.str() << " J/grain";
     }
-    if (p.step_ms > 0) std::cout << "  [" << fixed(p.step_ms, 1) << " ms/step, " << fixed(p.cores_busy, 2) << " cores]";
+    if (p.step_ms > 0) {
+        std::cout << "  [" << fixed(p.step_ms, 1) << " ms/step, " << fixed(p.cores_busy, 2) << " cores";
+        if (p.remaining_wall_s > 0) std::cout << "; ~" << duration_text(p.remaining_wall_s) << " left at this rate and cost";
+        std::cout << "]";
+    }
     if (!p.note.empty()) std::cout << "  " << p.note;
     std::cout << std::endl;
 }

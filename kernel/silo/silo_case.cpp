@@ -448,6 +448,13 @@ private:
             last_report_wall_ = w;
             last_report_cpu_ = c;
         }
+        pr_.remaining_wall_s = 0;
+        if (phase == "discharge" && pr_.step_ms > 0 && mass_out_ > 0 && pr_.discharge_time > 0) {
+            const double rate = mass_out_ / pr_.discharge_time;
+            const double left = std::min((s_.stop_fraction * r_.filled_mass - mass_out_) / rate,
+                                         s_.max_time - pr_.discharge_time);
+            pr_.remaining_wall_s = std::max(0.0, left) / r_.time_step * pr_.step_ms * 1e-3;
+        }
         pr_.note = note;
         progress_(pr_);
     }

@@ -81,6 +81,10 @@ struct SiloProgress {
     // the thread count when other work shared the machine or the run was paused).
     double step_ms = 0;
     double cores_busy = 0;
+    // Discharge only (0 otherwise): wall-clock seconds left if the mean discharge rate so far and step_ms held to the
+    // stop (empty, stop_fraction or max_time): a rough guide (the cost per step falls as the silo empties, the rate
+    // falls as the last grains leave the hopper).
+    double remaining_wall_s = 0;
     std::string note;
 };
 

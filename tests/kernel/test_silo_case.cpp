@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include <unistd.h>
 
@@ -126,8 +127,20 @@ TEST_CASE("silo case: bad settings name the field and the value", "[silo]") {
 
 TEST_CASE("silo case: a small rectangular hopper fills without losing grains and discharges", "[silo]") {
     SiloCaseSettings s = small_rectangular_case();
-    const auto r = run_silo_case(s);
+    std::vector<SiloProgress> reports;
+    const auto r = run_silo_case(s, [&](const SiloProgress& p) { reports.push_back(p); });
     CHECK(r.grains == 600);
+    // the progress reports measure the cost of the steps since the previous one, and estimate the time left
+    int costed = 0, estimated = 0;
+    for (const auto& p : reports) {
+        costed += p.step_ms > 0 && p.cores_busy > 0;
+        estimated += p.remaining_wall_s > 0;
+        if (p.phase != "discharge") CHECK(p.remaining_wall_s == 0);
+    }
+    CHECK(costed >= 2);
+    CHECK(estimated >= 1);
+    CHECK(r.cpu_s > 0);
+    CHECK(r.cpu_sessions == 1);
     CHECK(r.fill_at_rest);
     CHECK(r.grains_in_silo + r.grains_discharged == 600);
     CHECK(r.grains_discharged > 100);
