@@ -691,7 +691,8 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     version = 0;
     if (tag.rfind(prefix, 0) == 0) {
         const std::string v = tag.substr(prefix.size());
-        if (v == "1" || v == "2") version = std::stoi(v);
+        for (int k = 1; k <= kCheckpointVersion; ++k)
+            if (v == std::to_string(k)) version = k;
     }
     if (version == 0)
         r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + prefix + "1 or " + prefix +
