@@ -27,7 +27,7 @@ double cpu_seconds() {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
     if (argc != 4) {
         std::cerr << "usage: silo_step_cost CHECKPOINT THREADS SECONDS\n";
         return 2;
@@ -37,6 +37,13 @@ int main(int argc, char** argv) {
     const double seconds = std::stod(argv[3]);
     const fs::path dir = fs::temp_directory_path() / ("demcal-silo-step-cost-" + std::to_string(::getpid()));
     fs::create_directories(dir);
+    struct RemoveDir {  // the 80 MB copy goes, whatever happens
+        fs::path dir;
+        ~RemoveDir() {
+            std::error_code ec;
+            fs::remove_all(dir, ec);
+        }
+    } remove_dir{dir};
     const fs::path copy = dir / "checkpoint.bin";
     fs::copy_file(source, copy);
     using clock = std::chrono::steady_clock;
@@ -55,7 +62,6 @@ int main(int argc, char** argv) {
             step1 = p.step;
         }
     });
-    fs::remove_all(dir);
     const double s = std::chrono::duration<double>(t1 - t0).count();
     const long steps = step1 - step0;
     if (!r.suspended || steps <= 0) {
@@ -67,4 +73,13 @@ int main(int argc, char** argv) {
                 threads, spheres, steps, s, 1e3 * s / double(steps), double(spheres) * double(steps) / s,
                 (c1 - c0) / s);
     return 0;
+}
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::cerr << "silo_step_cost: " << e.what() << "\n";
+        return 1;
+    }
 }
