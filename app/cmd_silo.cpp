@@ -254,7 +254,8 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
                         " to start over");
     if (o.no_checkpoint && o.wall_limit > 0)
-        throw UserError("--wall-limit " + fixed(o.wall_limit, 0) + " needs the checkpoint that --no-checkpoint turns off");
+        throw UserError("--wall-limit " + (std::ostringstream() << o.wall_limit).str() +
+                        " needs the checkpoint that --no-checkpoint turns off");
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
@@ -322,8 +323,9 @@ std::string cpu_text(const ks::SiloCaseResult& r) {
 
 void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
     if (r.suspended) {  // nothing final to write: the checkpoint holds the run
-        std::cout << "\nsuspended: " << r.stop_reason << " at t = " << fixed(r.discharge_time, 3) << " s after the opening ("
-                  << r.steps << " steps, " << r.grains_discharged << " grains discharged); checkpoint "
+        std::cout << "\nsuspended: " << r.stop_reason << ", "
+                  << (r.discharge_time > 0 ? fixed(r.discharge_time, 3) + " s after the opening" : "while filling")
+                  << " (" << r.steps << " steps, " << r.grains_discharged << " grains discharged); checkpoint "
                   << r.checkpoints << " written to " << s.checkpoint_file << "\nwall time so far "
                   << duration_text(r.wall_s) << ", " << cpu_text(r) << "; continue with `demcal silo --resume "
                   << dir.string() << "`" << std::endl;
