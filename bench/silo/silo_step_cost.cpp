@@ -6,11 +6,11 @@
 //
 // Prints one JSON line: steps, seconds (from the end of the load to the checkpoint written at the wall limit, that
 // write included: about 1 % of a 60 s run), ms per step, sphere-steps per second, CPU cores kept busy.
+#include "kernel/process_time.hpp"
 #include "kernel/silo/silo_case.hpp"
 
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -18,14 +18,6 @@
 
 namespace fs = std::filesystem;
 using namespace demcal::kernel::silo;
-
-namespace {
-double cpu_seconds() {
-    timespec ts{};
-    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-}  // namespace
 
 int run(int argc, char** argv) {
     if (argc != 4) {
@@ -53,12 +45,12 @@ int run(int argc, char** argv) {
     const SiloCaseResult r = resume_silo_case(copy.string(), {threads, 1e9, seconds}, [&](const SiloProgress& p) {
         if (p.phase == "resumed") {
             t0 = clock::now();
-            c0 = cpu_seconds();
+            c0 = demcal::kernel::process_cpu_seconds();
             step0 = p.step;
             spheres = 3 * p.grains_in_silo;  // the wheat grain is a 3-sphere clump
         } else if (p.phase == "checkpoint") {
             t1 = clock::now();
-            c1 = cpu_seconds();
+            c1 = demcal::kernel::process_cpu_seconds();
             step1 = p.step;
         }
     });

@@ -2,6 +2,7 @@
 #include "kernel/silo/input_error.hpp"
 
 #include "kernel/clump.hpp"
+#include "kernel/process_time.hpp"
 #include "kernel/simulation.hpp"
 #include "kernel/walls.hpp"
 
@@ -13,7 +14,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -202,12 +202,6 @@ namespace {
 // Version 2 adds the CPU time; version 1 checkpoints are still read (their sessions' CPU time is not counted).
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
 constexpr int kCheckpointVersion = 2;
-
-double process_cpu_seconds() {
-    timespec ts{};
-    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
 
 // Every setting that shapes the run, named once: the checkpoint stores the settings through this list.
 template <class S, class F>
@@ -624,30 +618,30 @@ private:
         }
         r_.suspended = true;
         r_.stop_reason = "wall limit of the session (" + setting_text(s_.wall_limit) + " s) reached";
-        r_.steps = sim_.steps_done();
-        r_.grains_discharged = grains_out_;
-        r_.grains_in_silo = long(sim_.num_bodies());
-        r_.discharge_time = phase_ == Phase::discharge ? sim_.time() - t_open_ : 0;
-        r_.wall_s = wall();
-        r_.cpu_s = cpu();
+        record_state();
         report("suspended", r_.stop_reason);
         return r_;
     }
 
     void finish() {
         maybe_vtk(true);
-        r_.discharge_time = sim_.time() - t_open_;
-        r_.grains_discharged = grains_out_;
-        r_.grains_in_silo = long(sim_.num_bodies());
-        r_.steps = sim_.steps_done();
         // the steady part: between steady_lower and steady_upper of the mass discharged at the end
         std::vector<DischargeSample> samples;
         for (const auto& d : r_.discharge) samples.push_back({d.time, d.mass});
         r_.fit = fit_discharge_rate(samples, mass_out_, s_.steady_lower, s_.steady_upper);
         r_.flow = classifier_->result(s_.steady_lower * mass_out_, s_.steady_upper * mass_out_);
+        record_state();
+        report("done", r_.stop_reason);
+    }
+
+    // The state reached, as the result reports it: at the end of the run or at a session's wall limit.
+    void record_state() {
+        r_.steps = sim_.steps_done();
+        r_.grains_discharged = grains_out_;
+        r_.grains_in_silo = long(sim_.num_bodies());
+        r_.discharge_time = phase_ == Phase::discharge ? sim_.time() - t_open_ : 0;
         r_.wall_s = wall();
         r_.cpu_s = cpu();
-        report("done", r_.stop_reason);
     }
 
     SiloCaseSettings s_;
