@@ -209,6 +209,7 @@ class BasicSimulation {
   std::vector<std::int32_t> wall_slot_id_;                  // kWallSlots per sphere, -1 empty
   std::vector<Vec3> wall_slot_s_, wall_slot_f_;             // history, force on the sphere
   std::vector<Vec3> pair_f_, pair_tj_;                      // per pair: force on i, torque on j
+  std::vector<double> omega_norm_;                          // scratch of compute_forces: |w_| per sphere
   static constexpr int kMaxWallCandidates = 64;             // walls tracked per sphere (bit mask)
   std::vector<std::uint64_t> wall_cand_;                    // per sphere: walls within reach at the last build
 

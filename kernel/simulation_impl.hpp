@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernel/clump_rotation.hpp"
 #include "kernel/state_io.hpp"
 
 #include "kernel/simulation.hpp"
@@ -20,39 +21,6 @@ namespace detail {
 /// 1/I per principal moment (0 for a zero moment: a degenerate axis takes no angular velocity).
 inline Vec3 inverse_moments(const Vec3& I) {
   return Vec3(I.x() > 0 ? 1.0 / I.x() : 0.0, I.y() > 0 ? 1.0 / I.y() : 0.0, I.z() > 0 ? 1.0 / I.z() : 0.0);
-}
-/// omega (world) from angular momentum L (world), orientation q (principal -> world) and 1/I (principal).
-/// Two quaternion rotations: cheaper than building the rotation matrix.
-inline Vec3 omega_from_L(const Quat& q, const Vec3& L, const Vec3& inv_I) {
-  return q * (q.conjugate() * L).cwiseProduct(inv_I);
-}
-/// dq/dt = 1/2 (0, w) q
-inline Quat wq(const Vec3& w, const Quat& q) {
-  const Quat p = Quat(0.0, w.x(), w.y(), w.z()) * q;
-  return p;
-}
-inline Quat qadd(const Quat& a, double s, const Quat& b) {
-  return Quat(a.w() + s * b.w(), a.x() + s * b.x(), a.y() + s * b.y(), a.z() + s * b.z());
-}
-/// Brings a nearly unit quaternion back to unit length with one Newton step for 1/|q| (no square root, no
-/// division): |q|^2 = 1 + d gives an error O(d^2). Used on the intermediate quaternions of a step, where
-/// d = (|omega| dt / 2)^2 at most (5e-5 for 500 rad/s in the reduced silo's 28 us step); the quaternion kept at the
-/// end of the step is normalised exactly.
-inline Quat renormalized(const Quat& q) {
-  const double f = 1.5 - 0.5 * q.squaredNorm();
-  return Quat(f * q.w(), f * q.x(), f * q.y(), f * q.z());
-}
-/// Richardson iteration for the quaternion over dt (LAMMPS MathExtra::richardson), with L fixed over the step;
-/// w: omega at the start of the step (in), at its middle (out).
-inline void richardson(Quat& q, const Vec3& L, Vec3& w, const Vec3& inv_I, double dt) {
-  const double dtq = 0.5 * dt;
-  const Quat wq0 = wq(w, q);
-  const Quat qfull = renormalized(qadd(q, dtq, wq0));
-  Quat qhalf = renormalized(qadd(q, 0.5 * dtq, wq0));
-  w = omega_from_L(qhalf, L, inv_I);
-  qhalf = renormalized(qadd(qhalf, 0.5 * dtq, wq(w, qhalf)));
-  q = Quat(2 * qhalf.w() - qfull.w(), 2 * qhalf.x() - qfull.x(), 2 * qhalf.y() - qfull.y(), 2 * qhalf.z() - qfull.z());
-  q.normalize();
 }
 }  // namespace detail
 
@@ -294,21 +262,41 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
       x_[i] += dt * v_[i];
       if (check && (x_[i] - xb[i]).squaredNorm() > lim2) moved = 1;
     }
+    // clumps in batches of clump_rotation::kLanes: the orientation update runs on the batch side by side
+    namespace cr = clump_rotation;
+    const std::int64_t nbatch = (nc + cr::kLanes - 1) / cr::kLanes;
 #pragma omp for schedule(static)
-    for (std::int64_t c = 0; c < nc; ++c) {
-      cv_[c] += h * (cF_[c] / cm_[c] + g);
-      cx_[c] += dt * cv_[c];
-      cL_[c] += h * cT_[c];
-      const Vec3 inv_I = detail::inverse_moments(cI_[c]);
-      Vec3 w = detail::omega_from_L(cq_[c], cL_[c], inv_I);
-      detail::richardson(cq_[c], cL_[c], w, inv_I, dt);
+    for (std::int64_t b = 0; b < nbatch; ++b) {
+      const std::int64_t c0 = b * cr::kLanes, lanes = std::min<std::int64_t>(cr::kLanes, nc - c0);
+      cr::QuatPack q{};
+      cr::VecPack L{}, inv_I{};
+      for (int k = 0; k < cr::kLanes; ++k) q.w[k] = 1.0;  // unused lanes: identity, no momentum
+      for (int k = 0; k < lanes; ++k) {
+        const std::int64_t c = c0 + k;
+        cv_[c] += h * (cF_[c] / cm_[c] + g);
+        cx_[c] += dt * cv_[c];
+        cL_[c] += h * cT_[c];
+        const Vec3 iI = detail::inverse_moments(cI_[c]);
+        q.x[k] = cq_[c].x(); q.y[k] = cq_[c].y(); q.z[k] = cq_[c].z(); q.w[k] = cq_[c].w();
+        L.x[k] = cL_[c].x(); L.y[k] = cL_[c].y(); L.z[k] = cL_[c].z();
+        inv_I.x[k] = iI.x(); inv_I.y[k] = iI.y(); inv_I.z[k] = iI.z();
+      }
+      cr::richardson(q, L, inv_I, dt);
       // one rotation matrix for the new omega and the members
-      const Mat3 R = cq_[c].toRotationMatrix();
-      cw_[c] = R * (R.transpose() * cL_[c]).cwiseProduct(inv_I);
-      update_members(std::size_t(c), R, true);
-      if (check)
-        for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k)
-          if ((x_[cmem_[k]] - xb[cmem_[k]]).squaredNorm() > lim2) moved = 1;
+      const cr::MatPack R = cr::rotation_matrix(q);
+      const cr::VecPack w = cr::angular_velocity(R, L, inv_I);
+      for (int k = 0; k < lanes; ++k) {
+        const std::int64_t c = c0 + k;
+        cq_[c] = Quat(q.w[k], q.x[k], q.y[k], q.z[k]);
+        cw_[c] = Vec3(w.x[k], w.y[k], w.z[k]);
+        Mat3 Rk;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) Rk(i, j) = R.m[i][j][k];
+        update_members(std::size_t(c), Rk, true);
+        if (check)
+          for (std::uint32_t m = cmem_start_[c]; m < cmem_start_[c + 1]; ++m)
+            if ((x_[cmem_[m]] - xb[cmem_[m]]).squaredNorm() > lim2) moved = 1;
+      }
     }
   }
   return moved != 0;
@@ -454,8 +442,15 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   const std::uint32_t* row = nl_.row.data();
   const std::int32_t* nbr = nl_.nbr.data();
   Vec3* hist = nl_.hist.data();
+  if (Law::uses_omega_norm) omega_norm_.resize(std::size_t(n));
+  double* wnorm = omega_norm_.data();
 #pragma omp parallel num_threads(nt())
   {
+    if (Law::uses_omega_norm) {
+      // |omega| once per sphere, not once per contact side (a sphere has several contacts)
+#pragma omp for schedule(static)
+      for (std::int64_t i = 0; i < n; ++i) wnorm[i] = w_[i].norm();
+    }
     // dynamic: the contacts per sphere vary along the cell order (a packed hopper below, a loose top, an emptying
     // outlet), and a static split left one thread waiting (the silo's full case: 1.85 -> 1.91 cores busy of 2).
     // Each i writes only its own row, so the result does not depend on the schedule.
@@ -492,6 +487,10 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         ContactKinematics kin;
         kin.omega_i = wi;
         kin.omega_j = w_[j];
+        if (Law::uses_omega_norm) {
+          kin.omega_i_norm = wnorm[i];
+          kin.omega_j_norm = wnorm[j];
+        }
         kin.v_rel = (vi - geo.lever_i * wi.cross(geo.n)) - (v_[j] + geo.lever_j * w_[j].cross(geo.n));
         const ContactResult res = Law::compute(crow[mat_[j]], geo, kin, hist[p], dt, false);
         fi += res.force_i;
@@ -531,6 +530,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           ContactKinematics kin;
           kin.omega_i = wi;
           kin.omega_j = Vec3::Zero();
+          if (Law::uses_omega_norm) kin.omega_i_norm = wnorm[i];
           kin.v_rel = vi - dist * wi.cross(nrm);
           const ContactResult res = Law::compute(crow[wall.material], geo, kin, s, dt, true);
           fi += res.force_i;

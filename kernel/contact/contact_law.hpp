@@ -10,6 +10,8 @@ namespace demcal::kernel {
 
 template <class Normal, class Tangential, class Rolling>
 struct ComposedLaw {
+  /// Whether compute() reads ContactKinematics::omega_i_norm / omega_j_norm (the kernel skips that pass if not).
+  static constexpr bool uses_omega_norm = Rolling::uses_omega_norm;
   /// One contact: g (geometry, dn > 0), k (kinematics), c (pair constants), s (tangential history, in/out).
   [[gnu::always_inline]] static inline ContactResult compute(const PairCoeffs& c, const ContactGeometry& g, const ContactKinematics& k,
                                       Vec3& s, double dt, bool wall) {
@@ -24,7 +26,7 @@ struct ComposedLaw {
     const Vec3 nxft = g.n.cross(ft);
     r.torque_i = -g.lever_i * nxft;
     r.torque_j = -g.lever_j * nxft;
-    Rolling::torque(c, fn, g.radius_i, g.radius_j, k.omega_i, k.omega_j, r.torque_i, r.torque_j, wall);
+    Rolling::torque(c, fn, g.radius_i, g.radius_j, k, r.torque_i, r.torque_j, wall);
     return r;
   }
 };

@@ -21,6 +21,8 @@ struct ContactKinematics {
   Vec3 v_rel;   ///< velocity of i's contact point relative to j's (or the wall's) [m/s]
   Vec3 omega_i; ///< angular velocity of i (its body) [rad/s]
   Vec3 omega_j; ///< angular velocity of j (zero for a wall) [rad/s]
+  double omega_i_norm = 0; ///< |omega_i|, computed once per sphere and force evaluation (not per contact) [rad/s]
+  double omega_j_norm = 0; ///< |omega_j| (zero for a wall) [rad/s]
 };
 
 /// What a law returns: force on i (j gets -force_i), torques about the two sphere centres.
