@@ -76,75 +76,89 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
   const std::int64_t nx = grid.nx, ny = grid.ny, nz = grid.nz;
   const std::size_t nc = grid.count();
   cell_of_.resize(n);
+  const std::int64_t sn = std::int64_t(n);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (std::int64_t i = 0; i < sn; ++i) cell_of_[std::size_t(i)] = grid.cell_of(x[std::size_t(i)]);
   cell_start_.assign(nc + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    cell_of_[i] = grid.cell_of(x[i]);
-    ++cell_start_[cell_of_[i] + 1];
-  }
+  for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
   for (std::size_t c = 0; c < nc; ++c) cell_start_[c + 1] += cell_start_[c];
   cell_items_.resize(n);
   {
     std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell_of_[i]]++] = std::uint32_t(i);  // ascending i per cell
   }
-  // visit the partners of i (j > i) in the 27 cells around i's cell
-  auto visit = [&](std::size_t i, auto&& fn) {
-    const std::uint32_t c = cell_of_[i];
-    const std::int64_t cx = c % nx, cy = (c / nx) % ny, cz = c / (nx * ny);
-    const double ri = r[i];
-    const std::int32_t gi = group[i];
-    for (std::int64_t dz = -1; dz <= 1; ++dz) {
-      const std::int64_t z = cz + dz;
-      if (z < 0 || z >= nz) continue;
-      for (std::int64_t dy = -1; dy <= 1; ++dy) {
-        const std::int64_t y = cy + dy;
-        if (y < 0 || y >= ny) continue;
-        for (std::int64_t dx = -1; dx <= 1; ++dx) {
-          const std::int64_t xx = cx + dx;
-          if (xx < 0 || xx >= nx) continue;
-          const std::size_t cc = std::size_t((z * ny + y) * nx + xx);
-          for (std::uint32_t k = cell_start_[cc]; k < cell_start_[cc + 1]; ++k) {
-            const std::uint32_t j = cell_items_[k];
-            if (j <= i) continue;
-            if (gi >= 0 && group[j] == gi) continue;
-            const double cut = ri + r[j] + skin;
-            if ((x[i] - x[j]).squaredNorm() < cut * cut) fn(j);
+  // One pass over the 27 cells around each sphere i finds its partners on both sides: j > i (its row of the half
+  // list) and j < i (the pairs where i is the partner: its row of the transposed index). The test is symmetric
+  // (|x_i - x_j|^2 and r_i + r_j + skin are the same bits either way), so the two sides agree exactly. Each thread
+  // keeps what it found for its contiguous block of spheres and copies it into place once the row offsets are known:
+  // no second visit to count, no serial transposition.
+  fwd_count_.resize(n);
+  bwd_count_.resize(n);
+  const int nthreads = std::max(1, threads);
+  thread_fwd_.resize(std::size_t(nthreads));
+  thread_bwd_.resize(std::size_t(nthreads));
+#pragma omp parallel num_threads(nthreads)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const std::int64_t lo = sn * t / nt, hi = sn * (t + 1) / nt;  // this thread's block, in sphere order
+    std::vector<std::int32_t>& fwd = thread_fwd_[std::size_t(t)];
+    std::vector<std::int32_t>& bwd = thread_bwd_[std::size_t(t)];
+    fwd.clear();
+    bwd.clear();
+    for (std::int64_t i = lo; i < hi; ++i) {
+      const std::size_t f0 = fwd.size(), b0 = bwd.size();
+      const std::uint32_t c = cell_of_[std::size_t(i)];
+      const std::int64_t cx = c % nx, cy = (c / nx) % ny, cz = c / (nx * ny);
+      const Vec3 xi = x[std::size_t(i)];
+      const double ri = r[std::size_t(i)];
+      const std::int32_t gi = group[std::size_t(i)];
+      for (std::int64_t z = std::max<std::int64_t>(cz - 1, 0); z <= std::min(cz + 1, nz - 1); ++z)
+        for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0); y <= std::min(cy + 1, ny - 1); ++y)
+          for (std::int64_t xx = std::max<std::int64_t>(cx - 1, 0); xx <= std::min(cx + 1, nx - 1); ++xx) {
+            const std::size_t cc = std::size_t((z * ny + y) * nx + xx);
+            for (std::uint32_t k = cell_start_[cc]; k < cell_start_[cc + 1]; ++k) {
+              const std::uint32_t j = cell_items_[k];
+              if (j == std::uint32_t(i) || (gi >= 0 && group[j] == gi)) continue;
+              const double cut = ri + r[j] + skin;
+              if ((xi - x[j]).squaredNorm() < cut * cut) (j > std::uint32_t(i) ? fwd : bwd).push_back(std::int32_t(j));
+            }
           }
-        }
+      std::sort(fwd.begin() + std::ptrdiff_t(f0), fwd.end());
+      std::sort(bwd.begin() + std::ptrdiff_t(b0), bwd.end());
+      fwd_count_[std::size_t(i)] = std::uint32_t(fwd.size() - f0);
+      bwd_count_[std::size_t(i)] = std::uint32_t(bwd.size() - b0);
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+      trow.assign(n + 1, 0);
+      for (std::size_t i = 0; i < n; ++i) {
+        row[i + 1] = row[i] + fwd_count_[i];
+        trow[i + 1] = trow[i] + bwd_count_[i];
+      }
+      nbr.resize(row[n]);
+      hist.resize(row[n]);
+      tpair.resize(row[n]);
+    }  // (implicit barrier)
+    std::copy(fwd.begin(), fwd.end(), nbr.begin() + row[std::size_t(lo)]);
+    for (std::int64_t i = lo; i < hi; ++i) {
+      // carry the histories over (both rows sorted by j)
+      std::uint32_t q = 0, qe = 0;
+      if (std::size_t(i) < old_n) { q = old_row[std::size_t(i)]; qe = old_row[std::size_t(i) + 1]; }
+      for (std::uint32_t k = row[std::size_t(i)]; k < row[std::size_t(i) + 1]; ++k) {
+        while (q < qe && old_nbr[q] < nbr[k]) ++q;
+        hist[k] = (q < qe && old_nbr[q] == nbr[k]) ? old_hist[q] : Vec3::Zero();
       }
     }
-  };
-  const std::int64_t sn = std::int64_t(n);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (std::int64_t i = 0; i < sn; ++i) {
-    std::uint32_t cnt = 0;
-    visit(std::size_t(i), [&](std::uint32_t) { ++cnt; });
-    row[i + 1] = cnt;
-  }
-  for (std::size_t i = 0; i < n; ++i) row[i + 1] += row[i];
-  nbr.resize(row[n]);
-  hist.resize(row[n]);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (std::int64_t i = 0; i < sn; ++i) {
-    std::uint32_t p = row[i];
-    visit(std::size_t(i), [&](std::uint32_t j) { nbr[p++] = std::int32_t(j); });
-    std::sort(nbr.begin() + row[i], nbr.begin() + row[i + 1]);
-    // carry the histories over (both rows sorted by j)
-    std::uint32_t q = 0, qe = 0;
-    if (std::size_t(i) < old_n) { q = old_row[i]; qe = old_row[i + 1]; }
-    for (std::uint32_t k = row[i]; k < row[i + 1]; ++k) {
-      while (q < qe && old_nbr[q] < nbr[k]) ++q;
-      hist[k] = (q < qe && old_nbr[q] == nbr[k]) ? old_hist[q] : Vec3::Zero();
-    }
-  }
-  // transposed index, ascending i within each j (serial counting sort: deterministic)
-  trow.assign(n + 1, 0);
-  for (std::size_t p = 0; p < nbr.size(); ++p) ++trow[nbr[p] + 1];
-  for (std::size_t j = 0; j < n; ++j) trow[j + 1] += trow[j];
-  tpair.resize(nbr.size());
-  {
-    std::vector<std::uint32_t> fill(trow.begin(), trow.end() - 1);
-    for (std::size_t p = 0; p < nbr.size(); ++p) tpair[fill[nbr[p]]++] = std::uint32_t(p);
+#pragma omp barrier
+    // the transposed index: pair p of (i, j), i < j, listed under j in ascending i; p found in i's sorted row
+    std::size_t b = 0;
+    for (std::int64_t j = lo; j < hi; ++j)
+      for (std::uint32_t q = trow[std::size_t(j)]; q < trow[std::size_t(j) + 1]; ++q, ++b) {
+        const std::size_t i = std::size_t(bwd[b]);
+        const auto first = nbr.begin() + row[i], last = nbr.begin() + row[i + 1];
+        tpair[q] = std::uint32_t(std::lower_bound(first, last, std::int32_t(j)) - nbr.begin());
+      }
   }
   x_built_ = x;
   valid_ = true;

@@ -62,6 +62,9 @@ class NeighborList {
   std::size_t builds_ = 0;
   // cell grid scratch
   std::vector<std::uint32_t> cell_start_, cell_items_, cell_of_;
+  // build scratch: partners per sphere on each side, and what each thread found for its block of spheres
+  std::vector<std::uint32_t> fwd_count_, bwd_count_;
+  std::vector<std::vector<std::int32_t>> thread_fwd_, thread_bwd_;
 };
 
 /// All pairs (i < j, not in the same clump) whose spheres overlap (|x_i - x_j| < r_i + r_j), by brute force O(n^2).
