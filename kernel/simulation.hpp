@@ -208,8 +208,12 @@ class BasicSimulation {
   static constexpr int kWallSlots = 3;                      // wall contacts with history per sphere
   std::vector<std::int32_t> wall_slot_id_;                  // kWallSlots per sphere, -1 empty
   std::vector<Vec3> wall_slot_s_, wall_slot_f_;             // history, force on the sphere
-  std::vector<Vec3> pair_f_, pair_tj_;                      // per pair: force on i, torque on j
-  std::vector<double> omega_norm_;                          // scratch of compute_forces: |w_| per sphere
+  struct PairLoad {
+    Vec3 force_i, torque_j;  // one pair's force on i and torque on j, side by side for the gather's one read
+  };
+  std::vector<PairLoad> pair_load_;                         // per pair (written and gathered in compute_forces)
+  std::vector<double> omega_norm_;                          // |w_| per sphere, for the rolling torques
+  bool omega_norm_fresh_ = false;                           // kick_drift filled omega_norm_ for the current w_
   static constexpr int kMaxWallCandidates = 64;             // walls tracked per sphere (bit mask)
   std::vector<std::uint64_t> wall_cand_;                    // per sphere: walls within reach at the last build
 

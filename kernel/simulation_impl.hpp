@@ -252,6 +252,8 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
   const Vec3* xb = check ? nl_.built_positions().data() : nullptr;
   const double lim2 = 0.25 * skin_ * skin_;
   int moved = check ? 0 : 1;
+  if (Law::uses_omega_norm) omega_norm_.resize(std::size_t(n));
+  double* wnorm = omega_norm_.data();
 #pragma omp parallel num_threads(nt()) reduction(| : moved)
   {
 #pragma omp for schedule(static) nowait
@@ -259,6 +261,7 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
       if (clump_[i] >= 0) continue;
       v_[i] += h * (f_[i] * inv_mass_[i] + g);
       w_[i] += (h * inv_inertia_[i]) * t_[i];
+      if (Law::uses_omega_norm) wnorm[i] = w_[i].norm();
       x_[i] += dt * v_[i];
       if (check && (x_[i] - xb[i]).squaredNorm() > lim2) moved = 1;
     }
@@ -293,12 +296,17 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j) Rk(i, j) = R.m[i][j][k];
         update_members(std::size_t(c), Rk, true);
+        if (Law::uses_omega_norm) {
+          const double wn = cw_[c].norm();  // the members' omega is the clump's
+          for (std::uint32_t m = cmem_start_[c]; m < cmem_start_[c + 1]; ++m) wnorm[cmem_[m]] = wn;
+        }
         if (check)
           for (std::uint32_t m = cmem_start_[c]; m < cmem_start_[c + 1]; ++m)
             if ((x_[cmem_[m]] - xb[cmem_[m]]).squaredNorm() > lim2) moved = 1;
       }
     }
   }
+  omega_norm_fresh_ = Law::uses_omega_norm;
   return moved != 0;
 }
 
@@ -357,6 +365,7 @@ void BasicSimulation<Law>::reorder_spheres() {
     identity = identity && key[k].old == k;
   }
   if (identity) return;
+  omega_norm_fresh_ = false;  // (|omega| per sphere is scratch, not permuted: computed again)
   auto permute = [&](auto& vec, std::size_t per) {
     auto tmp = vec;
     for (std::size_t k = 0; k < n; ++k)
@@ -434,20 +443,23 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
     rebuild_neighbors();
   }
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
-  pair_f_.resize(nl_.num_pairs());
-  pair_tj_.resize(nl_.num_pairs());
+  pair_load_.resize(nl_.num_pairs());
+  PairLoad* load = pair_load_.data();
   const int nm = nm_coeffs_;
   const double dt = dt_history;  // the tangential springs advance by vt * dt_history
   const int nw = int(walls_.size());
   const std::uint32_t* row = nl_.row.data();
   const std::int32_t* nbr = nl_.nbr.data();
   Vec3* hist = nl_.hist.data();
+  // |omega| once per sphere, not once per contact side (a sphere has several contacts); kick_drift has filled it
+  // unless the angular velocities changed otherwise since (a velocity set, bodies added, removed or renumbered)
+  const bool fill_omega_norm = Law::uses_omega_norm && !(omega_norm_fresh_ && omega_norm_.size() == std::size_t(n));
   if (Law::uses_omega_norm) omega_norm_.resize(std::size_t(n));
+  omega_norm_fresh_ = false;  // the next kick changes omega
   double* wnorm = omega_norm_.data();
 #pragma omp parallel num_threads(nt())
   {
-    if (Law::uses_omega_norm) {
-      // |omega| once per sphere, not once per contact side (a sphere has several contacts)
+    if (fill_omega_norm) {
 #pragma omp for schedule(static)
       for (std::int64_t i = 0; i < n; ++i) wnorm[i] = w_[i].norm();
     }
@@ -467,8 +479,8 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         const double d2 = d.squaredNorm();
         if (d2 >= rs * rs) {
           hist[p].setZero();
-          pair_f_[p].setZero();
-          pair_tj_[p].setZero();
+          load[p].force_i.setZero();
+          load[p].torque_j.setZero();
           continue;
         }
         const double dist = std::sqrt(d2);
@@ -495,8 +507,8 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         const ContactResult res = Law::compute(crow[mat_[j]], geo, kin, hist[p], dt, false);
         fi += res.force_i;
         ti += res.torque_i;
-        pair_f_[p] = res.force_i;
-        pair_tj_[p] = res.torque_j;
+        load[p].force_i = res.force_i;
+        load[p].torque_j = res.torque_j;
       }
       // walls: up to kWallSlots simultaneous contacts keep a history
       if (nw > 0) {
@@ -560,8 +572,8 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
       Vec3 fj = Vec3::Zero(), tj = Vec3::Zero();
       for (std::uint32_t q = trow[j]; q < trow[j + 1]; ++q) {
         const std::uint32_t p = tpair[q];
-        fj -= pair_f_[p];
-        tj += pair_tj_[p];
+        fj -= load[p].force_i;
+        tj += load[p].torque_j;
       }
       f_[j] += fj;
       t_[j] += tj;
@@ -848,7 +860,13 @@ void BasicSimulation<Law>::save_state(std::ostream& os) const {
   auto* self = const_cast<BasicSimulation*>(this);
   self->for_each_sphere_array([&](auto& a, int) { w.array(a); });
   self->for_each_clump_array([&](auto& a) { w.array(a); });
-  w.array(pair_f_); w.array(pair_tj_); w.array(wall_cand_);
+  // (the pair loads as two arrays, force then torque: the format of demcal-kernel-state/2)
+  std::vector<Vec3> pair_f(pair_load_.size()), pair_tj(pair_load_.size());
+  for (std::size_t p = 0; p < pair_load_.size(); ++p) {
+    pair_f[p] = pair_load_[p].force_i;
+    pair_tj[p] = pair_load_[p].torque_j;
+  }
+  w.array(pair_f); w.array(pair_tj); w.array(wall_cand_);
   w.array(cmem_start_); w.array(cmem_);
   w.array(body_ref_); w.array(body_id_);
   w.value(next_id_);
@@ -885,7 +903,12 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   for (std::size_t k = 0; k < walls_.size(); ++k) walls_[k].enabled = enabled[k] != 0;
   for_each_sphere_array([&](auto& a, int) { r.array(a, "sphere arrays"); });
   for_each_clump_array([&](auto& a) { r.array(a, "clump arrays"); });
-  r.array(pair_f_, "pair forces"); r.array(pair_tj_, "pair torques"); r.array(wall_cand_, "wall candidates");
+  std::vector<Vec3> pair_f, pair_tj;
+  r.array(pair_f, "pair forces"); r.array(pair_tj, "pair torques"); r.array(wall_cand_, "wall candidates");
+  if (pair_f.size() != pair_tj.size()) r.fail("pair loads", "force and torque counts differ");
+  pair_load_.resize(pair_f.size());
+  for (std::size_t p = 0; p < pair_f.size(); ++p) pair_load_[p] = {pair_f[p], pair_tj[p]};
+  omega_norm_fresh_ = false;
   r.array(cmem_start_, "clump members"); r.array(cmem_, "clump members");
   r.array(body_ref_, "bodies"); r.array(body_id_, "body ids");
   r.value(next_id_, "next body id");
