@@ -75,7 +75,10 @@ inline QuatPack add_scaled(const QuatPack& a, const Pack& s, const QuatPack& b) 
   return {a.x + s * b.x, a.y + s * b.y, a.z + s * b.z, a.w + s * b.w};
 }
 
-/// One Newton step for 1/|q| (error O(d^2) for |q|^2 = 1 + d): the intermediate quaternions of a step.
+/// Brings a nearly unit quaternion back to unit length with one Newton step for 1/|q| (no square root, no
+/// division): |q|^2 = 1 + d gives an error O(d^2). Used on the intermediate quaternions of a step, where
+/// d = (|omega| dt / 2)^2 at most (5e-5 for 500 rad/s in the reduced silo's 28 us step); the quaternion kept at the
+/// end of the step is normalised exactly.
 inline QuatPack renormalized(const QuatPack& q) {
   const Pack f = 1.5 - 0.5 * squared_norm(q);
   return {f * q.x, f * q.y, f * q.z, f * q.w};
