@@ -2,9 +2,9 @@
 //
 // A clump's orientation advances by a Richardson iteration (LAMMPS MathExtra::richardson, as LIGGGHTS multisphere)
 // with its angular momentum L fixed over the step: omega from L, a full and two half quaternion steps, the
-// extrapolation 2 q_half - q_full, normalisation. That is a chain of about 250 dependent floating-point operations
-// per clump; done one clump after the other the core waits on latencies (measured: ~700 cycles per clump, 40 % of a
-// filling step of the full silo case). Here the same operations run on four clumps side by side (GCC vector
+// extrapolation 2 q_half - q_full, normalisation. That is a long chain of dependent floating-point operations per
+// clump; done one clump after the other the core waits on latencies (perf on the full silo case while filling: the
+// kick, mostly this, took 42 % of a step). Here the same operations run on four clumps side by side (GCC vector
 // extensions: AVX where the build allows it, two SSE2 halves otherwise), which hides the latencies.
 //
 // Every operation is the one Eigen performs for the scalar formulation (Quaternion * Quaternion in its SSE2 form,

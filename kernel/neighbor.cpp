@@ -92,8 +92,7 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
   // (|x_i - x_j|^2 and r_i + r_j + skin are the same bits either way), so the two sides agree exactly. Each thread
   // keeps what it found for its contiguous block of spheres and copies it into place once the row offsets are known:
   // no second visit to count, no serial transposition.
-  fwd_count_.resize(n);
-  bwd_count_.resize(n);
+  trow.assign(n + 1, 0);  // row[i + 1], trow[i + 1]: first the counts of sphere i, then the offsets
   const int nthreads = std::max(1, threads);
   thread_fwd_.resize(std::size_t(nthreads));
   thread_bwd_.resize(std::size_t(nthreads));
@@ -125,16 +124,15 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
           }
       std::sort(fwd.begin() + std::ptrdiff_t(f0), fwd.end());
       std::sort(bwd.begin() + std::ptrdiff_t(b0), bwd.end());
-      fwd_count_[std::size_t(i)] = std::uint32_t(fwd.size() - f0);
-      bwd_count_[std::size_t(i)] = std::uint32_t(bwd.size() - b0);
+      row[std::size_t(i) + 1] = std::uint32_t(fwd.size() - f0);
+      trow[std::size_t(i) + 1] = std::uint32_t(bwd.size() - b0);
     }
 #pragma omp barrier
 #pragma omp single
     {
-      trow.assign(n + 1, 0);
       for (std::size_t i = 0; i < n; ++i) {
-        row[i + 1] = row[i] + fwd_count_[i];
-        trow[i + 1] = trow[i] + bwd_count_[i];
+        row[i + 1] += row[i];
+        trow[i + 1] += trow[i];
       }
       nbr.resize(row[n]);
       hist.resize(row[n]);

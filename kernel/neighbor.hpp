@@ -62,8 +62,7 @@ class NeighborList {
   std::size_t builds_ = 0;
   // cell grid scratch
   std::vector<std::uint32_t> cell_start_, cell_items_, cell_of_;
-  // build scratch: partners per sphere on each side, and what each thread found for its block of spheres
-  std::vector<std::uint32_t> fwd_count_, bwd_count_;
+  // build scratch: the partners each thread found for its block of spheres (j > i and j < i)
   std::vector<std::vector<std::int32_t>> thread_fwd_, thread_bwd_;
 };
 

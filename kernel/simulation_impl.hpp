@@ -934,6 +934,7 @@ std::size_t BasicSimulation<Law>::memory_bytes() const {
                        kWallSlots * (sizeof(std::int32_t) + 2 * sizeof(Vec3)) + sizeof(std::uint32_t) +
                        sizeof(std::uint64_t));  // the last: the wall mask
   b += nl_.num_pairs() * (sizeof(std::int32_t) + 3 * sizeof(Vec3) + sizeof(std::uint32_t)) + 2 * (n + 1) * 4;
+  b += omega_norm_.size() * sizeof(double);  // (laws with rolling friction only)
   b += cx_.size() * (7 * sizeof(Vec3) + sizeof(Quat) + sizeof(double) + 3 * 4);
   return b;
 }
