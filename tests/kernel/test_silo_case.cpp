@@ -159,6 +159,20 @@ TEST_CASE("silo case: the same seed and thread count give the same discharge", "
     CHECK(a.fill_kinetic_energy == b.fill_kinetic_energy);
 }
 
+// Regression reference: the numbers below are what commit 177686b computed for this case (built for x86-64 without
+// AVX2, GCC 12, Debian 12). The kernel's results must not depend on the instruction set the build chose (CMakeLists.txt
+// enables AVX2 without FMA where the building machine has it) nor change silently: when a change alters the
+// arithmetic on purpose, run this case, put the new numbers here and say so in the commit message.
+TEST_CASE("silo case: the small rectangular case computes the committed reference bits", "[silo]") {
+    const SiloCaseSettings s = small_rectangular_case();
+    const auto r = run_silo_case(s);
+    INFO(std::hexfloat << "fill kinetic energy " << r.fill_kinetic_energy << ", rate " << r.fit.rate
+                       << ", discharged " << std::defaultfloat << r.grains_discharged << " grains");
+    CHECK(r.grains_discharged == 600);
+    CHECK(r.fill_kinetic_energy == 0x1.dfb1a8b3d2fb8p-30);
+    CHECK(r.fit.rate == 0x1.204c198b545f8p-2);
+}
+
 namespace {
 struct SimulatedCrash {};
 }  // namespace
