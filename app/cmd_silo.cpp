@@ -9,11 +9,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -57,6 +59,45 @@ struct SiloCli {
 constexpr int kExitSuspended = 75;
 
 constexpr const char* kCheckpointName = "checkpoint.bin";
+
+// SIGTERM (a batch system's time limit or scancel, kill) and SIGINT (Ctrl-C) during a checkpointed run: the run ends
+// its record interval, writes its checkpoint and exits 75, as at --wall-limit. The handler only records the signal
+// (async-signal-safe); the run asks for it between record intervals. SA_RESETHAND: a second signal takes the default
+// action and ends the process at once. A signal ignored at the start (SIGINT of a job started with `&` by a script)
+// stays ignored.
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+void record_stop_signal(int sig) { g_stop_signal = sig; }
+
+class StopOnSignal {
+public:
+    StopOnSignal() {
+        for (int i = 0; i < 2; ++i) {
+            struct sigaction sa {};
+            sa.sa_handler = record_stop_signal;
+            sigemptyset(&sa.sa_mask);
+            sa.sa_flags = SA_RESETHAND;
+            ::sigaction(kSignals[i], &sa, &previous_[i]);
+            if (previous_[i].sa_handler == SIG_IGN) ::sigaction(kSignals[i], &previous_[i], nullptr);
+        }
+    }
+    ~StopOnSignal() {
+        for (int i = 0; i < 2; ++i) ::sigaction(kSignals[i], &previous_[i], nullptr);
+    }
+    StopOnSignal(const StopOnSignal&) = delete;
+    StopOnSignal& operator=(const StopOnSignal&) = delete;
+
+    // For SiloCaseSettings::stop_request: empty until a signal came.
+    static std::string reason() {
+        const int sig = g_stop_signal;
+        if (sig == 0) return {};
+        return std::string(sig == SIGTERM ? "SIGTERM" : "SIGINT") + " received";
+    }
+
+private:
+    static constexpr int kSignals[2] = {SIGTERM, SIGINT};
+    struct sigaction previous_[2] {};
+};
 
 std::string fixed(double v, int digits) {
     char buf[64];
@@ -274,6 +315,11 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
                   << " (continue an interrupted run with `demcal silo --resume " << dir.string() << "`)";
     std::cout << std::endl;
+    std::optional<StopOnSignal> stop_on_signal;  // without a checkpoint there is nothing to stop to
+    if (!s.checkpoint_file.empty()) {
+        stop_on_signal.emplace();
+        s.stop_request = StopOnSignal::reason;
+    }
     write_outputs(dir, s, ks::run_silo_case(s, print_progress), o.no_plots);
 }
 
@@ -308,8 +354,10 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     std::cout << "demcal silo --resume: " << s.geometry.describe() << "\n  " << threads << " thread(s), seed "
               << s.seed << ", stiffness scale " << s.materials.stiffness_scale << ", checkpoint " << file.string()
               << std::endl;
+    const StopOnSignal stop_on_signal;
     write_outputs(dir, s,
-                  ks::resume_silo_case(file.string(), {threads, o.checkpoint_every, o.wall_limit}, print_progress),
+                  ks::resume_silo_case(file.string(), {threads, o.checkpoint_every, o.wall_limit, StopOnSignal::reason},
+                                       print_progress),
                   o.no_plots);
 }
 
@@ -498,7 +546,7 @@ void add_silo_command(CLI::App& app) {
     sub->add_option("--wall-limit", o->wall_limit,
                     "stop after this many wall-clock seconds of this session (0: none), at the end of a record "
                     "interval, with a checkpoint written; exit status 75: not finished, continue with --resume "
-                    "(a batch system's time limit)")
+                    "(a batch system's time limit); SIGTERM or Ctrl-C does the same at any time")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     sub->add_option("--resume", o->resume,

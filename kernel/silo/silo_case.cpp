@@ -407,7 +407,19 @@ private:
     }
     double wall() const { return wall_before_ + session_wall(); }
     double cpu() const { return cpu_before_ + process_cpu_seconds() - cpu_start_; }
-    bool wall_limit_reached() const { return s_.wall_limit > 0 && session_wall() >= s_.wall_limit; }
+    // Whether this session ends here (at the end of a record interval), and why: its wall limit, or the caller's
+    // stop request. The run is then suspended with a checkpoint.
+    bool session_must_end() {
+        if (s_.wall_limit > 0 && session_wall() >= s_.wall_limit) {
+            suspend_reason_ = "wall limit of the session (" + setting_text(s_.wall_limit) + " s) reached";
+            return true;
+        }
+        if (s_.stop_request && !s_.checkpoint_file.empty()) {
+            suspend_reason_ = s_.stop_request();
+            return !suspend_reason_.empty();
+        }
+        return false;
+    }
     long progress_every() const { return std::max(1L, std::lround(s_.progress_interval / r_.time_step)); }
     long chunk() const { return std::max(1L, std::lround(s_.record_interval / r_.time_step)); }
     bool is_below_outlet(const BodyState& b) const { return b.position.z() < -s_.removal_depth; }
@@ -508,7 +520,7 @@ private:
                 break;
             }
             if (sim_.time() >= s_.fill_time_max) break;
-            if (wall_limit_reached()) return false;
+            if (session_must_end()) return false;
             maybe_checkpoint();
         }
         r_.fill_time = sim_.time();
@@ -601,23 +613,24 @@ private:
                 r_.stop_reason = "time limit " + setting_text(s_.max_time) + " s";
                 break;
             }
-            if (wall_limit_reached()) return false;
+            if (session_must_end()) return false;
             maybe_checkpoint();
         }
         return true;
     }
 
-    // At the session's wall limit: the checkpoint (it must be written: without it the session's work is lost, which
-    // is reported as an error) and the state reached, marked suspended.
+    // At the session's end (session_must_end): the checkpoint (it must be written: without it the session's work is
+    // lost, which is reported as an error) and the state reached, marked suspended.
     SiloCaseResult suspend() {
         try {
             save(s_.checkpoint_file);
         } catch (const std::runtime_error& e) {
-            throw std::runtime_error(std::string("at the wall limit: ") + e.what() + " (the previous checkpoint, " +
-                                     std::to_string(r_.checkpoints - 1) + ", is the one to resume from)");
+            throw std::runtime_error("on suspending (" + suspend_reason_ + "): " + e.what() +
+                                     " (the previous checkpoint, " + std::to_string(r_.checkpoints - 1) +
+                                     ", is the one to resume from)");
         }
         r_.suspended = true;
-        r_.stop_reason = "wall limit of the session (" + setting_text(s_.wall_limit) + " s) reached";
+        r_.stop_reason = suspend_reason_;
         record_state();
         report("suspended", r_.stop_reason);
         return r_;
@@ -659,6 +672,7 @@ private:
     long last_report_step_ = -1;      // the previous progress report of this session that measured the step cost
     double last_report_wall_ = 0, last_report_cpu_ = 0;
     double last_checkpoint_wall_ = 0;
+    std::string suspend_reason_;      // why this session ends early (session_must_end)
     // the run's own variables, carried from one record interval to the next
     Phase phase_ = Phase::filling;
     double wall_top_ = 0;
@@ -717,6 +731,7 @@ SiloCaseResult resume_silo_case(const std::string& file, const SiloSession& sess
     s.checkpoint_file = file;
     s.checkpoint_interval = session.checkpoint_interval;
     s.wall_limit = session.wall_limit;
+    s.stop_request = session.stop_request;
     SiloRun run(s, progress);
     run.load(is, "checkpoint '" + file + "'", version);
     return run.run();

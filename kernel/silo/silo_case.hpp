@@ -58,10 +58,14 @@ struct SiloCaseSettings {
     // writes its checkpoint and returns suspended, to be resumed later (a batch system's time limit, a machine lent
     // for a few hours). Needs a checkpoint file. Not stored: each session sets its own.
     double wall_limit = 0;
+    // Asked at the end of every record interval, as the wall limit: a non-empty answer (why, e.g. "SIGTERM received")
+    // suspends the run the same way (checkpoint written, result marked suspended). The caller's way to stop a run
+    // cleanly from outside (demcal silo: SIGTERM and SIGINT). Only with a checkpoint file. Not stored.
+    std::function<std::string()> stop_request;
 };
 // A new setting that changes the run must also be listed in for_each_setting (silo_case.cpp): the checkpoint stores
-// the settings through that list. threads, checkpoint_file, checkpoint_interval and wall_limit are not stored: a
-// resumed run takes them from its caller.
+// the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit and stop_request are not
+// stored: a resumed run takes them from its caller.
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions).
 void validate(const SiloCaseSettings& s);
@@ -116,7 +120,8 @@ struct SiloCaseResult {
     // or waited for cores other work held.
     double cpu_s = 0;
     int cpu_sessions = 0;
-    bool suspended = false;              // stopped at SiloCaseSettings::wall_limit: resume it from its checkpoint
+    bool suspended = false;  // stopped at SiloCaseSettings::wall_limit or stop_request (stop_reason says which):
+                             // resume it from its checkpoint
     long checkpoints = 0;                // written over the whole run
     long vtk_files = 0;
 };
@@ -134,6 +139,7 @@ struct SiloSession {
     int threads = 1;
     double checkpoint_interval = 900;  // [s] wall clock
     double wall_limit = 0;             // [s] wall clock of this session; 0: none
+    std::function<std::string()> stop_request;  // see SiloCaseSettings::stop_request
 };
 
 // Continues the run saved in checkpoint_file (the settings stored in it), checkpointing to the same file; the result

@@ -1,6 +1,7 @@
 // demcal silo end to end: bad input exits 2 naming the field and the value, before anything is written; a tiny run
-// writes discharge.csv and summary.json; a run killed with -9 and resumed from its checkpoint writes the same
-// discharge.csv as an uninterrupted one. Needs the demcal binary (built with the project: CI builds everything).
+// writes discharge.csv and summary.json; a run killed with -9, resumed, stopped by its wall limit and by SIGTERM and
+// resumed again writes the same discharge.csv as an uninterrupted one. Needs the demcal binary (built with the
+// project: CI builds everything).
 #include <catch2/catch.hpp>
 
 #include <signal.h>
@@ -41,6 +42,27 @@ std::string read_file(const fs::path& file) {
     std::stringstream s;
     s << f.rdbuf();
     return s.str();
+}
+
+// Starts `demcal silo ARGS` in the background (exec'd by sh, so that a signal reaches demcal itself), output to LOG.
+pid_t spawn_demcal(const std::string& args, const fs::path& log) {
+    const std::string cmd = std::string("exec '") + DEMCAL_BINARY + "' silo " + args + " > '" + log.string() + "' 2>&1";
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    return pid;
+}
+
+// Waits until `ready` holds or the process ends; true when it has ended (its wait status in `status`).
+template <class Ready>
+bool wait_until(pid_t pid, Ready ready, int& status) {
+    while (!ready()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        if (::waitpid(pid, &status, WNOHANG) == pid) return true;
+    }
+    return false;
 }
 
 void require_demcal() {
@@ -102,7 +124,8 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     fs::remove_all(dir);
 }
 
-TEST_CASE("demcal silo: a run killed with -9 resumes from its checkpoint to the uninterrupted result", "[silo][cli]") {
+TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to the uninterrupted result",
+          "[silo][cli]") {
     require_demcal();
     const fs::path dir = fs::temp_directory_path() / ("demcal_test_silo_cli_resume_" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -115,21 +138,11 @@ TEST_CASE("demcal silo: a run killed with -9 resumes from its checkpoint to the 
 
     // the same run, checkpointing every 0.1 s of wall time, killed with -9 once its first checkpoint is written
     const fs::path out = dir / "killed", ckpt = out / "checkpoint.bin";
-    const std::string cmd = std::string("exec '") + DEMCAL_BINARY + "' silo " + case_args +
-                            "--threads 1 --checkpoint-every 0.1 --out '" + out.string() + "' > '" +
-                            (dir / "killed.log").string() + "' 2>&1";
-    const pid_t pid = ::fork();
-    REQUIRE(pid >= 0);
-    if (pid == 0) {
-        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-        ::_exit(127);
-    }
+    const pid_t pid =
+        spawn_demcal(case_args + "--threads 1 --checkpoint-every 0.1 --out '" + out.string() + "'", dir / "killed.log");
+    REQUIRE(pid > 0);
     int status = 0;
-    bool finished = false;
-    while (!fs::exists(ckpt) && !finished) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        finished = ::waitpid(pid, &status, WNOHANG) == pid;
-    }
+    const bool finished = wait_until(pid, [&] { return fs::exists(ckpt); }, status);
     if (!finished) {
         ::kill(pid, SIGKILL);
         ::waitpid(pid, &status, 0);
@@ -155,13 +168,32 @@ TEST_CASE("demcal silo: a run killed with -9 resumes from its checkpoint to the 
     CHECK_FALSE(fs::exists(out / "summary.json"));
     CHECK_THAT(read_file(dir / "out.log"), Catch::Matchers::Contains("suspended: wall limit"));
 
+    // SIGTERM (a batch system's time limit, scancel) once the session steps: the same clean stop
+    const pid_t term_pid = spawn_demcal("--resume '" + out.string() + "' --threads 1", dir / "term.log");
+    REQUIRE(term_pid > 0);
+    int term_status = 0;
+    const bool term_finished =
+        wait_until(term_pid, [&] { return read_file(dir / "term.log").find("resumed") != std::string::npos; },
+                   term_status);
+    if (!term_finished) {
+        ::kill(term_pid, SIGTERM);
+        ::waitpid(term_pid, &term_status, 0);
+    }
+    INFO(read_file(dir / "term.log"));
+    REQUIRE_FALSE(term_finished);
+    CHECK(WIFEXITED(term_status));
+    CHECK(WEXITSTATUS(term_status) == 75);
+    CHECK(fs::exists(ckpt));
+    CHECK_FALSE(fs::exists(out / "summary.json"));
+    CHECK_THAT(read_file(dir / "term.log"), Catch::Matchers::Contains("suspended: SIGTERM received"));
+
     const Run resumed = demcal("--resume '" + out.string() + "' --threads 2", dir);
     INFO(resumed.err);
     REQUIRE(resumed.rc == 0);
     CHECK(read_file(out / "discharge.csv") == read_file(dir / "whole" / "discharge.csv"));
     const std::string summary = read_file(out / "summary.json");
-    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 3"));
-    CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 3"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 4"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 4"));
     CHECK_FALSE(fs::exists(ckpt));  // removed once the outputs are written
     const Run finished_run = demcal("--resume '" + out.string() + "'", dir);
     CHECK(finished_run.rc == 2);
