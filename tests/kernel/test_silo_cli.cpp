@@ -2,6 +2,8 @@
 // writes discharge.csv and summary.json; a run killed with -9, resumed, stopped by its wall limit and by SIGTERM and
 // resumed again writes the same discharge.csv as an uninterrupted one. Needs the demcal binary (built with the
 // project: CI builds everything).
+#include "test_files.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <signal.h>
@@ -14,34 +16,25 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using demcal::test::read_file;
+
 struct Run {
     int rc;
     std::string err;
 };
 
-Run demcal(const std::string& args, const fs::path& dir) {
+Run run_silo(const std::string& args, const fs::path& dir) {
     fs::create_directories(dir);
     const std::string cmd = std::string("'") + DEMCAL_BINARY + "' silo " + args + " > '" + (dir / "out.log").string() +
                             "' 2> '" + (dir / "err.log").string() + "'";
     const int status = std::system(cmd.c_str());
-    std::ifstream e(dir / "err.log");
-    std::stringstream s;
-    s << e.rdbuf();
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
-}
-
-std::string read_file(const fs::path& file) {
-    std::ifstream f(file, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(dir / "err.log")};
 }
 
 // Starts `demcal silo ARGS` in the background (exec'd by sh, so that a signal reaches demcal itself), output to LOG.
@@ -92,13 +85,13 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --wall-limit 60 --no-checkpoint", "--wall-limit 60 needs the checkpoint"},
                           Case{"", "theta: missing"}}) {
         INFO(c.args);
-        const Run r = demcal(c.args + " --out '" + out.string() + "'", dir);
+        const Run r = run_silo(c.args + " --out '" + out.string() + "'", dir);
         CHECK(r.rc == 2);
         CHECK_THAT(r.err, Catch::Matchers::Contains(c.expect));
         CHECK_FALSE(fs::exists(out));
     }
     std::ofstream(dir / "g.json") << R"({"shape": "conical", "theta_deg": 30, "outlet_mm": 35})";
-    const Run r = demcal("--geometry '" + (dir / "g.json").string() + "' --out '" + out.string() + "'", dir);
+    const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' --out '" + out.string() + "'", dir);
     CHECK(r.rc == 2);
     CHECK_THAT(r.err, Catch::Matchers::Contains("unknown key 'outlet_mm'"));
     fs::remove_all(dir);
@@ -108,7 +101,7 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     require_demcal();
     const fs::path dir = fs::temp_directory_path() / "demcal_test_silo_cli_run";
     fs::remove_all(dir);
-    const Run r = demcal("--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
+    const Run r = run_silo("--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
                              "/examples/silo/reduced_conical_70deg.json' --theta 45 --particles 300 "
                              "--stiffness-scale 0.001 --fill-time 0.3 --max-time 0.2 --threads 1 --no-plots --out '" +
                              (dir / "out").string() + "'",
@@ -116,11 +109,9 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     INFO(r.err);
     REQUIRE(r.rc == 0);
     CHECK(fs::exists(dir / "out" / "discharge.csv"));
-    std::ifstream f(dir / "out" / "summary.json");
-    std::stringstream s;
-    s << f.rdbuf();
-    CHECK_THAT(s.str(), Catch::Matchers::Contains("\"wall_to_axis_velocity_ratio\""));
-    CHECK_THAT(s.str(), Catch::Matchers::Contains("\"grains\": 300"));
+    const std::string summary = read_file(dir / "out" / "summary.json");
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"wall_to_axis_velocity_ratio\""));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"grains\": 300"));
     fs::remove_all(dir);
 }
 
@@ -132,7 +123,7 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to th
     const std::string case_args = "--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
                                   "/examples/silo/reduced_conical_70deg.json' --theta 45 --particles 600 "
                                   "--stiffness-scale 0.001 --fill-time 0.3 --max-time 0.4 --no-plots ";
-    const Run whole = demcal(case_args + "--threads 1 --no-checkpoint --out '" + (dir / "whole").string() + "'", dir);
+    const Run whole = run_silo(case_args + "--threads 1 --no-checkpoint --out '" + (dir / "whole").string() + "'", dir);
     INFO(whole.err);
     REQUIRE(whole.rc == 0);
 
@@ -153,16 +144,16 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to th
     CHECK_FALSE(fs::exists(out / "summary.json"));
 
     // a new run into that directory would overwrite the checkpoint: refused
-    const Run again = demcal(case_args + "--out '" + out.string() + "'", dir);
+    const Run again = run_silo(case_args + "--out '" + out.string() + "'", dir);
     CHECK(again.rc == 2);
     CHECK_THAT(again.err, Catch::Matchers::Contains("holds the checkpoint of an unfinished run"));
     // a resumed run keeps its stored settings
-    const Run mixed = demcal("--resume '" + out.string() + "' --theta 30", dir);
+    const Run mixed = run_silo("--resume '" + out.string() + "' --theta 30", dir);
     CHECK(mixed.rc == 2);
     CHECK_THAT(mixed.err, Catch::Matchers::Contains("--theta cannot be combined with --resume"));
 
     // a session with a wall limit stops itself after one record interval: exit 75, checkpoint kept, no outputs
-    const Run limited = demcal("--resume '" + out.string() + "' --threads 1 --wall-limit 0.001", dir);
+    const Run limited = run_silo("--resume '" + out.string() + "' --threads 1 --wall-limit 0.001", dir);
     CHECK(limited.rc == 75);
     CHECK(fs::exists(ckpt));
     CHECK_FALSE(fs::exists(out / "summary.json"));
@@ -187,7 +178,7 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to th
     CHECK_FALSE(fs::exists(out / "summary.json"));
     CHECK_THAT(read_file(dir / "term.log"), Catch::Matchers::Contains("suspended: SIGTERM received"));
 
-    const Run resumed = demcal("--resume '" + out.string() + "' --threads 2", dir);
+    const Run resumed = run_silo("--resume '" + out.string() + "' --threads 2", dir);
     INFO(resumed.err);
     REQUIRE(resumed.rc == 0);
     CHECK(read_file(out / "discharge.csv") == read_file(dir / "whole" / "discharge.csv"));
@@ -195,7 +186,7 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to th
     CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 4"));
     CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 4"));
     CHECK_FALSE(fs::exists(ckpt));  // removed once the outputs are written
-    const Run finished_run = demcal("--resume '" + out.string() + "'", dir);
+    const Run finished_run = run_silo("--resume '" + out.string() + "'", dir);
     CHECK(finished_run.rc == 2);
     CHECK_THAT(finished_run.err, Catch::Matchers::Contains("that run has finished"));
     fs::remove_all(dir);

@@ -5,6 +5,7 @@
 #include "kernel/silo/silo_geometry.hpp"
 #include "kernel/silo/silo_output.hpp"
 #include "kernel/silo/wheat.hpp"
+#include "test_files.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -12,7 +13,6 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <sstream>
 
 using namespace demcal::kernel::silo;
 using Catch::Matchers::Contains;
@@ -173,10 +173,8 @@ TEST_CASE("section field and output files", "[silo]") {
     s.radii = {0.0015};
     s.clump = {0};
     write_vtk(dir / "s.vtk", s, 0.5);
-    std::ifstream vtk(dir / "s.vtk");
-    std::stringstream all;
-    all << vtk.rdbuf();
-    CHECK_THAT(all.str(), Contains("POINTS 1 double"));
-    CHECK_THAT(all.str(), Contains("VECTORS velocity double"));
+    const std::string vtk = demcal::test::read_file(dir / "s.vtk");
+    CHECK_THAT(vtk, Contains("POINTS 1 double"));
+    CHECK_THAT(vtk, Contains("VECTORS velocity double"));
     std::filesystem::remove_all(dir);
 }

@@ -2,6 +2,8 @@
 // and stops: a tiny silo case stopped by SIGTERM to its batch shell (as SLURM's --signal=B:TERM@120 sends it before
 // the time limit) suspends with its checkpoint, submits the next job, and the chain ends with the discharge.csv of an
 // uninterrupted run. Needs root (the SLURM daemons) and the demcal binary.
+#include "test_files.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
@@ -12,8 +14,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -22,12 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_file(const fs::path& file) {
-    std::ifstream f(file, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
+using demcal::test::read_file;
 
 // Runs a shell command; its standard output, trailing newline removed.
 std::string shell_output(const std::string& cmd) {

@@ -1,8 +1,6 @@
 #include "campaign_test_support.hpp"
 
 #include <fcntl.h>
-#include <fstream>
-#include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -48,13 +46,6 @@ int spawn_demcal(const std::vector<std::string>& args, const fs::path& log) {
         ::_exit(127);
     }
     return pid;
-}
-
-std::string read_file(const fs::path& p) {
-    std::ifstream f(p);
-    std::ostringstream s;
-    s << f.rdbuf();
-    return s.str();
 }
 
 fs::path find_file(const fs::path& dir, const std::string& prefix, const std::string& suffix) {

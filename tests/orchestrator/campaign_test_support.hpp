@@ -1,6 +1,7 @@
 // Helpers for tests that drive the real `demcal` binary over real YADE runs.
 #pragma once
 #include "orchestrator/campaign_store.hpp"
+#include "test_files.hpp"  // read_file
 
 #include <filesystem>
 #include <string>
@@ -14,7 +15,6 @@ std::filesystem::path source_path(const std::string& relative);  // a file of th
 int run_demcal(const std::vector<std::string>& args, const std::filesystem::path& log);
 // Starts demcal in the background; returns its pid.
 int spawn_demcal(const std::vector<std::string>& args, const std::filesystem::path& log);
-std::string read_file(const std::filesystem::path& p);
 // The first file in `dir` whose name starts with `prefix` and ends with `suffix` (empty path if none).
 std::filesystem::path find_file(const std::filesystem::path& dir, const std::string& prefix, const std::string& suffix);
 // All runs of all campaigns in a campaign directory's store.
