@@ -3,10 +3,13 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
+#include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
+#include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -15,6 +18,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -26,18 +30,23 @@ namespace ks = kernel::silo;
 
 namespace {
 
+// a [m], the slot width of a rectangular hopper when none is given (the seed's section 2.1.2 model).
+constexpr double kDefaultSlotWidth = 0.03;
+
 struct SiloCli {
     std::string geometry_file;
-    double theta = -1;  // -1: not given
-    double outlet = -1;  // -1: default (0.035 conical, a = 0.03 rectangular)
-    double diameter = 0.105;
-    double body_height = 0.4;
+    // Geometry: a value counts only where its option was given (sub.count); otherwise the --geometry file's, then
+    // the default (SiloGeometry's: the seed's silo).
+    double theta = 0;
+    double outlet = ks::SiloGeometry{}.outlet;
+    double diameter = ks::SiloGeometry{}.diameter;
+    double body_height = ks::SiloGeometry{}.body_height;
     bool rect = false;
-    double a = -1, b = 0.05, c = 0.1;
+    double a = kDefaultSlotWidth, b = ks::SiloGeometry{}.depth, c = ks::SiloGeometry{}.width;
     long particles = 50000;
     double fill_mass = 0;
     int threads = 0;
-    unsigned long seed = 1;
+    long long seed = 1;  // signed, so that a negative seed is refused rather than wrapped
     std::string out;
     std::string vtk;
     double vtk_every = 0.05;
@@ -105,66 +114,149 @@ std::string fixed(double v, int digits) {
     return buf;
 }
 
-// Reads --geometry FILE.json into the options the command line did not set itself.
-void apply_geometry_file(SiloCli& o, CLI::App& sub) {
-    const nlohmann::json j = read_json_file(o.geometry_file, "geometry");
-    if (!j.is_object()) throw UserError("geometry = '" + o.geometry_file + "': must be a JSON object");
-    auto number = [&](const std::string& key) {
-        const auto& v = j.at(key);
-        if (!v.is_number()) throw UserError(o.geometry_file + ": " + key + " = " + v.dump() + ": must be a number");
-        return v.get<double>();
-    };
+// One geometry quantity as given, and where: "--theta" or "FILE: theta_deg" (for the error messages).
+struct GivenValue {
+    double value;
+    std::string source;
+    bool named_slot_width = false;  // given as a_m or --a, which only a rectangular hopper has
+};
+
+// The geometry keys of a --geometry file and the options that set the same quantity; a_m and --a are the
+// rectangular slot width, which outlet_m / --outlet also set.
+constexpr std::pair<const char*, const char*> kGeometryKeys[] = {
+    {"theta_deg", "--theta"}, {"outlet_m", "--outlet"}, {"D_m", "--diameter"}, {"body_height_m", "--body-height"},
+    {"a_m", "--a"},           {"b_m", "--b"},           {"c_m", "--c"}};
+
+// The geometry given at one level (the file, or the command line), by file key; the slot width under "outlet_m".
+struct GeometryGiven {
+    std::optional<bool> rect;
+    std::string rect_source;
+    std::map<std::string, GivenValue> values;
+
+    // outlet_m and a_m name one quantity: both at one level is a contradiction, not a precedence.
+    void merge_slot_width() {
+        const auto a = values.find("a_m");
+        if (a == values.end()) return;
+        if (const auto d = values.find("outlet_m"); d != values.end())
+            throw UserError(d->second.source + " and " + a->second.source +
+                            " both set the outlet (slot) width; give one");
+        GivenValue slot = a->second;
+        slot.named_slot_width = true;
+        values.emplace("outlet_m", slot);
+        values.erase("a_m");
+    }
+};
+
+GeometryGiven read_geometry_file(const std::string& file) {
+    const nlohmann::json j = read_json_file(file, "geometry");
+    if (!j.is_object()) throw UserError("geometry = '" + file + "': must be a JSON object");
+    GeometryGiven g;
     for (const auto& [key, value] : j.items()) {
+        if (key.rfind("_", 0) == 0) continue;  // keys starting with '_' are comments
         if (key == "shape") {
             if (!value.is_string() || (value != "conical" && value != "rectangular"))
-                throw UserError(o.geometry_file + ": shape = " + value.dump() + ": must be \"conical\" or \"rectangular\"");
-            if (!sub.count("--rect")) o.rect = value == "rectangular";
-        } else if (key == "theta_deg") {
-            if (!sub.count("--theta")) o.theta = number(key);
-        } else if (key == "outlet_m") {
-            if (!sub.count("--outlet") && !sub.count("--a")) o.outlet = number(key);
-        } else if (key == "D_m") {
-            if (!sub.count("--diameter")) o.diameter = number(key);
-        } else if (key == "body_height_m") {
-            if (!sub.count("--body-height")) o.body_height = number(key);
-        } else if (key == "a_m") {
-            if (!sub.count("--a") && !sub.count("--outlet")) o.a = number(key);
-        } else if (key == "b_m") {
-            if (!sub.count("--b")) o.b = number(key);
-        } else if (key == "c_m") {
-            if (!sub.count("--c")) o.c = number(key);
-        } else if (key.rfind("_", 0) != 0) {  // keys starting with '_' are comments
-            throw UserError(o.geometry_file + ": unknown key '" + key +
-                            "' (known: shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m)");
+                throw UserError(file + ": shape = " + value.dump() + ": must be \"conical\" or \"rectangular\"");
+            g.rect = value == "rectangular";
+            g.rect_source = file + ": shape";
+            continue;
         }
+        const bool known = std::any_of(std::begin(kGeometryKeys), std::end(kGeometryKeys),
+                                       [&](const auto& k) { return key == k.first; });
+        if (!known)
+            throw UserError(file + ": unknown key '" + key +
+                            "' (known: shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m)");
+        if (!value.is_number()) throw UserError(file + ": " + key + " = " + value.dump() + ": must be a number");
+        g.values[key] = {value.get<double>(), file + ": " + key};
     }
+    return g;
 }
 
-ks::SiloCaseSettings settings_from(SiloCli o, CLI::App& sub) {
-    ks::SiloCaseSettings s;
-    if (!o.geometry_file.empty()) apply_geometry_file(o, sub);
-    if (o.theta == -1 && !sub.count("--theta"))
-        throw UserError("theta: missing; give --theta DEG (or theta_deg in --geometry)");
-    if (o.rect) {
-        if (sub.count("--diameter")) throw UserError("--diameter applies to the conical silo, not with --rect");
-        if (sub.count("--outlet") && sub.count("--a"))
-            throw UserError("--outlet and --a both set the slot width of the rectangular hopper; give one");
-        if (sub.count("--a") && !(o.a > 0)) throw UserError("a = " + std::to_string(o.a) + ": must be positive");
-        const double a = o.a != -1 ? o.a : (o.outlet != -1 ? o.outlet : 0.03);
-        s.geometry = ks::SiloGeometry::rectangular(o.theta, a, o.b, o.c, o.body_height);
-    } else {
-        for (const char* opt : {"--a", "--b", "--c"})
-            if (sub.count(opt)) throw UserError(std::string(opt) + " applies to a rectangular hopper: add --rect");
-        s.geometry = ks::SiloGeometry::conical(o.theta, o.outlet != -1 ? o.outlet : 0.035, o.diameter, o.body_height);
+GeometryGiven geometry_options(const SiloCli& o, CLI::App& sub) {
+    const std::map<std::string, double> option_value{{"--theta", o.theta}, {"--outlet", o.outlet},
+                                                     {"--diameter", o.diameter}, {"--body-height", o.body_height},
+                                                     {"--a", o.a}, {"--b", o.b}, {"--c", o.c}};
+    GeometryGiven g;
+    if (sub.count("--rect")) {
+        g.rect = true;
+        g.rect_source = "--rect";
     }
-    if (sub.count("--particles") && sub.count("--fill-mass"))
-        throw UserError("--particles and --fill-mass both set the amount of grain; give one");
-    s.particles = o.particles;
-    s.fill_mass = o.fill_mass;
-    s.threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    for (const auto& [key, option] : kGeometryKeys)
+        if (sub.count(option)) g.values[key] = {option_value.at(option), option};
+    return g;
+}
+
+// The command line over the --geometry file over the defaults; a quantity that does not belong to the shape is
+// refused wherever it was given.
+ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub) {
+    GeometryGiven given = o.geometry_file.empty() ? GeometryGiven{} : read_geometry_file(o.geometry_file);
+    GeometryGiven cli = geometry_options(o, sub);
+    given.merge_slot_width();
+    cli.merge_slot_width();
+    if (cli.rect) {
+        given.rect = cli.rect;
+        given.rect_source = cli.rect_source;
+    }
+    for (auto& [key, v] : cli.values) given.values.insert_or_assign(key, v);
+    const bool rect = given.rect.value_or(false);
+    const auto value = [&](const char* key) -> std::optional<double> {
+        const auto it = given.values.find(key);
+        return it == given.values.end() ? std::nullopt : std::optional<double>(it->second.value);
+    };
+    const auto refuse_if_given = [&](const char* key, const std::string& why) {
+        if (const auto it = given.values.find(key); it != given.values.end())
+            throw UserError(it->second.source + " = " + ks::setting_text(it->second.value) + ": " + why);
+    };
+    const auto theta = value("theta_deg");
+    if (!theta) throw UserError("theta: missing; give --theta DEG (or theta_deg in --geometry)");
+    const ks::SiloGeometry seed_silo;
+    if (rect) {
+        refuse_if_given("D_m", "the diameter applies to the conical silo, not to a rectangular one (" +
+                                   given.rect_source + ")");
+        return ks::SiloGeometry::rectangular(*theta, value("outlet_m").value_or(kDefaultSlotWidth),
+                                             value("b_m").value_or(seed_silo.depth),
+                                             value("c_m").value_or(seed_silo.width),
+                                             value("body_height_m").value_or(seed_silo.body_height));
+    }
+    const std::string add_rect = "applies to a rectangular hopper (add --rect, or \"shape\": \"rectangular\")";
+    refuse_if_given("b_m", add_rect);
+    refuse_if_given("c_m", add_rect);
+    if (const auto it = given.values.find("outlet_m"); it != given.values.end() && it->second.named_slot_width)
+        refuse_if_given("outlet_m", add_rect);
+    return ks::SiloGeometry::conical(*theta, value("outlet_m").value_or(seed_silo.outlet),
+                                     value("D_m").value_or(seed_silo.diameter),
+                                     value("body_height_m").value_or(seed_silo.body_height));
+}
+
+// --threads, or every core when not given.
+int thread_count(const SiloCli& o) {
+    return o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+// The options that shape a session rather than the run (also with --resume): checked before anything is written.
+void check_session_options(const SiloCli& o, CLI::App& sub) {
     if (sub.count("--threads") && o.threads < 1)
         throw UserError("threads = " + std::to_string(o.threads) + ": must be at least 1");
-    s.seed = o.seed;
+    if (!(o.checkpoint_every > 0) || !std::isfinite(o.checkpoint_every))
+        throw UserError("checkpoint-every = " + ks::setting_text(o.checkpoint_every) +
+                        ": must be a positive number of seconds");
+    if (!(o.wall_limit >= 0) || !std::isfinite(o.wall_limit))
+        throw UserError("wall-limit = " + ks::setting_text(o.wall_limit) +
+                        ": must be a number of seconds >= 0 (0: none)");
+}
+
+ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
+    check_session_options(o, sub);
+    ks::SiloCaseSettings s;
+    s.geometry = geometry_from(o, sub);
+    if (sub.count("--particles") && sub.count("--fill-mass"))
+        throw UserError("--particles and --fill-mass both set the amount of grain; give one");
+    if (sub.count("--vtk-every") && o.vtk.empty())
+        throw UserError("--vtk-every applies to the VTK snapshots: add --vtk DIR");
+    if (o.seed < 0) throw UserError("seed = " + std::to_string(o.seed) + ": must be >= 0");
+    s.particles = o.particles;
+    s.fill_mass = o.fill_mass;
+    s.threads = thread_count(o);
+    s.seed = static_cast<unsigned long>(o.seed);
     s.max_time = o.max_time;
     s.fill_time_max = o.fill_time;
     s.fill_time_min = std::min(s.fill_time_min, o.fill_time);
@@ -222,7 +314,7 @@ void write_plots(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::S
     if (r.section && r.section->frames() > 0) {
         const auto& sec = *r.section;
         {
-            std::ofstream f(dir / "section.dat");
+            std::ostringstream f;
             f << "# x_m z_m vz_m_s: mean vertical velocity in the mid-plane slab over " << sec.frames()
               << " frames of the steady discharge\n";
             for (int i = 0; i < sec.nx(); ++i)
@@ -230,6 +322,7 @@ void write_plots(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::S
                     const double v = sec.vz(i, k);
                     if (!std::isnan(v)) f << sec.x_centre(i) << " " << sec.z_centre(k) << " " << v << "\n";
                 }
+            orchestrator::write_text_file_atomically(dir / "section.dat", f.str());
         }
         sec.write_outline(dir / "section_outline.dat");
         double zmax = r.fill_height + 0.01;
@@ -295,14 +388,18 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
                         " to start over");
     if (o.no_checkpoint && o.wall_limit > 0)
-        throw UserError("--wall-limit " + (std::ostringstream() << o.wall_limit).str() +
+        throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
     std::error_code ec;
-    fs::create_directories(dir, ec);
+    const bool created_out = fs::create_directories(dir, ec);
     if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
     if (!s.vtk_dir.empty()) {
         fs::create_directories(s.vtk_dir, ec);
-        if (ec) throw UserError("vtk = '" + s.vtk_dir + "': cannot create the directory: " + ec.message());
+        if (ec) {
+            std::error_code ignored;
+            if (created_out) fs::remove(dir, ignored);  // nothing half-made left behind: it is empty
+            throw UserError("vtk = '" + s.vtk_dir + "': cannot create the directory: " + ec.message());
+        }
     }
     if (!o.no_checkpoint) {
         s.checkpoint_file = (dir / kCheckpointName).string();
@@ -333,15 +430,18 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
                                    "its checkpoint (only --threads, --checkpoint-every, --wall-limit and --no-plots "
                                    "apply)");
     }
+    check_session_options(o, sub);
+    if (o.resume.empty()) throw UserError("resume = '': give the output directory of the run to continue");
     const fs::path dir(o.resume);
     const fs::path file = dir / kCheckpointName;
+    if (fs::exists(file) && !fs::is_regular_file(file))
+        throw UserError("resume = '" + dir.string() + "': " + file.string() + " is not a regular file");
     if (!fs::exists(file)) {
         std::string why = fs::exists(dir / "summary.json") ? " (summary.json is there: that run has finished)"
                                                               : fs::exists(dir) ? "" : " (no such directory)";
         throw UserError("resume = '" + dir.string() + "' holds no " + kCheckpointName + why);
     }
-    if (o.no_checkpoint) throw UserError("--no-checkpoint cannot be combined with --resume");
-    const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = thread_count(o);
     ks::SiloCaseSettings s;
     try {
         s = ks::read_checkpoint_settings(file.string());
@@ -379,7 +479,6 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                   << dir.string() << "`" << std::endl;
         throw CLI::RuntimeError(kExitSuspended);
     }
-    ks::write_discharge_csv(dir / "discharge.csv", r.discharge);
     nlohmann::json j;
     j["geometry"] = geometry_json(s.geometry);
     j["grains"] = r.grains;
@@ -461,17 +560,23 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                                         {"friction", s.materials.wheat_steel.friction},
                                         {"rolling_friction", s.materials.wheat_steel.rolling_friction}}}}}};
     if (!s.vtk_dir.empty()) j["vtk"] = {{"dir", s.vtk_dir}, {"files", r.vtk_files}};
-    {
-        std::ofstream f(dir / "summary.json");
-        f << j.dump(2) << "\n";
+    try {
+        ks::write_discharge_csv(dir / "discharge.csv", r.discharge);
+        orchestrator::write_text_file_atomically(dir / "summary.json", j.dump(2) + "\n");
+    } catch (const std::exception& e) {
+        // the checkpoint stays: resuming from it computes the end again and writes the results
+        throw std::runtime_error(std::string(e.what()) + "; the results are not written" +
+                                 (s.checkpoint_file.empty() ? std::string()
+                                                            : "; the checkpoint is kept: make room, then `demcal silo "
+                                                              "--resume " + dir.string() + "` finishes the run again"));
     }
-    if (!no_plots) write_plots(dir, s, r);
-    // every output is written: the checkpoint has served its purpose (and would block a new run in this directory)
+    // the results are written: the checkpoint has served its purpose (and would block a new run in this directory)
     if (!s.checkpoint_file.empty()) {
         std::error_code ec;
         fs::remove(s.checkpoint_file, ec);
         fs::remove(s.checkpoint_file + ".tmp", ec);
     }
+    if (!no_plots) write_plots(dir, s, r);  // after the results: a plot that fails loses no data
 
     std::cout << "\n" << r.grains << " grains (" << fixed(r.filled_mass * 1e3, 1) << " g), filled in "
               << fixed(r.fill_time, 3) << " s" << (r.fill_at_rest ? " (at rest)" : " (time limit, not at rest)")
@@ -540,20 +645,18 @@ void add_silo_command(CLI::App& app) {
     sub->add_option("--checkpoint-every", o->checkpoint_every,
                     "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "
                     "the outputs are written)")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->capture_default_str();
     sub->add_flag("--no-checkpoint", o->no_checkpoint, "write no checkpoint");
     sub->add_option("--wall-limit", o->wall_limit,
                     "stop after this many wall-clock seconds of this session (0: none), at the end of a record "
                     "interval, with a checkpoint written; exit status 75: not finished, continue with --resume "
                     "(a batch system's time limit); SIGTERM or Ctrl-C does the same at any time")
-        ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->capture_default_str();
     sub->add_option("--resume", o->resume,
                     "continue the interrupted run whose output directory (and checkpoint.bin) is DIR, bit for bit, "
                     "with the settings stored in its checkpoint");
     sub->callback([o, sub] {
-        if (!o->resume.empty()) resume_silo(*o, *sub);
+        if (sub->count("--resume")) resume_silo(*o, *sub);
         else run_silo(*o, *sub);
     });
 }

@@ -12,8 +12,11 @@ int main(int argc, char** argv) {
     demcal::add_calibration_commands(app);
     try {
         app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
+    } catch (const CLI::RuntimeError& e) {  // a command's own exit status (75: suspended, resume it)
         return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        // --help and --version exit 0; a malformed command line is bad input like any other: exit 2
+        return app.exit(e) == 0 ? 0 : 2;
     } catch (const demcal::UserError& e) {
         std::cerr << "demcal: error: " << e.what() << "\n";
         return 2;

@@ -1,7 +1,9 @@
 #include "orchestrator/run_identity.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include <openssl/evp.h>
 
@@ -63,8 +65,12 @@ void write_text_file_atomically(const std::filesystem::path& p, const std::strin
     {
         std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
         f << text;
-        f.flush();
-        if (!f) throw std::runtime_error("cannot write " + tmp.string());
+        f.close();
+        if (!f) {
+            std::error_code ignored;
+            std::filesystem::remove(tmp, ignored);  // no half-written file left behind
+            throw std::runtime_error("cannot write " + p.string() + " (" + std::strerror(errno) + ")");
+        }
     }
     std::filesystem::rename(tmp, p);
 }

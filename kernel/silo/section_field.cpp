@@ -59,6 +59,8 @@ void SectionField::write_outline(const std::filesystem::path& file) const {
     for (int side : {-1, 1}) {
         f << side * r0 << " 0\n" << side * r1 << " " << hh << "\n" << side * r1 << " " << top << "\n\n";
     }
+    f.close();
+    if (!f) throw std::runtime_error("failed writing " + file.string());
 }
 
 }  // namespace demcal::kernel::silo

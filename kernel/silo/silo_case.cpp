@@ -173,10 +173,22 @@ void validate(const SiloCaseSettings& s) {
     validate(s.geometry, wheat_length);
     if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
     if (s.fill_mass == 0 && s.particles < 1) reject_setting("particles", double(s.particles), "must be at least 1");
-    if (s.particles > 5000000) reject_setting("particles", double(s.particles), "more than 5,000,000 grains");
+    constexpr double kMaxGrains = 5e6;  // 15e6 spheres: about 9 GB of state, beyond any machine this runs on
+    if (s.particles > kMaxGrains) reject_setting("particles", double(s.particles), "more than 5,000,000 grains");
+    const double grain_mass = s.materials.wheat.density * wheat_grain_volume();
+    if (s.fill_mass / grain_mass > kMaxGrains)
+        reject_setting("fill_mass", s.fill_mass,
+                       "more than 5,000,000 grains of " + setting_text(grain_mass * 1e3) + " g");
     if (!(s.materials.stiffness_scale > 0) || s.materials.stiffness_scale > 100)
         reject_setting("stiffness_scale", s.materials.stiffness_scale, "must lie in (0, 100]");
     if (s.time_step < 0 || !std::isfinite(s.time_step)) reject_setting("dt", s.time_step, "must be >= 0 s (0: automatic)");
+    double smallest_radius = 1;
+    for (const auto& sphere : wheat_clump()) smallest_radius = std::min(smallest_radius, sphere.radius);
+    // beyond the Rayleigh step the explicit integration of the stiffest contact is no longer resolved
+    if (const double rayleigh = rayleigh_time_step(s.materials.wheat_scaled(), smallest_radius); s.time_step > rayleigh)
+        reject_setting("dt", s.time_step,
+                       "larger than the Rayleigh time step of the smallest wheat sphere (" + setting_text(rayleigh) +
+                           " s at this stiffness); use a fraction of it, or --dt-fraction");
     if (!(s.time_step_fraction > 0 && s.time_step_fraction <= 1))
         reject_setting("dt_fraction", s.time_step_fraction, "must lie in (0, 1] (of the Rayleigh time step)");
     if (!(s.fill_time_max > 0) || !std::isfinite(s.fill_time_max)) reject_setting("fill_time", s.fill_time_max, "must be > 0 s");
@@ -733,7 +745,11 @@ SiloCaseResult resume_silo_case(const std::string& file, const SiloSession& sess
     s.wall_limit = session.wall_limit;
     s.stop_request = session.stop_request;
     SiloRun run(s, progress);
-    run.load(is, "checkpoint '" + file + "'", version);
+    try {
+        run.load(is, "checkpoint '" + file + "'", version);
+    } catch (const std::runtime_error& e) {  // a damaged or foreign file is bad input, wherever the damage lies
+        throw std::invalid_argument(e.what());
+    }
     return run.run();
 }
 

@@ -11,6 +11,7 @@ void write_discharge_csv(const std::filesystem::path& file, const std::vector<Di
     if (!f) throw std::runtime_error("cannot write " + file.string());
     f << "time_s,discharged_mass_kg,discharged_grains\n" << std::setprecision(9);
     for (const auto& r : rows) f << r.time << "," << r.mass << "," << r.grains << "\n";
+    f.close();  // the last buffer reaches the disk here: a full disk shows now
     if (!f) throw std::runtime_error("failed writing " + file.string());
 }
 
@@ -29,6 +30,7 @@ void write_vtk(const std::filesystem::path& file, const SphereSnapshot& s, doubl
     for (const auto& v : s.velocities) f << v.x() << " " << v.y() << " " << v.z() << "\n";
     f << "SCALARS clump int 1\nLOOKUP_TABLE default\n";
     for (long c : s.clump) f << c << "\n";
+    f.close();
     if (!f) throw std::runtime_error("failed writing " + file.string());
 }
 

@@ -1,5 +1,7 @@
 #include "kernel/silo/wheat.hpp"
 
+#include "kernel/material.hpp"
+
 #include <cmath>
 
 namespace demcal::kernel::silo {
@@ -10,10 +12,12 @@ std::vector<ClumpSphere> wheat_clump() {
             {Eigen::Vector3d(0.0015, 0, 0), 0.00125}};
 }
 
-double wheat_equivalent_diameter() { return std::cbrt(6 * (wheat_mass / 1430.0) / 3.14159265358979323846); }
+double wheat_grain_volume() { return wheat_mass / WheatMaterials{}.wheat.density; }
+
+double wheat_equivalent_diameter() { return std::cbrt(6 * wheat_grain_volume() / 3.14159265358979323846); }
 
 double rayleigh_time_step(const Material& m, double radius) {
-    return 3.14159265358979323846 * radius * std::sqrt(m.density / m.shear_modulus) / (0.1631 * m.poisson + 0.8766);
+    return kernel::rayleigh_timestep(radius, m.density, m.shear_modulus, m.poisson);
 }
 
 }  // namespace demcal::kernel::silo

@@ -20,7 +20,9 @@ inline constexpr double wheat_length = 0.0055;       // end to end [m]: the part
 inline constexpr double wheat_mass = 3.56e-5;        // seed [kg]
 inline constexpr double wheat_inertia_axial = 2.918e-11;      // seed [kg m^2]
 inline constexpr double wheat_inertia_transverse = 7.654e-11;  // seed [kg m^2]
-// Equivalent-volume sphere diameter of the grain (24.9 mm^3): (6 V / pi)^(1/3) = 3.62 mm.
+// Volume of the grain (the seed's mass at the seed's density): 24.9 mm^3.
+double wheat_grain_volume();
+// Equivalent-volume sphere diameter of the grain: (6 V / pi)^(1/3) = 3.62 mm.
 double wheat_equivalent_diameter();
 
 struct Material {

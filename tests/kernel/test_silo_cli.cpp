@@ -81,19 +81,44 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --particles 0", "particles = 0"},
                           Case{"--theta 30 --stiffness-scale -1", "stiffness_scale = -1"},
                           Case{"--theta 30 --stop-fraction 2", "stop_fraction = 2"},
-                          Case{"--theta 30 --b 0.05", "--b applies to a rectangular hopper"},
+                          Case{"--theta 30 --b 0.05", "--b = 0.05: applies to a rectangular hopper"},
                           Case{"--theta 30 --wall-limit 60 --no-checkpoint", "--wall-limit 60 needs the checkpoint"},
-                          Case{"", "theta: missing"}}) {
+                          Case{"", "theta: missing"},
+                          // a value that once meant "not given" is a value like any other
+                          Case{"--theta 30 --outlet -1", "outlet = -1"},
+                          Case{"--theta 30 --rect --outlet -1", "a (outlet width) = -1"},
+                          Case{"--theta 30 --seed -1", "seed = -1"},
+                          Case{"--theta 30 --a 0.02", "--a = 0.02: applies to a rectangular hopper"},
+                          Case{"--theta 30 --checkpoint-every nan", "checkpoint-every = nan"},
+                          Case{"--theta 30 --wall-limit -5", "wall-limit = -5"},
+                          Case{"--theta 30 --vtk /dev/null/x", "vtk = '/dev/null/x'"},
+                          Case{"--theta 30 --vtk-every 0.1", "--vtk-every applies to the VTK snapshots"},
+                          Case{"--theta 30 --fill-mass 1e9", "fill_mass = 1e+09"},
+                          Case{"--theta 30 --dt 1e-4", "dt = 0.0001: larger than the Rayleigh time step"},
+                          // the command-line parser's own refusals exit 2 as well
+                          Case{"--theta abc", "--theta = abc"},
+                          Case{"--theta 30 --thetaa 3", "not expected"}}) {
         INFO(c.args);
         const Run r = run_silo(c.args + " --out '" + out.string() + "'", dir);
         CHECK(r.rc == 2);
         CHECK_THAT(r.err, Catch::Matchers::Contains(c.expect));
         CHECK_FALSE(fs::exists(out));
     }
-    std::ofstream(dir / "g.json") << R"({"shape": "conical", "theta_deg": 30, "outlet_mm": 35})";
-    const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' --out '" + out.string() + "'", dir);
-    CHECK(r.rc == 2);
-    CHECK_THAT(r.err, Catch::Matchers::Contains("unknown key 'outlet_mm'"));
+    // a geometry file: the same rules as the options, the key named
+    for (const Case& c : {Case{R"({"shape": "conical", "theta_deg": 30, "outlet_mm": 35})", "unknown key 'outlet_mm'"},
+                          Case{R"({"theta_deg": -1})", "theta = -1"},
+                          Case{R"({"theta_deg": 30, "a_m": 0.02})", "a_m = 0.02: applies to a rectangular hopper"},
+                          Case{R"({"shape": "rectangular", "theta_deg": 30, "D_m": 0.2})", "D_m = 0.2: the diameter"},
+                          Case{R"({"shape": "rectangular", "theta_deg": 30, "outlet_m": 0.03, "a_m": 0.02})",
+                               "both set the outlet (slot) width"},
+                          Case{R"({"theta_deg": "30"})", R"(theta_deg = "30": must be a number)"}}) {
+        INFO(c.args);
+        std::ofstream(dir / "g.json") << c.args;
+        const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' --out '" + out.string() + "'", dir);
+        CHECK(r.rc == 2);
+        CHECK_THAT(r.err, Catch::Matchers::Contains(c.expect));
+        CHECK_FALSE(fs::exists(out));
+    }
     fs::remove_all(dir);
 }
 
@@ -112,6 +137,32 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     const std::string summary = read_file(dir / "out" / "summary.json");
     CHECK_THAT(summary, Catch::Matchers::Contains("\"wall_to_axis_velocity_ratio\""));
     CHECK_THAT(summary, Catch::Matchers::Contains("\"grains\": 300"));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal silo: results that cannot be written keep the checkpoint, and resuming writes them",
+          "[silo][cli]") {
+    require_demcal();
+    const fs::path dir = fs::temp_directory_path() / "demcal_test_silo_cli_unwritable";
+    fs::remove_all(dir);
+    const fs::path out = dir / "out";
+    fs::create_directories(out / "summary.json" / "in_the_way");  // a directory where summary.json must go
+    const Run r = run_silo("--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
+                               "/examples/silo/reduced_conical_70deg.json' --theta 45 --particles 300 "
+                               "--stiffness-scale 0.001 --fill-time 0.3 --max-time 0.2 --threads 1 --no-plots "
+                               "--checkpoint-every 0.001 --out '" + out.string() + "'",
+                           dir);
+    INFO(r.err);
+    CHECK(r.rc == 1);
+    CHECK_THAT(r.err, Catch::Matchers::Contains("the results are not written"));
+    CHECK_THAT(r.err, Catch::Matchers::Contains("the checkpoint is kept"));
+    REQUIRE(fs::exists(out / "checkpoint.bin"));
+    fs::remove_all(out / "summary.json");
+    const Run resumed = run_silo("--resume '" + out.string() + "' --threads 1", dir);
+    INFO(resumed.err);
+    CHECK(resumed.rc == 0);
+    CHECK_THAT(read_file(out / "summary.json"), Catch::Matchers::Contains("\"grains\": 300"));
+    CHECK_FALSE(fs::exists(out / "checkpoint.bin"));
     fs::remove_all(dir);
 }
 
@@ -147,6 +198,14 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to th
     const Run again = run_silo(case_args + "--out '" + out.string() + "'", dir);
     CHECK(again.rc == 2);
     CHECK_THAT(again.err, Catch::Matchers::Contains("holds the checkpoint of an unfinished run"));
+    // a damaged checkpoint (cut short in the run's state) is bad input: exit 2, the file left as it was
+    const std::string bytes = read_file(ckpt);
+    fs::create_directories(dir / "cut");
+    std::ofstream(dir / "cut" / "checkpoint.bin", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    const Run damaged = run_silo("--resume '" + (dir / "cut").string() + "' --threads 1", dir);
+    CHECK(damaged.rc == 2);
+    CHECK_THAT(damaged.err, Catch::Matchers::Contains("checkpoint"));
+    CHECK(read_file(dir / "cut" / "checkpoint.bin") == bytes.substr(0, bytes.size() / 2));
     // a resumed run keeps its stored settings
     const Run mixed = run_silo("--resume '" + out.string() + "' --theta 30", dir);
     CHECK(mixed.rc == 2);
