@@ -83,6 +83,11 @@ double jenike_mass_flow_limit_deg(double effective_friction_deg, double wall_fri
         throw std::invalid_argument("delta_e_deg=" + num(effective_friction_deg) + " not in (0, 90)");
     if (!(wall_friction_deg >= 0 && wall_friction_deg < 90))
         throw std::invalid_argument("phi_w_deg=" + num(wall_friction_deg) + " not in [0, 90)");
+    // the approximation's arccos needs sin(delta_e) >= 1/3; bulk solids lie well above (wheat: about 30-40 deg)
+    if (std::sin(rad(effective_friction_deg)) < 1.0 / 3.0)
+        throw std::invalid_argument("delta_e_deg=" + num(effective_friction_deg) +
+                                    " is below 19.47 deg, where the approximation of Jenike's mass-flow limit is "
+                                    "not defined (sin(delta_e) < 1/3)");
     if (wall_friction_deg >= effective_friction_deg)
         throw std::invalid_argument("phi_w_deg=" + num(wall_friction_deg) +
                                     " is not below delta_e_deg=" + num(effective_friction_deg) +

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
+#include <sstream>
 
 namespace demcal {
 
@@ -13,9 +15,50 @@ nlohmann::json read_json_file(const std::string& path, const std::string& field)
     if (!f) throw UserError(field + " = '" + path + "' cannot be read");
     try {
         return nlohmann::json::parse(f);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number too large for a double
         throw UserError(field + " = '" + path + "' is not valid JSON: " + e.what());
     }
+}
+
+namespace {
+
+// A validator that accepts a finite number for which `ok` holds; `what` completes "VALUE is not ...".
+CLI::Validator number_check(const std::string& what, std::function<bool(double)> ok) {
+    return CLI::Validator(
+        [what, ok](std::string& text) -> std::string {
+            double v = 0;
+            size_t used = 0;
+            try {
+                v = std::stod(text, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used == 0 || used != text.size()) return "'" + text + "' is not a number";
+            if (!std::isfinite(v) || !ok(v)) return text + " is not " + what;
+            return {};
+        },
+        what);
+}
+
+std::string bound_text(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+}  // namespace
+
+CLI::Validator number_in(double lo, double hi) {
+    return number_check("between " + bound_text(lo) + " and " + bound_text(hi),
+                        [lo, hi](double v) { return v >= lo && v <= hi; });
+}
+
+CLI::Validator positive_number() {
+    return number_check("a positive number", [](double v) { return v > 0; });
+}
+
+CLI::Validator non_negative_number() {
+    return number_check("a number >= 0", [](double v) { return v >= 0; });
 }
 
 std::string duration_text(double seconds) {

@@ -1,5 +1,6 @@
-// Small helpers every subcommand shares: reading a JSON input file, printing a duration.
+// Small helpers every subcommand shares: reading a JSON input file, checking a number option, printing a duration.
 #pragma once
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <string>
@@ -8,6 +9,12 @@ namespace demcal {
 
 // Parses the JSON file at `path`; a missing file or bad JSON is a UserError naming `field` and the path.
 nlohmann::json read_json_file(const std::string& path, const std::string& field);
+
+// Checks of number options. CLI11's own Range and PositiveNumber let NaN through and print their bounds with 300
+// digits; these refuse NaN and infinities and state the bounds as a user would type them.
+CLI::Validator number_in(double lo, double hi);  // lo <= x <= hi
+CLI::Validator positive_number();                // x > 0
+CLI::Validator non_negative_number();            // x >= 0
 
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);

@@ -40,7 +40,7 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
     cmd->add_option("--normal-stress,-s", c.normal_stresses, "normal stresses of every failure line [Pa]")
         ->delimiter(',')
         ->capture_default_str();
-    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(CLI::PositiveNumber);
+    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(positive_number());
     cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)");
     cmd->add_option("--campaign,-c", c.campaign_dir, "campaign directory (store, runs, results)")->capture_default_str();
     cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
@@ -76,12 +76,17 @@ std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<
     return out;
 }
 
-void check_stresses(const CampaignCli& c) {
+CampaignSettings settings_of(const CampaignCli& c, const std::string& label) {
+    return {c.normal_stresses, c.replicates, c.seed, c.template_path, label};
+}
+
+// The campaign every failure line will run (stresses, replicates, seeds, template), checked on `material` before the
+// campaign directory exists.
+void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
     if (c.normal_stresses.size() < 2)
         throw UserError("normal-stress: a failure line needs at least 2 normal stresses, got " +
                         std::to_string(c.normal_stresses.size()));
-    for (double s : c.normal_stresses)
-        if (!(s > 0)) throw UserError("normal-stress = " + std::to_string(s) + " must be > 0 Pa");
+    orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));
 }
 
 std::string duration(double s) {
@@ -100,10 +105,9 @@ struct CampaignSession {
     std::unique_ptr<orchestrator::ShearCampaignRunner> runner;
     FailureLineEvaluator evaluate;
     CampaignSession(const CampaignCli& c, const std::string& label) {
-        check_stresses(c);
         orchestrator::find_yade(c.exec.yade);
         runner = std::make_unique<orchestrator::ShearCampaignRunner>(c.campaign_dir, c.exec);
-        CampaignSettings settings{c.normal_stresses, c.replicates, c.seed, c.template_path, label};
+        const CampaignSettings settings = settings_of(c, label);
         auto progress = [](const orchestrator::CampaignProgress& p) {
             if (p.event != "failed" && p.event != "retry") return;  // the study prints one line per failure line
             std::cout << "    run " << p.event << " (sigma = " << (p.run ? p.run->label.value("normal_stress", 0.0) : 0)
@@ -189,11 +193,10 @@ void write_study(const fs::path& dir, const SensitivityStudy& study, const std::
     }
 }
 
-// Checks every level before anything is written or run: a bad range must not cost simulations.
+// Checks every level's material before anything is written or run: a bad range must not cost simulations.
 void check_study(const nlohmann::json& base, const SensitivityCli& o) {
-    const auto options = sensitivity_options(o);
-    for (const auto& name : options.params.empty() ? orchestrator::micromechanical_param_names() : options.params)
-        sensitivity_levels(base, name, options);
+    sensitivity_plan(base, sensitivity_options(o));
+    check_campaign(o.campaign, base);
 }
 
 SensitivityStudy run_study(const nlohmann::json& base, const SensitivityCli& o, const FailureLineEvaluator& evaluate) {
@@ -259,8 +262,14 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
         const auto colon = item.find(':');
         try {
             if (colon == std::string::npos) throw std::invalid_argument(item);
-            sigma.push_back(std::stod(item.substr(0, colon)));
-            tau.push_back(std::stod(item.substr(colon + 1)));
+            const auto whole_number = [](const std::string& text) {  // "5e3x" is not 5e3
+                std::size_t used = 0;
+                const double v = std::stod(text, &used);
+                if (used != text.size()) throw std::invalid_argument(text);
+                return v;
+            };
+            sigma.push_back(whole_number(item.substr(0, colon)));
+            tau.push_back(whole_number(item.substr(colon + 1)));
         } catch (const std::exception&) {
             throw UserError("measured point '" + item + "' is not of the form SIGMA:TAU (Pa)");
         }
@@ -305,18 +314,29 @@ void add_calibrate(CLI::App& app) {
         options.max_evaluations = o->max_evaluations;
         options.grid_points = o->grid_points;
         options.line = line_kind_from_string(camp.line);
-        if (!(o->tol > 0 && o->tol < 1)) throw UserError("tol = " + std::to_string(o->tol) + " must be in (0, 1)");
+        // every option checked before the study or the campaign runs, and before the log is rewritten
+        check_calibration_options(options);
+        if (!o->controls.empty() && o->controls.size() != targets.size())
+            throw UserError("controls: " + std::to_string(o->controls.size()) + " given for " +
+                            std::to_string(targets.size()) + " targets");
+        for (const auto& [name, range] : bounds) check_control(start, {name, range.first, range.second});
         if (o->sensitivity_file.empty()) {
             if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
             check_study(start, o->study);
         }
+        check_campaign(camp, start);
+        SensitivityStudy study;
+        if (!o->sensitivity_file.empty()) {
+            try {
+                study = SensitivityStudy::from_json(read_json_file(o->sensitivity_file, "sensitivity"));
+            } catch (const nlohmann::json::exception& e) {  // a key missing or of the wrong type
+                throw UserError("sensitivity = '" + o->sensitivity_file + "': " + e.what());
+            }
+        }
         CampaignSession session(camp, "calibrate");
         const fs::path dir = camp.campaign_dir;
 
-        SensitivityStudy study;
-        if (!o->sensitivity_file.empty()) {
-            study = SensitivityStudy::from_json(read_json_file(o->sensitivity_file, "sensitivity"));
-        } else {
+        if (o->sensitivity_file.empty()) {
             study = run_study(start, o->study, session.evaluate);
             write_study(dir, study, camp.plot_format);
             std::cout << "\n" << study.table() << std::endl;
@@ -325,9 +345,6 @@ void add_calibrate(CLI::App& app) {
         if (o->controls.empty()) {
             controls = choose_controls(study, targets, o->tol, {}, bounds);
         } else {
-            if (o->controls.size() != targets.size())
-                throw UserError("controls: " + std::to_string(o->controls.size()) + " given for " +
-                                std::to_string(targets.size()) + " targets");
             for (const auto& name : o->controls) {
                 const auto* p = study.find(name);
                 auto b = bounds.find(name);
@@ -347,7 +364,8 @@ void add_calibrate(CLI::App& app) {
         const fs::path log_path = dir / ("calibration_log_" + o->method + ".jsonl");
         // Rewritten by every invocation, like calibration_<method>.json: a resumed calibration replays its finished
         // evaluations from the store, so the log still holds all of them once, in order (appending repeated them).
-        std::ofstream log(log_path, std::ios::trunc);
+        // Opened at the first evaluation: a calibration refused before it leaves the previous log as it was.
+        std::ofstream log;
         const auto result = calibrate(start, targets, controls, &study, session.evaluate, options,
                                       [&](const CalibrationIteration& it) {
                                           std::ostringstream line;  // own stream: cout's format stays as it was
@@ -362,6 +380,7 @@ void add_calibrate(CLI::App& app) {
                                                << "  [" << it.simulations_run << " run, "
                                                << it.simulations_reused << " reused]";
                                           std::cout << line.str() << std::endl;
+                                          if (!log.is_open()) log.open(log_path, std::ios::trunc);
                                           log << it.to_json().dump() << "\n" << std::flush;
                                       });
         auto summary = result.to_json();
@@ -396,7 +415,30 @@ struct EnlargeCli {
     std::vector<std::string> materials;
     std::string output = "enlargement.json";
     std::string plot_format = "png";
+    bool no_plot = false;
 };
+
+// The points and both fitted laws, side by side: OUTPUT with the plot's extension, its data in OUTPUT.dat.
+void plot_enlargement(const fs::path& output, const std::vector<double>& r, const std::vector<double>& e,
+                      const std::vector<double>& nu, const analytics::ScalingLawFit& e_law,
+                      const analytics::ScalingLawFit& nu_law, const std::string& format) {
+    fs::path data = output, picture = output;
+    data.replace_extension(".dat");
+    picture.replace_extension("." + format);
+    std::ostringstream d;
+    d << "# particle_radius_m young_modulus_Pa poisson_ratio\n" << std::setprecision(10);
+    for (std::size_t i = 0; i < r.size(); ++i) d << r[i] << " " << e[i] << " " << nu[i] << "\n";
+    orchestrator::write_text_file_atomically(data, d.str());
+    std::ostringstream g;
+    g << std::setprecision(10) << "set multiplot layout 1,2\nset xlabel 'particle radius r_p [mm]'\nunset key\n"
+      << "set ylabel 'E [MPa]'\nset title 'E(r_p) = A r_p + B'\n"
+      << "plot " << gnuplot_quote(data) << " using ($1*1e3):($2/1e6) with points pt 7, (" << e_law.params[0].value
+      << " * x / 1e3 + " << e_law.params[1].value << ") / 1e6 with lines lw 2\n"
+      << "set ylabel 'nu (YADE ks/kn)'\nset title 'nu(r_p) = C r_p^{-D}'\n"
+      << "plot " << gnuplot_quote(data) << " using ($1*1e3):3 with points pt 7, " << nu_law.params[0].value
+      << " * (x / 1e3)**(-" << nu_law.params[1].value << ") with lines lw 2\nunset multiplot\n";
+    render_gnuplot(picture, g.str(), 1000, 450);
+}
 
 void add_enlarge(CLI::App& app) {
     auto o = std::make_shared<EnlargeCli>();
@@ -406,7 +448,13 @@ void add_enlarge(CLI::App& app) {
         ->required();
     cmd->add_option("--output,-o", o->output, "result JSON (a plot beside it)")->capture_default_str();
     cmd->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    cmd->add_flag("--no-plot", o->no_plot, "write no plot (no gnuplot needed)");
     cmd->callback([o] {
+        if (fs::path(o->output).extension() != ".json")  // the plot and its data take the same name
+            throw UserError("output = '" + o->output + "': must end in .json");
+        const fs::path folder = fs::path(o->output).parent_path();
+        if (!folder.empty() && !fs::is_directory(folder))
+            throw UserError("output = '" + o->output + "': the directory " + folder.string() + " does not exist");
         std::vector<double> r, e, nu;
         for (const auto& file : o->materials) {
             const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
@@ -424,12 +472,15 @@ void add_enlarge(CLI::App& app) {
         for (std::size_t i = 0; i < r.size(); ++i)
             j["points"].push_back({{"particle_radius", r[i]}, {"young_modulus", e[i]}, {"poisson_ratio", nu[i]}});
         orchestrator::write_text_file_atomically(o->output, j.dump(2) + "\n");
+        if (!o->no_plot) plot_enlargement(o->output, r, e, nu, e_law, nu_law, o->plot_format);
         std::cout << "E(r)  = A r + B:  A = " << e_law.params[0].value << " +/- " << e_law.params[0].std_error
                   << " Pa/m, B = " << e_law.params[1].value << " +/- " << e_law.params[1].std_error << " Pa (R^2 "
                   << e_law.r_squared << ")\n"
                   << "nu(r) = C r^-D:   C = " << nu_law.params[0].value << " +/- " << nu_law.params[0].std_error
                   << ", D = " << nu_law.params[1].value << " +/- " << nu_law.params[1].std_error << " (R^2 "
-                  << nu_law.r_squared << "; nu is YADE's ks/kn)\nresults: " << o->output << "\n";
+                  << nu_law.r_squared << "; nu is YADE's ks/kn)\nresults: " << o->output
+                  << (o->no_plot ? "" : ", " + fs::path(o->output).replace_extension("." + o->plot_format).string())
+                  << "\n";
     });
 }
 

@@ -263,14 +263,14 @@ void add_discharge_commands(CLI::App& app) {
     diagnose->add_option("--alpha", args->options.family_alpha,
                          "family-wise error rate of each round's candidate tests (Holm)")
         ->capture_default_str()
-        ->check(CLI::Range(1e-6, 0.5));
+        ->check(number_in(1e-6, 0.5));
     diagnose->add_option("--min-cv-gain", args->options.min_cv_improvement,
                          "least relative drop of the cross-validated RMSE for an effect to be added")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 0.9));
+        ->check(number_in(0.0, 0.9));
     diagnose->add_option("--max-effects", args->options.max_effects, "most effects to add")
         ->capture_default_str()
-        ->check(CLI::Range(0, 10));
+        ->check(number_in(0, 10));
     diagnose->footer(diagnose_help);
     diagnose->callback([args] { run_diagnose(*args); });
 }

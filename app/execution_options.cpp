@@ -1,11 +1,13 @@
 #include "app/execution_options.hpp"
 
+#include "app/cli_support.hpp"
+
 namespace demcal {
 
 void add_execution_options(CLI::App* cmd, orchestrator::ExecutionOptions& e) {
-    cmd->add_option("--jobs,-j", e.jobs, "runs in parallel (0 = one per core)")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--timeout", e.timeout_s, "per-run wall-clock limit [s]")->check(CLI::PositiveNumber);
-    cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--jobs,-j", e.jobs, "runs in parallel (0 = one per core)")->check(non_negative_number());
+    cmd->add_option("--timeout", e.timeout_s, "per-run wall-clock limit [s]")->check(positive_number());
+    cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout")->check(non_negative_number());
     cmd->add_option("--executor", e.executor, "local (process pool) or slurm (job arrays)")
         ->check(CLI::IsMember({"local", "slurm"}));
     cmd->add_option("--partition", e.slurm_partition, "SLURM partition (slurm executor)");

@@ -659,32 +659,43 @@ std::vector<ControlParameter> choose_controls(const SensitivityStudy& study, con
     return controls;
 }
 
-CalibrationResult calibrate(const nlohmann::json& start, const std::vector<MacroTarget>& targets,
-                            const std::vector<ControlParameter>& controls, const SensitivityStudy* study,
-                            const FailureLineEvaluator& evaluate, const CalibrationOptions& options,
-                            const IterationCallback& on_iteration) {
+void check_calibration_options(const CalibrationOptions& options) {
     if (!(options.tolerance > 0 && options.tolerance < 1))
         throw std::invalid_argument("tol = " + num(options.tolerance) + " must be in (0, 1) (a relative distance)");
     if (options.max_evaluations < 1)
         throw std::invalid_argument("max-evaluations = " + std::to_string(options.max_evaluations) + " must be >= 1");
     if (options.method == SearchMethod::grid && options.grid_points < 2)
         throw std::invalid_argument("grid-points = " + std::to_string(options.grid_points) + " must be >= 2");
+}
+
+void check_control(const nlohmann::json& start, const ControlParameter& c) {
+    const auto* spec = orchestrator::find_shear_param(c.name);
+    if (!spec) throw std::invalid_argument("controlling parameter '" + c.name + "' is not a material parameter");
+    if (!(c.low < c.high))
+        throw std::invalid_argument("bounds of " + c.name + " = " + num(c.low) + ":" + num(c.high) +
+                                    " must have low < high");
+    const double v = start.at(c.name).get<double>();
+    if (v < c.low || v > c.high)
+        throw std::invalid_argument("start value " + c.name + " = " + num(v) + " is outside its bounds " +
+                                    num(c.low) + ":" + num(c.high));
+    for (double end : {c.low, c.high}) {  // the search evaluates materials up to either end
+        nlohmann::json material = start;
+        material[c.name] = end;
+        orchestrator::validate_material(material, "bounds of " + c.name + " = " + num(c.low) + ":" + num(c.high));
+    }
+}
+
+CalibrationResult calibrate(const nlohmann::json& start, const std::vector<MacroTarget>& targets,
+                            const std::vector<ControlParameter>& controls, const SensitivityStudy* study,
+                            const FailureLineEvaluator& evaluate, const CalibrationOptions& options,
+                            const IterationCallback& on_iteration) {
+    check_calibration_options(options);
     if (controls.empty()) throw std::invalid_argument("no controlling parameter to calibrate");
     if (targets.empty()) throw std::invalid_argument("no target to calibrate to");
     if (options.sequential && controls.size() != targets.size())
         throw std::invalid_argument("--sequential needs one controlling parameter per target, got " +
                                     std::to_string(controls.size()) + " for " + std::to_string(targets.size()));
-    for (const auto& c : controls) {
-        const auto* spec = orchestrator::find_shear_param(c.name);
-        if (!spec) throw std::invalid_argument("controlling parameter '" + c.name + "' is not a material parameter");
-        if (!(c.low < c.high))
-            throw std::invalid_argument("bounds of " + c.name + " = " + num(c.low) + ":" + num(c.high) +
-                                        " must have low < high");
-        const double v = start.at(c.name).get<double>();
-        if (v < c.low || v > c.high)
-            throw std::invalid_argument("start value " + c.name + " = " + num(v) + " is outside its bounds " +
-                                        num(c.low) + ":" + num(c.high));
-    }
+    for (const auto& c : controls) check_control(start, c);
     if (options.method == SearchMethod::surrogate && !study)
         throw std::invalid_argument("the surrogate search needs a sensitivity study");
     CalibrationResult result;

@@ -89,6 +89,12 @@ std::vector<ControlParameter> choose_controls(const SensitivityStudy& study, con
                                               double tolerance, const std::vector<std::string>& candidates = {},
                                               const std::map<std::string, std::pair<double, double>>& bounds = {});
 
+// The checks calibrate() makes before its first evaluation, for a caller to make before it runs anything else
+// (a sensitivity study, a campaign): the options' values, and a control's bounds (a material parameter, low < high,
+// `start` inside, both ends admissible values of a run's material). Throw std::invalid_argument naming the field.
+void check_calibration_options(const CalibrationOptions& options);
+void check_control(const nlohmann::json& start, const ControlParameter& control);
+
 // Runs the calibration from `start` (whose control values must lie inside the bounds). The surrogate method needs
 // `study` holding every control; the baselines ignore it. Throws std::invalid_argument for bad options or controls.
 CalibrationResult calibrate(const nlohmann::json& start, const std::vector<MacroTarget>& targets,

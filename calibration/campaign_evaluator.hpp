@@ -17,6 +17,9 @@ struct CampaignSettings {
     long base_seed = 1;                    // fixed: common random numbers across materials
     std::filesystem::path template_path;   // empty: the installed yade_scripts/shear_box.py
     std::string label;                     // campaign label prefix, e.g. "sensitivity" or "calibrate"
+
+    // The campaign of one failure line of `material`.
+    orchestrator::ShearCampaignSpec spec_for(const nlohmann::json& material) const;
 };
 
 // Evaluates materials through `runner` (which must outlive the evaluator). Throws std::runtime_error when the campaign

@@ -37,6 +37,30 @@ bool admissible(const orchestrator::ParamSpec& s, double v) {
     return std::isfinite(v) && above_min && below_max;
 }
 
+// Whether `base` with `name` = v is a valid run material (its range, and the box at least 4 particle lengths).
+bool valid_level(const nlohmann::json& base, const std::string& name, double v) {
+    nlohmann::json material = base;
+    material[name] = v;
+    try {
+        orchestrator::validate_material(material);
+        return true;
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+}
+
+// `end` when valid; else the farthest valid value from the (valid) base towards it, found by bisection and kept 2 %
+// of the way inside, so that rounding the levels (6 significant digits) cannot cross the limit.
+double farthest_valid(const nlohmann::json& base, const std::string& name, double base_value, double end) {
+    if (end == base_value || valid_level(base, name, end) || !valid_level(base, name, base_value)) return end;
+    double good = base_value, bad = end;
+    for (int i = 0; i < 50; ++i) {
+        const double mid = 0.5 * (good + bad);
+        (valid_level(base, name, mid) ? good : bad) = mid;
+    }
+    return base_value + 0.98 * (good - base_value);
+}
+
 }  // namespace
 
 std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::string& name,
@@ -73,6 +97,9 @@ std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::st
             lo += shift, hi += shift;
         }
         if (!admissible(spec, hi)) hi = spec.max - (spec.max_exclusive ? margin : 0);
+        // and inside what the rest of the material allows (particle_form and particle_radius against the box size)
+        lo = farthest_valid(base, name, b, lo);
+        hi = farthest_valid(base, name, b, hi);
     }
     if (!admissible(spec, lo) || !admissible(spec, hi))
         throw std::invalid_argument("range of " + name + " = " + number_text(lo) + ":" + number_text(hi) +
@@ -105,22 +132,35 @@ void fit_responses(ParameterSensitivity& p, const analytics::ResponseShapeOption
     p.tau_c = analytics::classify_response(x, tau, se_tau, p.base_value, shape);
 }
 
+std::vector<std::pair<std::string, std::vector<std::pair<double, nlohmann::json>>>>
+sensitivity_plan(const nlohmann::json& base, const SensitivityOptions& options) {
+    if (!(options.shape.alpha > 0 && options.shape.alpha < 1))
+        throw std::invalid_argument("alpha = " + number_text(options.shape.alpha) + " must be in (0, 1)");
+    std::vector<std::pair<std::string, std::vector<std::pair<double, nlohmann::json>>>> plan;
+    for (const auto& name : options.params.empty() ? orchestrator::micromechanical_param_names() : options.params) {
+        std::vector<std::pair<double, nlohmann::json>> levels;
+        for (double v : sensitivity_levels(base, name, options)) {
+            nlohmann::json material = base;
+            material[name] = v;
+            orchestrator::validate_material(material, "sensitivity level " + name + " = " + number_text(v));
+            levels.emplace_back(v, std::move(material));
+        }
+        plan.emplace_back(name, std::move(levels));
+    }
+    return plan;
+}
+
 SensitivityStudy run_sensitivity_study(const nlohmann::json& base, const FailureLineEvaluator& evaluate,
                                        const SensitivityOptions& options, const SensitivityProgress& progress) {
     SensitivityStudy study;
     study.base_material = base;
     study.options = options;
     if (study.options.params.empty()) study.options.params = orchestrator::micromechanical_param_names();
-    // All levels are checked before the first simulation, so a bad range fails at once.
-    std::vector<std::vector<double>> all_levels;
-    for (const auto& name : study.options.params) all_levels.push_back(sensitivity_levels(base, name, study.options));
-    for (std::size_t k = 0; k < study.options.params.size(); ++k) {
+    for (const auto& [name, levels] : sensitivity_plan(base, study.options)) {  // checked before the first run
         ParameterSensitivity p;
-        p.name = study.options.params[k];
+        p.name = name;
         p.base_value = base.at(p.name).get<double>();
-        for (double v : all_levels[k]) {
-            nlohmann::json material = base;
-            material[p.name] = v;
+        for (const auto& [v, material] : levels) {
             const auto ev = evaluate(material);
             const auto& line = line_of(ev, options.line);
             SensitivityLevel l{v,

@@ -55,11 +55,18 @@ struct SensitivityStudy {
     std::string table() const;
 };
 
-// The values a parameter takes in the study. Throws std::invalid_argument naming the parameter and the value when it
-// is not a micromechanical parameter, when its base is 0 with no explicit range, or when a range leaves its
-// admissible interval.
+// The values a parameter takes in the study: an explicit range as given, else base * (1 -+ span) moved inside the
+// admissible interval and shrunk towards the base where the material would be invalid (a box under 4 particle
+// lengths). Throws std::invalid_argument naming the parameter and the value when it is not a micromechanical
+// parameter, when its base is 0 with no explicit range, or when a range leaves its admissible interval.
 std::vector<double> sensitivity_levels(const nlohmann::json& base_material, const std::string& name,
                                        const SensitivityOptions& options);
+
+// Every material the study would simulate, per parameter in study order ({name, [(value, material)]}), each
+// checked as a run's material (its range, a box large enough for the particles), and the shape test's alpha: a study
+// that would stop after hours of simulation stops here instead. Throws std::invalid_argument naming the field.
+std::vector<std::pair<std::string, std::vector<std::pair<double, nlohmann::json>>>>
+sensitivity_plan(const nlohmann::json& base_material, const SensitivityOptions& options);
 
 // Fits the two responses of one parameter from its levels.
 void fit_responses(ParameterSensitivity& p, const analytics::ResponseShapeOptions& shape);

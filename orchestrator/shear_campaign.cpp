@@ -134,6 +134,9 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
     if (spec.replicates < 1)
         throw std::invalid_argument("replicates = " + std::to_string(spec.replicates) + " must be at least 1");
     if (spec.base_seed < 0) throw std::invalid_argument("seed = " + std::to_string(spec.base_seed) + " must be >= 0");
+    // every run's own fields in their ranges (each stress, the last replicate's seed), before anything is written
+    const nlohmann::json material = validate_material(spec.material);
+    for (double s : spec.normal_stresses) make_run_params(material, s, spec.base_seed + spec.replicates - 1);
     const ShearCampaignSpec s = resolved(spec);
     if (!fs::is_regular_file(s.template_path))
         throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");

@@ -63,6 +63,9 @@ TEST_CASE("Rose-Tanaka factor and Jenike's mass-flow limit", "[discharge]") {
     // Smoother walls keep wider hoppers in mass flow.
     CHECK(jenike_mass_flow_limit_deg(50, 10) > jenike_mass_flow_limit_deg(50, 20));
     CHECK_THROWS_WITH(jenike_mass_flow_limit_deg(30, 35), Catch::Contains("phi_w_deg=35"));
+    // below 19.47 deg the approximation's arccos has no value: refused rather than NaN
+    CHECK_THROWS_WITH(jenike_mass_flow_limit_deg(15, 5), Catch::Contains("delta_e_deg=15"));
+    CHECK(std::isfinite(jenike_mass_flow_limit_deg(19.5, 5)));
 }
 
 TEST_CASE("the rectangular Oldal model says when it is used outside its limits", "[discharge]") {

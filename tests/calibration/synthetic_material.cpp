@@ -12,8 +12,8 @@ nlohmann::json synthetic_base_material() {
     return {{"density", 2650.0},          {"young_modulus", 5e7},        {"poisson_ratio", 0.3},
             {"friction_coefficient", 0.5}, {"bond_normal_strength", 2000.0}, {"bond_shear_strength", 2000.0},
             {"particle_form", 1.0},       {"timestep_fraction", 0.5},    {"particle_radius", 0.002},
-            {"radius_spread", 0.1},       {"box_length", 0.04},          {"box_width", 0.04},
-            {"box_height", 0.02},         {"shear_velocity", 0.05},      {"shear_displacement", 0.004},
+            {"radius_spread", 0.1},       {"box_length", 0.08},          {"box_width", 0.08},
+            {"box_height", 0.04},         {"shear_velocity", 0.05},      {"shear_displacement", 0.004},
             {"damping", 0.2},             {"samples", 40}};
 }
 

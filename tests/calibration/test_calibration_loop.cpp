@@ -1,7 +1,9 @@
 // The sensitivity study and the calibration loop on the analytic shear box (tests/calibration/synthetic_material):
 // known shapes, a hidden target material, an unreachable target, and the grid / coordinate baselines.
 #include "calibration/calibration_loop.hpp"
+#include "orchestrator/shear_params.hpp"
 #include "synthetic_material.hpp"
+#include "test_files.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -189,6 +191,27 @@ TEST_CASE("bad targets and options are refused with the field named", "[calibrat
     const auto form = sensitivity_levels(base, "particle_form", o);  // a sphere base slides up, inside [1, 3]
     CHECK(form.front() == 1.0);
     CHECK(form.back() == Approx(2.0));
+    // ... and shrinks towards the base where the box would hold fewer than 4 particle lengths
+    const auto tiny = orchestrator::validate_material(nlohmann::json::parse(
+        test::read_file(std::string(DEMCAL_SOURCE_DIR) + "/examples/materials/sand-tiny.json")));
+    const auto tiny_form = sensitivity_levels(tiny, "particle_form", o);
+    CHECK(tiny_form.front() == 1.0);
+    CHECK(tiny_form.back() > 1.0);
+    CHECK(tiny_form.back() < 2.0);
+    for (double v : tiny_form) {
+        auto m = tiny;
+        m["particle_form"] = v;
+        CHECK_NOTHROW(orchestrator::validate_material(m));
+    }
+    // an explicit range is the user's: refused, with the level named, before any run
+    o.params = {"particle_form"};
+    o.ranges["particle_form"] = {1.0, 3.0};
+    CHECK_THROWS_WITH(sensitivity_plan(tiny, o), Catch::Contains("sensitivity level particle_form = 1.5"));
+    o.ranges.clear();
+    o.shape.alpha = 2;
+    CHECK_THROWS_WITH(sensitivity_plan(tiny, o), Catch::Contains("alpha = 2"));
+    CHECK_THROWS_WITH(check_control(base, {"friction_coefficient", -5, 50}),
+                      Catch::Contains("'friction_coefficient' = -5"));
     test::SyntheticShearBox box;
     CalibrationOptions bad;
     bad.tolerance = 2;

@@ -1,5 +1,7 @@
 // `demcal sensitivity` over real YADE runs of the tiny box (examples/materials/sand-tiny.json): one parameter at three
 // levels at three stresses (9 runs), killed with SIGKILL half-way and resumed by running the same command again.
+#include "test_files.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -7,8 +9,6 @@
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <sys/wait.h>
 #include <thread>
@@ -17,13 +17,6 @@
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
 
 // Counts finished runs: each writes result.json in its run directory.
 int finished_runs(const fs::path& dir) {
@@ -63,10 +56,10 @@ TEST_CASE("a sensitivity study on real YADE runs, killed with SIGKILL, resumes r
 
     const std::string cmd = std::string(DEMCAL_BINARY) + args + " > " + (dir / "second.log").string() + " 2>&1";
     const int rc = std::system(cmd.c_str());
-    const std::string second = slurp(dir / "second.log");
-    INFO(slurp(dir / "first.log") << "\n----\n" << second);
+    const std::string second = demcal::test::read_file(dir / "second.log");
+    INFO(demcal::test::read_file(dir / "first.log") << "\n----\n" << second);
     REQUIRE(WEXITSTATUS(rc) == 0);
-    const auto study = nlohmann::json::parse(slurp(dir / "sensitivity.json"));
+    const auto study = nlohmann::json::parse(demcal::test::read_file(dir / "sensitivity.json"));
     // Every run finished before the kill is reused, none computed twice.
     CHECK(study.at("simulations_reused").get<int>() >= done_before_kill);
     CHECK(study.at("simulations_run").get<int>() + done_before_kill <= 9 + 4);  // 3 levels x 3 stresses (+ running at the kill)
@@ -76,6 +69,6 @@ TEST_CASE("a sensitivity study on real YADE runs, killed with SIGKILL, resumes r
     for (const auto& l : p.at("levels")) CHECK(std::isfinite(l.at("mu_b").get<double>()));
     CHECK(p.at("mu_b").contains("shape"));
     CHECK(fs::exists(dir / "sensitivity_friction_coefficient.png"));
-    CHECK(slurp(dir / "sensitivity_table.txt").find("friction_coefficient") != std::string::npos);
+    CHECK(demcal::test::read_file(dir / "sensitivity_table.txt").find("friction_coefficient") != std::string::npos);
     fs::remove_all(dir);
 }

@@ -1,0 +1,105 @@
+// Bad input to the campaign commands (shear, sensitivity, calibrate, enlarge) through the real demcal binary: exit 2
+// with the field and the value named, before a campaign directory exists or a previous result is touched; each case
+// stops before YADE would start. And `demcal enlarge` writing its laws and their plot.
+#include "campaign_test_support.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace demcal;
+using Catch::Matchers::Contains;
+
+TEST_CASE("campaign commands refuse bad input before the campaign directory exists", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-input");
+    const fs::path campaign = dir / "never";
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    struct Case {
+        std::vector<std::string> args;
+        std::string expect;
+    };
+    const std::vector<Case> cases{
+        // a run's own fields, checked for every stress and for the last replicate's seed
+        {{"shear", tiny, "-s", "2e10"}, "'normal_stress' = 20000000000.0"},
+        {{"shear", tiny, "-s", "5e3", "--seed", "2147483647", "-r", "2"}, "'seed' = 2147483648"},
+        // NaN passed CLI11's own range checks
+        {{"shear", tiny, "-s", "5e3", "--timeout", "nan"}, "--timeout: nan is not a positive number"},
+        {{"sensitivity", tiny, "-s", "5e3,inf", "--params", "friction_coefficient"}, "normal_stress = inf"},
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "friction_coefficient", "--alpha", "2"}, "alpha = 2"},
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "particle_form", "--range", "particle_form=1:3"},
+         "sensitivity level particle_form = 1.5"},
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--max-evaluations", "0"},
+         "max-evaluations = 0"},
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--controls", "friction_coefficient"},
+         "controls: 1 given for 2 targets"},
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--bounds", "friction_coefficient=-5:50"},
+         "'friction_coefficient' = -5"},
+        {{"calibrate", "--start", tiny, "--measured", "5e3x:7000,1e4:13000,2e4:25000"}, "measured point '5e3x:7000'"},
+    };
+    for (const auto& c : cases) {
+        std::vector<std::string> args = c.args;
+        args.insert(args.end(), {"--campaign", campaign.string()});
+        INFO(args[0] + " ... " + c.expect);
+        const int rc = test::run_demcal(args, dir / "out.log");
+        const std::string log = test::read_file(dir / "out.log");
+        INFO(log);
+        CHECK(rc == 2);
+        CHECK_THAT(log, Contains(c.expect));
+        CHECK_FALSE(fs::exists(campaign));
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a calibration refused for its options leaves the previous log as it was", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-calibrate-log");
+    const fs::path log = dir / "calibration_log_surrogate.jsonl";
+    const std::string previous = "{\"evaluation\": 1, \"kept\": true}\n";
+    std::ofstream(log) << previous;
+    const int rc = test::run_demcal({"calibrate", "--start", test::source_path("examples/materials/sand-tiny.json"),
+                                     "--target", "mu_b=1.3,tau_c=800", "--grid-points", "1", "--method", "grid",
+                                     "--campaign", dir.string()},
+                                    dir / "out.log");
+    INFO(test::read_file(dir / "out.log"));
+    CHECK(rc == 2);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("grid-points = 1"));
+    CHECK(test::read_file(log) == previous);
+    CHECK_FALSE(fs::exists(dir / "campaign.sqlite"));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal enlarge fits both laws and draws them, and refuses an output it cannot write first", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-enlarge");
+    auto material = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand.json")));
+    std::vector<std::string> files;
+    // E = A r + B with A = 1e10 Pa/m, B = 5e6 Pa; nu = 0.01 r^-0.5
+    for (double r : {0.0025, 0.003, 0.0035}) {
+        material["particle_radius"] = r;
+        material["young_modulus"] = 1e10 * r + 5e6;
+        material["poisson_ratio"] = 0.01 / std::sqrt(r);
+        files.push_back((dir / ("r" + std::to_string(files.size()) + ".json")).string());
+        std::ofstream(files.back()) << material.dump();
+    }
+    auto args = files;
+    args.insert(args.begin(), "enlarge");
+    auto missing = args;
+    missing.insert(missing.end(), {"-o", (dir / "no_such_folder" / "e.json").string()});
+    CHECK(test::run_demcal(missing, dir / "missing.log") == 2);
+    CHECK_THAT(test::read_file(dir / "missing.log"), Contains("does not exist"));
+    args.insert(args.end(), {"-o", (dir / "e.json").string()});
+    const int rc = test::run_demcal(args, dir / "out.log");
+    INFO(test::read_file(dir / "out.log"));
+    REQUIRE(rc == 0);
+    const auto result = nlohmann::json::parse(test::read_file(dir / "e.json"));
+    INFO(result.dump(1));
+    CHECK(result["young_modulus"]["params"]["A"]["value"].get<double>() == Approx(1e10).epsilon(1e-6));
+    CHECK(result["poisson_ratio"]["params"]["D"]["value"].get<double>() == Approx(0.5).epsilon(1e-6));
+    CHECK(fs::file_size(dir / "e.png") > 1000);
+    CHECK(fs::exists(dir / "e.dat"));
+    fs::remove_all(dir);
+}
