@@ -472,14 +472,20 @@ void add_enlarge(CLI::App& app) {
         for (std::size_t i = 0; i < r.size(); ++i)
             j["points"].push_back({{"particle_radius", r[i]}, {"young_modulus", e[i]}, {"poisson_ratio", nu[i]}});
         orchestrator::write_text_file_atomically(o->output, j.dump(2) + "\n");
-        if (!o->no_plot) plot_enlargement(o->output, r, e, nu, e_law, nu_law, o->plot_format);
+        bool plotted = false;
+        if (!o->no_plot) try {  // the laws are written: a missing gnuplot costs only the picture
+                plot_enlargement(o->output, r, e, nu, e_law, nu_law, o->plot_format);
+                plotted = true;
+            } catch (const std::exception& err) {
+                std::cerr << "demcal: warning: plot not written: " << err.what() << "\n";
+            }
         std::cout << "E(r)  = A r + B:  A = " << e_law.params[0].value << " +/- " << e_law.params[0].std_error
                   << " Pa/m, B = " << e_law.params[1].value << " +/- " << e_law.params[1].std_error << " Pa (R^2 "
                   << e_law.r_squared << ")\n"
                   << "nu(r) = C r^-D:   C = " << nu_law.params[0].value << " +/- " << nu_law.params[0].std_error
                   << ", D = " << nu_law.params[1].value << " +/- " << nu_law.params[1].std_error << " (R^2 "
                   << nu_law.r_squared << "; nu is YADE's ks/kn)\nresults: " << o->output
-                  << (o->no_plot ? "" : ", " + fs::path(o->output).replace_extension("." + o->plot_format).string())
+                  << (plotted ? ", " + fs::path(o->output).replace_extension("." + o->plot_format).string() : "")
                   << "\n";
     });
 }

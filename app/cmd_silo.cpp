@@ -192,7 +192,8 @@ ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub) {
     GeometryGiven cli = geometry_options(o, sub);
     given.merge_slot_width();
     cli.merge_slot_width();
-    if (cli.rect) {
+    if (cli.rect) {  // the command line's shape wins: the file's diameter of a conical silo no longer applies
+        if (!given.rect.value_or(false)) given.values.erase("D_m");
         given.rect = cli.rect;
         given.rect_source = cli.rect_source;
     }

@@ -670,7 +670,8 @@ void check_calibration_options(const CalibrationOptions& options) {
 
 void check_control(const nlohmann::json& start, const ControlParameter& c) {
     const auto* spec = orchestrator::find_shear_param(c.name);
-    if (!spec) throw std::invalid_argument("controlling parameter '" + c.name + "' is not a material parameter");
+    if (!spec || spec->per_run)  // normal_stress and seed are the campaign's, not the material's
+        throw std::invalid_argument("controlling parameter '" + c.name + "' is not a material parameter");
     if (!(c.low < c.high))
         throw std::invalid_argument("bounds of " + c.name + " = " + num(c.low) + ":" + num(c.high) +
                                     " must have low < high");

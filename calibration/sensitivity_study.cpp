@@ -49,8 +49,9 @@ bool valid_level(const nlohmann::json& base, const std::string& name, double v) 
     }
 }
 
-// `end` when valid; else the farthest valid value from the (valid) base towards it, found by bisection and kept 2 %
-// of the way inside, so that rounding the levels (6 significant digits) cannot cross the limit.
+// `end` when valid; else the farthest valid value from the (valid) base towards it, found by bisection, kept 2 % of
+// the way inside and rounded as the levels are (6 significant digits), stepping back towards the base while the
+// rounded value is invalid (a base at the limit itself).
 double farthest_valid(const nlohmann::json& base, const std::string& name, double base_value, double end) {
     if (end == base_value || valid_level(base, name, end) || !valid_level(base, name, base_value)) return end;
     double good = base_value, bad = end;
@@ -58,7 +59,10 @@ double farthest_valid(const nlohmann::json& base, const std::string& name, doubl
         const double mid = 0.5 * (good + bad);
         (valid_level(base, name, mid) ? good : bad) = mid;
     }
-    return base_value + 0.98 * (good - base_value);
+    double inside = base_value + 0.98 * (good - base_value);
+    for (int i = 0; i < 60 && !valid_level(base, name, round_significant(inside)); ++i)
+        inside = base_value + 0.5 * (inside - base_value);
+    return valid_level(base, name, round_significant(inside)) ? round_significant(inside) : base_value;
 }
 
 }  // namespace
@@ -100,6 +104,9 @@ std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::st
         // and inside what the rest of the material allows (particle_form and particle_radius against the box size)
         lo = farthest_valid(base, name, b, lo);
         hi = farthest_valid(base, name, b, hi);
+        if (!(lo < hi))
+            throw std::invalid_argument("range of " + name + ": the material allows no value but its base " +
+                                        number_text(b) + " (its box); give one with --range " + name + "=LOW:HIGH");
     }
     if (!admissible(spec, lo) || !admissible(spec, hi))
         throw std::invalid_argument("range of " + name + " = " + number_text(lo) + ":" + number_text(hi) +

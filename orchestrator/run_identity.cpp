@@ -67,12 +67,19 @@ void write_text_file_atomically(const std::filesystem::path& p, const std::strin
         f << text;
         f.close();
         if (!f) {
+            const std::string why = std::strerror(errno);
             std::error_code ignored;
             std::filesystem::remove(tmp, ignored);  // no half-written file left behind
-            throw std::runtime_error("cannot write " + p.string() + " (" + std::strerror(errno) + ")");
+            throw std::runtime_error("cannot write " + p.string() + " (" + why + ")");
         }
     }
-    std::filesystem::rename(tmp, p);
+    std::error_code ec;
+    std::filesystem::rename(tmp, p, ec);
+    if (ec) {
+        std::error_code ignored;
+        std::filesystem::remove(tmp, ignored);
+        throw std::runtime_error("cannot write " + p.string() + " (" + ec.message() + ")");
+    }
 }
 
 }  // namespace demcal::orchestrator

@@ -105,16 +105,24 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
         CHECK_FALSE(fs::exists(out));
     }
     // a geometry file: the same rules as the options, the key named
-    for (const Case& c : {Case{R"({"shape": "conical", "theta_deg": 30, "outlet_mm": 35})", "unknown key 'outlet_mm'"},
-                          Case{R"({"theta_deg": -1})", "theta = -1"},
-                          Case{R"({"theta_deg": 30, "a_m": 0.02})", "a_m = 0.02: applies to a rectangular hopper"},
-                          Case{R"({"shape": "rectangular", "theta_deg": 30, "D_m": 0.2})", "D_m = 0.2: the diameter"},
-                          Case{R"({"shape": "rectangular", "theta_deg": 30, "outlet_m": 0.03, "a_m": 0.02})",
-                               "both set the outlet (slot) width"},
-                          Case{R"({"theta_deg": "30"})", R"(theta_deg = "30": must be a number)"}}) {
-        INFO(c.args);
-        std::ofstream(dir / "g.json") << c.args;
-        const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' --out '" + out.string() + "'", dir);
+    struct GeometryCase {
+        std::string json, options, expect;
+    };
+    for (const GeometryCase& c :
+         {GeometryCase{R"({"shape": "conical", "theta_deg": 30, "outlet_mm": 35})", "", "unknown key 'outlet_mm'"},
+          GeometryCase{R"({"theta_deg": -1})", "", "theta = -1"},
+          GeometryCase{R"({"theta_deg": 30, "a_m": 0.02})", "", "a_m = 0.02: applies to a rectangular hopper"},
+          GeometryCase{R"({"shape": "rectangular", "theta_deg": 30, "D_m": 0.2})", "", "D_m = 0.2: the diameter"},
+          GeometryCase{R"({"shape": "rectangular", "theta_deg": 30, "outlet_m": 0.03, "a_m": 0.02})", "",
+                       "both set the outlet (slot) width"},
+          GeometryCase{R"({"theta_deg": "30"})", "", R"(theta_deg = "30": must be a number)"},
+          // --rect over a conical file drops its D_m (the command line's shape wins); the rest stands
+          GeometryCase{R"({"theta_deg": 30, "D_m": 0.105})", "--rect --c 0.02", "c (width) = 0.02"}}) {
+        INFO(c.json + " " + c.options);
+        std::ofstream(dir / "g.json") << c.json;
+        const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' " + c.options + " --out '" +
+                                   out.string() + "'",
+                               dir);
         CHECK(r.rc == 2);
         CHECK_THAT(r.err, Catch::Matchers::Contains(c.expect));
         CHECK_FALSE(fs::exists(out));
