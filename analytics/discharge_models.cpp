@@ -1,9 +1,10 @@
 #include "analytics/discharge_models.hpp"
 
+#include "analytics/number_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
 
 namespace demcal::analytics {
@@ -12,13 +13,6 @@ namespace {
 constexpr double pi = std::numbers::pi;
 double rad(double deg) { return deg * pi / 180.0; }
 double deg(double rad) { return rad * 180.0 / pi; }
-
-std::string num(double v) {
-    std::ostringstream s;
-    s.precision(6);
-    s << v;
-    return s.str();
-}
 
 // Smallest outlet-to-particle ratio for which Beverloo-type correlations hold (Mankoc et al. 2007: d > 5-6 d_p).
 constexpr double min_outlet_particle_ratio = 6.0;
@@ -80,17 +74,17 @@ double rose_tanaka_factor(double half_angle_deg, double stagnant_angle_deg) {
 
 double jenike_mass_flow_limit_deg(double effective_friction_deg, double wall_friction_deg) {
     if (!(effective_friction_deg > 0 && effective_friction_deg < 90))
-        throw std::invalid_argument("delta_e_deg=" + num(effective_friction_deg) + " not in (0, 90)");
+        throw std::invalid_argument("delta_e_deg=" + number_text(effective_friction_deg) + " not in (0, 90)");
     if (!(wall_friction_deg >= 0 && wall_friction_deg < 90))
-        throw std::invalid_argument("phi_w_deg=" + num(wall_friction_deg) + " not in [0, 90)");
+        throw std::invalid_argument("phi_w_deg=" + number_text(wall_friction_deg) + " not in [0, 90)");
     // the approximation's arccos needs sin(delta_e) >= 1/3; bulk solids lie well above (wheat: about 30-40 deg)
     if (std::sin(rad(effective_friction_deg)) < 1.0 / 3.0)
-        throw std::invalid_argument("delta_e_deg=" + num(effective_friction_deg) +
+        throw std::invalid_argument("delta_e_deg=" + number_text(effective_friction_deg) +
                                     " is below 19.47 deg, where the approximation of Jenike's mass-flow limit is "
                                     "not defined (sin(delta_e) < 1/3)");
     if (wall_friction_deg >= effective_friction_deg)
-        throw std::invalid_argument("phi_w_deg=" + num(wall_friction_deg) +
-                                    " is not below delta_e_deg=" + num(effective_friction_deg) +
+        throw std::invalid_argument("phi_w_deg=" + number_text(wall_friction_deg) +
+                                    " is not below delta_e_deg=" + number_text(effective_friction_deg) +
                                     ": the wall is rougher than the bulk, no mass flow is possible");
     const double se = std::sin(rad(effective_friction_deg)), sw = std::sin(rad(wall_friction_deg));
     const double beta = 0.5 * (wall_friction_deg + deg(std::asin(sw / se)));
@@ -100,41 +94,41 @@ double jenike_mass_flow_limit_deg(double effective_friction_deg, double wall_fri
 std::vector<std::string> oldal_rectangular_limit_violations(double depth, double width, double outlet) {
     std::vector<std::string> out;
     const double cb = width / depth, ac = outlet / width;
-    if (cb < 1.0 || cb > 4.0) out.push_back("c/b = " + num(cb) + " outside the validated range 1 <= c/b <= 4");
-    if (ac < 0.15 || ac > 0.7) out.push_back("a/c = " + num(ac) + " outside the validated range 0.15 <= a/c <= 0.7");
+    if (cb < 1.0 || cb > 4.0) out.push_back("c/b = " + number_text(cb) + " outside the validated range 1 <= c/b <= 4");
+    if (ac < 0.15 || ac > 0.7) out.push_back("a/c = " + number_text(ac) + " outside the validated range 0.15 <= a/c <= 0.7");
     return out;
 }
 
 void validate(const SiloGeometry& g) {
     auto positive = [](const char* field, double v) {
-        if (!(std::isfinite(v) && v > 0)) throw std::invalid_argument(std::string(field) + "=" + num(v) + " must be > 0");
+        if (!(std::isfinite(v) && v > 0)) throw std::invalid_argument(std::string(field) + "=" + number_text(v) + " must be > 0");
     };
     positive("outlet_m", g.outlet);
     positive("d_p_m", g.particle_size);
     positive("rho_b_kg_m3", g.bulk_density);
     if (!(g.half_angle_deg > 0 && g.half_angle_deg <= 90))
-        throw std::invalid_argument("theta_deg=" + num(g.half_angle_deg) + " not in (0, 90] (90 = flat bottom)");
+        throw std::invalid_argument("theta_deg=" + number_text(g.half_angle_deg) + " not in (0, 90] (90 = flat bottom)");
     if (g.outlet <= g.particle_size)
-        throw std::invalid_argument("outlet_m=" + num(g.outlet) + " is not larger than the particles (d_p_m=" +
-                                    num(g.particle_size) + ")");
+        throw std::invalid_argument("outlet_m=" + number_text(g.outlet) + " is not larger than the particles (d_p_m=" +
+                                    number_text(g.particle_size) + ")");
     if (g.shape == SiloShape::conical) {
         positive("D_m", g.silo_diameter);
         if (g.outlet >= g.silo_diameter)
-            throw std::invalid_argument("outlet_m=" + num(g.outlet) + " is not smaller than the silo, D_m=" +
-                                        num(g.silo_diameter));
+            throw std::invalid_argument("outlet_m=" + number_text(g.outlet) + " is not smaller than the silo, D_m=" +
+                                        number_text(g.silo_diameter));
     } else {
         positive("b_m", g.depth);
         positive("c_m", g.width);
         if (g.outlet >= g.width)
-            throw std::invalid_argument("outlet_m=" + num(g.outlet) + " is not smaller than the silo width, c_m=" +
-                                        num(g.width));
+            throw std::invalid_argument("outlet_m=" + number_text(g.outlet) + " is not smaller than the silo width, c_m=" +
+                                        number_text(g.width));
     }
     positive("beverloo_C", g.beverloo_c);
-    if (!(g.beverloo_k >= 0)) throw std::invalid_argument("beverloo_k=" + num(g.beverloo_k) + " must be >= 0");
+    if (!(g.beverloo_k >= 0)) throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + " must be >= 0");
     positive("slot_C", g.slot_c);
     positive("delta", g.arch_delta);
     if (!(g.stagnant_angle_deg > 0 && g.stagnant_angle_deg < 90))
-        throw std::invalid_argument("phi_d_deg=" + num(g.stagnant_angle_deg) + " not in (0, 90)");
+        throw std::invalid_argument("phi_d_deg=" + number_text(g.stagnant_angle_deg) + " not in (0, 90)");
     if (g.effective_friction_deg.has_value() != g.wall_friction_deg.has_value())
         throw std::invalid_argument("delta_e_deg and phi_w_deg go together: give both or neither");
     if (g.effective_friction_deg) jenike_mass_flow_limit_deg(*g.effective_friction_deg, *g.wall_friction_deg);
@@ -158,12 +152,12 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
         const double limit = jenike_mass_flow_limit_deg(*g.effective_friction_deg, *g.wall_friction_deg);
         if (theta < limit) {
             mass_flow = true;
-            pattern_note = "mass flow (theta " + num(theta) + " < Jenike limit " + num(limit) + " deg)";
+            pattern_note = "mass flow (theta " + number_text(theta) + " < Jenike limit " + number_text(limit) + " deg)";
         } else if (conical) {
             mass_flow = false;
-            pattern_note = "funnel flow (theta " + num(theta) + " >= Jenike limit " + num(limit) + " deg)";
+            pattern_note = "funnel flow (theta " + number_text(theta) + " >= Jenike limit " + number_text(limit) + " deg)";
         } else {
-            pattern_note = "theta " + num(theta) + " >= conical Jenike limit " + num(limit) +
+            pattern_note = "theta " + number_text(theta) + " >= conical Jenike limit " + number_text(limit) +
                            " deg; the plane-flow limit of a wedge is wider, flow pattern not decided";
         }
     }
@@ -178,8 +172,8 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
     auto needs_outlet_ratio = [&](DischargePrediction& p, double outlet) {
         if (outlet < min_outlet_particle_ratio * g.particle_size) {
             p.valid = false;
-            p.warnings.push_back("outlet/d_p = " + num(outlet / g.particle_size) + " < " +
-                                 num(min_outlet_particle_ratio) + ": intermittent flow and clogging, correlation not valid");
+            p.warnings.push_back("outlet/d_p = " + number_text(outlet / g.particle_size) + " < " +
+                                 number_text(min_outlet_particle_ratio) + ": intermittent flow and clogging, correlation not valid");
         }
     };
     auto wrong_shape = [&](DischargePrediction& p) {
@@ -196,7 +190,7 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
             p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k);
             needs_outlet_ratio(p, g.outlet);
             if (g.silo_diameter < min_silo_outlet_ratio * g.outlet)
-                p.warnings.push_back("D/d = " + num(g.silo_diameter / g.outlet) + " < 2.5: wall effects likely");
+                p.warnings.push_back("D/d = " + number_text(g.silo_diameter / g.outlet) + " < 2.5: wall effects likely");
             if (rose_tanaka_factor(theta, g.stagnant_angle_deg) > 1.0)
                 p.warnings.push_back("hopper steeper than the stagnant zone (theta < 90 - phi_d): Beverloo "
                                      "underestimates, see beverloo+rose-tanaka");

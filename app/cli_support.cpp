@@ -1,12 +1,12 @@
 #include "app/cli_support.hpp"
 
+#include "analytics/number_text.hpp"
 #include "app/commands.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
-#include <sstream>
 
 namespace demcal {
 
@@ -40,16 +40,10 @@ CLI::Validator number_check(const std::string& what, std::function<bool(double)>
         what);
 }
 
-std::string bound_text(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-
 }  // namespace
 
 CLI::Validator number_in(double lo, double hi) {
-    return number_check("between " + bound_text(lo) + " and " + bound_text(hi),
+    return number_check("between " + analytics::number_text(lo) + " and " + analytics::number_text(hi),
                         [lo, hi](double v) { return v >= lo && v <= hi; });
 }
 

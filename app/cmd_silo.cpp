@@ -121,11 +121,18 @@ struct GivenValue {
     bool named_slot_width = false;  // given as a_m or --a, which only a rectangular hopper has
 };
 
-// The geometry keys of a --geometry file and the options that set the same quantity; a_m and --a are the
-// rectangular slot width, which outlet_m / --outlet also set.
-constexpr std::pair<const char*, const char*> kGeometryKeys[] = {
-    {"theta_deg", "--theta"}, {"outlet_m", "--outlet"}, {"D_m", "--diameter"}, {"body_height_m", "--body-height"},
-    {"a_m", "--a"},           {"b_m", "--b"},           {"c_m", "--c"}};
+// The geometry keys of a --geometry file, the options that set the same quantity and where the option's value is;
+// a_m and --a are the rectangular slot width, which outlet_m / --outlet also set.
+struct GeometryKey {
+    const char* file_key;
+    const char* option;
+    double SiloCli::*value;
+};
+constexpr GeometryKey kGeometryKeys[] = {
+    {"theta_deg", "--theta", &SiloCli::theta},       {"outlet_m", "--outlet", &SiloCli::outlet},
+    {"D_m", "--diameter", &SiloCli::diameter},       {"body_height_m", "--body-height", &SiloCli::body_height},
+    {"a_m", "--a", &SiloCli::a},                     {"b_m", "--b", &SiloCli::b},
+    {"c_m", "--c", &SiloCli::c}};
 
 // The geometry given at one level (the file, or the command line), by file key; the slot width under "outlet_m".
 struct GeometryGiven {
@@ -161,7 +168,7 @@ GeometryGiven read_geometry_file(const std::string& file) {
             continue;
         }
         const bool known = std::any_of(std::begin(kGeometryKeys), std::end(kGeometryKeys),
-                                       [&](const auto& k) { return key == k.first; });
+                                       [&](const GeometryKey& k) { return key == k.file_key; });
         if (!known)
             throw UserError(file + ": unknown key '" + key +
                             "' (known: shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m)");
@@ -172,16 +179,13 @@ GeometryGiven read_geometry_file(const std::string& file) {
 }
 
 GeometryGiven geometry_options(const SiloCli& o, CLI::App& sub) {
-    const std::map<std::string, double> option_value{{"--theta", o.theta}, {"--outlet", o.outlet},
-                                                     {"--diameter", o.diameter}, {"--body-height", o.body_height},
-                                                     {"--a", o.a}, {"--b", o.b}, {"--c", o.c}};
     GeometryGiven g;
     if (sub.count("--rect")) {
         g.rect = true;
         g.rect_source = "--rect";
     }
-    for (const auto& [key, option] : kGeometryKeys)
-        if (sub.count(option)) g.values[key] = {option_value.at(option), option};
+    for (const GeometryKey& k : kGeometryKeys)
+        if (sub.count(k.option)) g.values[k.file_key] = {o.*k.value, k.option};
     return g;
 }
 

@@ -1,5 +1,6 @@
 #include "calibration/calibration_loop.hpp"
 
+#include "analytics/number_text.hpp"
 #include "orchestrator/shear_params.hpp"
 
 #include <nlopt.h>
@@ -80,12 +81,7 @@ nlohmann::json CalibrationResult::to_json() const {
 
 namespace {
 
-std::string num(double v) {
-    std::ostringstream o;
-    o.precision(5);
-    o << v;
-    return o.str();
-}
+std::string num(double v) { return analytics::number_text(v, 5); }
 
 double determinant(std::vector<std::vector<double>> a) {  // Gaussian elimination; matrices here are 1x1 or 2x2
     const std::size_t n = a.size();

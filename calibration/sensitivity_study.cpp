@@ -1,5 +1,6 @@
 #include "calibration/sensitivity_study.hpp"
 
+#include "analytics/number_text.hpp"
 #include "orchestrator/shear_params.hpp"
 
 #include <algorithm>
@@ -24,11 +25,7 @@ const ParameterSensitivity* SensitivityStudy::find(const std::string& name) cons
 
 namespace {
 
-std::string number_text(double v) {
-    std::ostringstream o;
-    o << v;
-    return o.str();
-}
+using analytics::number_text;
 
 // Inside the parameter's admissible range, with open ends kept strictly inside.
 bool admissible(const orchestrator::ParamSpec& s, double v) {
