@@ -50,14 +50,14 @@ std::uint32_t CellGrid::cell_of(const Vec3& p) const {
 }
 
 void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& r,
-                         const std::vector<std::int32_t>& group, double skin, int threads) {
+                         const std::vector<std::int32_t>& group, double skin, int threads, double reach) {
   const std::size_t n = x.size();
   skin_ = skin;
   ++builds_;
   // keep the old list for the history carry-over
   std::vector<std::uint32_t> old_row;
   std::vector<std::int32_t> old_nbr;
-  std::vector<Vec3> old_hist;
+  std::vector<double> old_hist;
   old_row.swap(row);
   old_nbr.swap(nbr);
   old_hist.swap(hist);
@@ -71,7 +71,7 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
   }
   // grid
   CellGrid grid;
-  if (!grid.fit(x, r, skin))
+  if (!grid.fit(x, r, skin + reach))
     throw std::runtime_error("NeighborList::build: a sphere position is not finite (the simulation blew up?)");
   const std::int64_t nx = grid.nx, ny = grid.ny, nz = grid.nz;
   const std::size_t nc = grid.count();
@@ -118,7 +118,7 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
             for (std::uint32_t k = cell_start_[cc]; k < cell_start_[cc + 1]; ++k) {
               const std::uint32_t j = cell_items_[k];
               if (j == std::uint32_t(i) || (gi >= 0 && group[j] == gi)) continue;
-              const double cut = ri + r[j] + skin;
+              const double cut = ri + r[j] + skin + reach;
               if ((xi - x[j]).squaredNorm() < cut * cut) (j > std::uint32_t(i) ? fwd : bwd).push_back(std::int32_t(j));
             }
           }
@@ -135,7 +135,7 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
         trow[i + 1] += trow[i];
       }
       nbr.resize(row[n]);
-      hist.resize(row[n]);
+      hist.resize(row[n] * hsize_);
       tpair.resize(row[n]);
     }  // (implicit barrier)
     std::copy(fwd.begin(), fwd.end(), nbr.begin() + row[std::size_t(lo)]);
@@ -145,7 +145,8 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
       if (std::size_t(i) < old_n) { q = old_row[std::size_t(i)]; qe = old_row[std::size_t(i) + 1]; }
       for (std::uint32_t k = row[std::size_t(i)]; k < row[std::size_t(i) + 1]; ++k) {
         while (q < qe && old_nbr[q] < nbr[k]) ++q;
-        hist[k] = (q < qe && old_nbr[q] == nbr[k]) ? old_hist[q] : Vec3::Zero();
+        const bool kept = q < qe && old_nbr[q] == nbr[k];
+        for (std::size_t m = 0; m < hsize_; ++m) hist[k * hsize_ + m] = kept ? old_hist[q * hsize_ + m] : 0.0;
       }
     }
 #pragma omp barrier
@@ -162,9 +163,11 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
   valid_ = true;
 }
 
-void NeighborList::renumber(const std::vector<std::int32_t>& old2new, std::size_t new_count) {
+void NeighborList::renumber(const std::vector<std::int32_t>& old2new, std::size_t new_count,
+                            void (*swap_history)(double*)) {
   const std::size_t old_n = row.empty() ? 0 : row.size() - 1;
-  struct P { std::int32_t i, j; Vec3 s; };
+  struct P { std::int32_t i, j; std::size_t h; };  // h: where its history starts in `carried`
+  std::vector<double> carried;
   std::vector<P> keep;
   keep.reserve(nbr.size());
   for (std::size_t i = 0; i < old_n && i < old2new.size(); ++i) {
@@ -174,9 +177,16 @@ void NeighborList::renumber(const std::vector<std::int32_t>& old2new, std::size_
       if (std::size_t(nbr[p]) >= old2new.size()) continue;
       const std::int32_t nj = old2new[nbr[p]];
       if (nj < 0) continue;
-      if (hist[p].squaredNorm() == 0.0) continue;  // nothing to carry
-      if (ni < nj) keep.push_back({ni, nj, hist[p]});
-      else keep.push_back({nj, ni, -hist[p]});
+      const double* h = hist.data() + std::size_t(p) * hsize_;
+      if (std::all_of(h, h + hsize_, [](double v) { return v == 0.0; })) continue;  // nothing to carry
+      const std::size_t at = carried.size();
+      carried.insert(carried.end(), h, h + hsize_);
+      if (ni < nj) {
+        keep.push_back({ni, nj, at});
+      } else {
+        swap_history(carried.data() + at);
+        keep.push_back({nj, ni, at});
+      }
     }
   }
   std::sort(keep.begin(), keep.end(), [](const P& a, const P& b) { return a.i != b.i ? a.i < b.i : a.j < b.j; });
@@ -184,8 +194,11 @@ void NeighborList::renumber(const std::vector<std::int32_t>& old2new, std::size_
   for (const P& k : keep) ++row[k.i + 1];
   for (std::size_t i = 0; i < new_count; ++i) row[i + 1] += row[i];
   nbr.resize(keep.size());
-  hist.resize(keep.size());
-  for (std::size_t p = 0; p < keep.size(); ++p) { nbr[p] = keep[p].j; hist[p] = keep[p].s; }
+  hist.resize(keep.size() * hsize_);
+  for (std::size_t p = 0; p < keep.size(); ++p) {
+    nbr[p] = keep[p].j;
+    std::copy_n(carried.begin() + std::ptrdiff_t(keep[p].h), hsize_, hist.begin() + std::ptrdiff_t(p * hsize_));
+  }
   trow.clear();
   tpair.clear();
   valid_ = false;
@@ -218,7 +231,7 @@ void NeighborList::load(StateReader& r) {
   r.array(trow, "transposed rows"); r.array(tpair, "transposed pairs"); r.array(x_built_, "build positions");
   r.value(skin_, "neighbour skin"); r.value(valid_, "neighbour list state");
   builds_ = std::size_t(r.value<std::uint64_t>("neighbour builds"));
-  if (hist.size() != nbr.size() || (valid_ && (row.empty() || row.back() != nbr.size() || tpair.size() != nbr.size())))
+  if (hist.size() != nbr.size() * hsize_ || (valid_ && (row.empty() || row.back() != nbr.size() || tpair.size() != nbr.size())))
     r.fail("neighbour list", "inconsistent sizes");
 }
 

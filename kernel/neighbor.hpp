@@ -1,5 +1,5 @@
 // Linked-cell neighbour search with a Verlet skin, producing a half list (pairs i < j) in CSR form, with the
-// tangential history of each pair carried across rebuilds and a transposed index (pairs by their j) so that forces
+// contact history of each pair (the contact law's history_size doubles) carried across rebuilds and a transposed index (pairs by their j) so that forces
 // can be gathered per sphere in a fixed order (deterministic for any thread count, no atomics).
 #pragma once
 #include <cstdint>
@@ -25,16 +25,21 @@ struct CellGrid {
 
 class NeighborList {
  public:
+  /// Doubles of contact history per pair (the law's history_size); set before the first build.
+  void set_history_size(int doubles) { hsize_ = std::size_t(doubles); }
+  std::size_t history_size() const { return hsize_; }
   /// Rebuilds the list: pairs (i < j) with |x_i - x_j| < r_i + r_j + skin, excluding pairs of the same clump
   /// (group[i] == group[j] >= 0). Histories of pairs present before are kept (matched by (i, j)); new pairs start
   /// at zero. Uses `threads` OpenMP threads; the result does not depend on it.
+  /// reach: how far beyond touching the contact law may act (adhesion) [m]; the list then holds the pairs with
+  /// |x_i - x_j| < r_i + r_j + skin + reach.
   void build(const std::vector<Vec3>& x, const std::vector<double>& r, const std::vector<std::int32_t>& group,
-             double skin, int threads);
+             double skin, int threads, double reach = 0.0);
   /// True when some sphere moved more than skin/2 since the last build (or the list was never built / invalidated).
   bool needs_rebuild(const std::vector<Vec3>& x, int threads) const;
   /// Renumbers spheres after a removal or a permutation: old2new[old] = new index or -1 (removed). Pairs keep their
-  /// history (sign flipped where i and j swap order). The list must then be rebuilt before use (invalidated).
-  void renumber(const std::vector<std::int32_t>& old2new, std::size_t new_count);
+  /// history (passed through swap_history where i and j swap order). The list must then be rebuilt before use.
+  void renumber(const std::vector<std::int32_t>& old2new, std::size_t new_count, void (*swap_history)(double*));
   void invalidate() { valid_ = false; }
   /// Sphere positions at the last build (for the skin/2 displacement check).
   const std::vector<Vec3>& built_positions() const { return x_built_; }
@@ -47,10 +52,11 @@ class NeighborList {
   std::size_t num_pairs() const { return nbr.size(); }
   std::size_t num_builds() const { return builds_; }
 
-  // CSR half list: pairs of sphere i are p in [row[i], row[i+1]), partner nbr[p] > i, history hist[p].
+  // CSR half list: pairs of sphere i are p in [row[i], row[i+1]), partner nbr[p] > i, history
+  // hist[p * history_size() ...].
   std::vector<std::uint32_t> row;
   std::vector<std::int32_t> nbr;
-  std::vector<Vec3> hist;
+  std::vector<double> hist;
   // transposed: pairs where sphere j is the partner: pair_of[q] for q in [trow[j], trow[j+1]), ascending i.
   std::vector<std::uint32_t> trow;
   std::vector<std::uint32_t> tpair;
@@ -58,6 +64,7 @@ class NeighborList {
  private:
   std::vector<Vec3> x_built_;
   double skin_ = 0;
+  std::size_t hsize_ = 0;
   bool valid_ = false;
   std::size_t builds_ = 0;
   // cell grid scratch

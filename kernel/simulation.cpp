@@ -5,4 +5,5 @@
 namespace demcal::kernel {
 template class BasicSimulation<HertzMindlinEdem>;
 template class BasicSimulation<HertzMindlin>;
+template class BasicSimulation<JkrMindlinEdem>;
 }  // namespace demcal::kernel

@@ -1,5 +1,5 @@
-// The native DEM simulation: spheres and rigid multi-sphere clumps, analytic walls, a contact law composed at
-// compile time (kernel/contact/contact_law.hpp), linked-cell + Verlet-skin neighbour list, velocity-Verlet
+// The native DEM simulation: spheres and rigid multi-sphere clumps, analytic walls that can move (a prescribed law or a
+// driver's velocity), a contact law composed at compile time from sub-models (kernel/contact/contact_law.hpp), linked-cell + Verlet-skin neighbour list, velocity-Verlet
 // integration (clumps: angular momentum + Richardson quaternion update, as LAMMPS/LIGGGHTS fix rigid / multisphere),
 // OpenMP. Same input and thread count => bit-identical results (no atomics, fixed-order gathers and sums).
 //
@@ -7,8 +7,8 @@
 //   Simulation sim;
 //   int wheat = sim.add_material({.young = 2 * 3.58e8 * 1.4, .poisson = 0.4, .density = 1430});
 //   int steel = sim.add_material({.young = 2 * 8e8 * 1.3, .poisson = 0.3, .density = 7500});
-//   sim.set_pair(wheat, wheat, {.restitution = 0.5, .friction = 0.3, .rolling_friction = 0.01});
-//   sim.set_pair(wheat, steel, {.restitution = 0.6, .friction = 0.25, .rolling_friction = 0.01});
+//   sim.set_pair(wheat, wheat, {{.restitution = 0.5}, {.friction = 0.3}, {.rolling_friction = 0.01}});
+//   sim.set_pair(wheat, steel, {{.restitution = 0.6}, {.friction = 0.25}, {.rolling_friction = 0.01}});
 //   int grain = sim.add_clump_template(wheat_clump_template());
 //   sim.add_wall(Wall::cylinder(0, 0, 0.0525, 0.0, 0.4, steel));
 //   sim.add_clump(grain, wheat, {0, 0, 0.1}, Quat::Identity());
@@ -62,6 +62,8 @@ struct RemovalResult {
 template <class Law>
 class BasicSimulation {
  public:
+  /// The per-material-pair inputs of the law: its sub-models' fields side by side (kernel/contact/).
+  using PairParams = typename Law::Params;
   BasicSimulation();
 
   // ---------------------------------------------------------------- setup
@@ -70,7 +72,8 @@ class BasicSimulation {
   const Material& material(int id) const { return materials_.at(id); }
   /// Sets the properties of the (unordered) material pair (a, b). Every pair of materials that can meet (particle-
   /// particle, particle-wall) must be set before stepping, or step() throws naming the pair.
-  void set_pair(int a, int b, const PairProperties& p);
+  /// The fields are validated here (std::invalid_argument naming the field).
+  void set_pair(int a, int b, const PairParams& p);
   /// Gravity acceleration [m/s^2] (default (0, 0, -9.81)).
   void set_gravity(const Vec3& g) { gravity_ = g; }
   const Vec3& gravity() const { return gravity_; }
@@ -99,6 +102,9 @@ class BasicSimulation {
   int add_wall(const Wall& w);
   /// Enables/disables a wall (e.g. opens the outlet plate). A disabled wall exerts no force.
   void set_wall_enabled(int id, bool enabled);
+  /// Sets the velocity [m/s] of a wall without a prescribed motion law (a driver's servo or a shear frame): it moves by
+  /// velocity * dt each step from then on. Throws for a wall that follows a law.
+  void set_wall_velocity(int id, const Vec3& velocity);
   const Wall& wall(int id) const { return walls_.at(id); }
   std::size_t num_walls() const { return walls_.size(); }
   /// Total contact force exerted BY the particles ON wall `id` at the last force evaluation [N].
@@ -169,6 +175,7 @@ class BasicSimulation {
   std::size_t memory_bytes() const;
 
  private:
+  static constexpr const char* kStateFormat = "demcal-kernel-state/3";  // 3: contact histories of any size, walls move
   void prepare();
   void compute_forces(bool rebuild, double dt_history);
   bool kick_drift(double kick);
@@ -181,7 +188,7 @@ class BasicSimulation {
   void for_each_sphere_array(F&& f) {
     f(x_, 1); f(v_, 1); f(w_, 1); f(f_, 1); f(t_, 1);
     f(r_, 1); f(mass_, 1); f(inv_mass_, 1); f(inv_inertia_, 1); f(mat_, 1); f(clump_, 1);
-    f(wall_slot_id_, kWallSlots); f(wall_slot_s_, kWallSlots); f(wall_slot_f_, kWallSlots);
+    f(wall_slot_id_, kWallSlots); f(wall_slot_s_, kWallSlots * kHist); f(wall_slot_f_, kWallSlots);
   }
   template <class F>
   void for_each_clump_array(F&& f) {
@@ -191,14 +198,19 @@ class BasicSimulation {
   void reorder_spheres();
   void rebuild_neighbors();  // the neighbour list and the wall candidates, always together
   void find_wall_candidates();
+  void move_walls();  // to the current time: displacement and velocity over the step
+  bool walls_left_reach() const;  // a wall moved more than skin/2 since the last neighbour build
 
   // materials
   std::vector<Material> materials_;
-  std::vector<PairProperties> pair_props_;  // nm * nm
+  std::vector<PairParams> pair_props_;        // nm * nm
   std::vector<char> pair_set_;
-  std::vector<PairCoeffs> coeffs_;          // nm * nm (built in prepare)
+  std::vector<typename Law::Coeffs> coeffs_;  // nm * nm, ordered (row: sphere i's material; built in prepare)
   int nm_coeffs_ = 0;
+  double law_reach_ = 0;  // how far beyond touching the law can act for the radii present [m] (prepare)
   std::vector<Wall> walls_;
+  std::vector<Vec3> wall_disp_built_;  // each wall's displacement at the last neighbour build
+  bool walls_move_ = false;            // some wall has a motion law or a velocity
   std::vector<ClumpTemplate> templates_;
 
   // per sphere (structure of arrays)
@@ -206,8 +218,10 @@ class BasicSimulation {
   std::vector<double> r_, mass_, inv_mass_, inv_inertia_;  // mass_: body mass (m* of a clump member); inv_*: spheres
   std::vector<std::int32_t> mat_, clump_;                  // clump_: clump index or -1
   static constexpr int kWallSlots = 3;                      // wall contacts with history per sphere
+  static constexpr int kHist = Law::history_size;           // doubles of contact history per contact
   std::vector<std::int32_t> wall_slot_id_;                  // kWallSlots per sphere, -1 empty
-  std::vector<Vec3> wall_slot_s_, wall_slot_f_;             // history, force on the sphere
+  std::vector<double> wall_slot_s_;                         // kWallSlots * kHist per sphere: history
+  std::vector<Vec3> wall_slot_f_;                           // kWallSlots per sphere: force on the sphere
   struct PairLoad {
     Vec3 force_i, torque_j;  // one pair's force on i and torque on j, side by side for the gather's one read
   };
@@ -244,8 +258,11 @@ class BasicSimulation {
 
 extern template class BasicSimulation<HertzMindlinEdem>;
 extern template class BasicSimulation<HertzMindlin>;
+extern template class BasicSimulation<JkrMindlinEdem>;
 
 /// The seed's model: Hertz-Mindlin (no slip) + EDEM constant directional torque rolling friction.
 using Simulation = BasicSimulation<HertzMindlinEdem>;
+/// The seed's model with JKR adhesion (cohesive powders).
+using CohesiveSimulation = BasicSimulation<JkrMindlinEdem>;
 
 }  // namespace demcal::kernel

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <istream>
 #include <ostream>
 #include <stdexcept>
@@ -27,6 +28,7 @@ inline Vec3 inverse_moments(const Vec3& I) {
 template <class Law>
 BasicSimulation<Law>::BasicSimulation() {
   threads_ = 1;
+  nl_.set_history_size(kHist);
 }
 
 template <class Law>
@@ -38,7 +40,7 @@ int BasicSimulation<Law>::add_material(const Material& m) {
   const int nm_old = int(materials_.size());
   materials_.push_back(m);
   const int nm = nm_old + 1;
-  std::vector<PairProperties> pp(nm * nm);
+  std::vector<PairParams> pp(nm * nm);
   std::vector<char> ps(nm * nm, 0);
   for (int a = 0; a < nm_old; ++a)
     for (int b = 0; b < nm_old; ++b) {
@@ -52,12 +54,14 @@ int BasicSimulation<Law>::add_material(const Material& m) {
 }
 
 template <class Law>
-void BasicSimulation<Law>::set_pair(int a, int b, const PairProperties& p) {
+void BasicSimulation<Law>::set_pair(int a, int b, const PairParams& p) {
   const int nm = int(materials_.size());
   if (a < 0 || b < 0 || a >= nm || b >= nm) throw std::invalid_argument("set_pair: unknown material id");
-  restitution_beta(p.restitution);  // validates
-  if (!(p.friction >= 0)) throw std::invalid_argument("set_pair: friction must be >= 0");
-  if (!(p.rolling_friction >= 0)) throw std::invalid_argument("set_pair: rolling_friction must be >= 0");
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("set_pair(" + std::to_string(a) + ", " + std::to_string(b) + "): " + e.what());
+  }
   pair_props_[a * nm + b] = pair_props_[b * nm + a] = p;
   pair_set_[a * nm + b] = pair_set_[b * nm + a] = 1;
   prepared_ = false;
@@ -109,6 +113,39 @@ void BasicSimulation<Law>::set_wall_enabled(int id, bool enabled) {
 }
 
 template <class Law>
+void BasicSimulation<Law>::set_wall_velocity(int id, const Vec3& velocity) {
+  Wall& w = walls_.at(id);
+  if (w.motion) throw std::logic_error("set_wall_velocity: wall " + std::to_string(id) + " follows a motion law");
+  if (!velocity.allFinite()) throw std::invalid_argument("set_wall_velocity: the velocity must be finite");
+  w.velocity = velocity;
+  forces_valid_ = false;
+}
+
+template <class Law>
+void BasicSimulation<Law>::move_walls() {
+  // The displacement at the current time; the velocity contacts see is the mean over the step just taken, so the
+  // tangential springs advance by exactly the wall's displacement (the particles' velocities are mid-step too).
+  for (Wall& w : walls_) {
+    if (w.motion) {
+      const Vec3 d = w.motion->displacement(time_ + dt_);
+      w.velocity = (d - w.displacement) / dt_;
+      w.displacement = d;
+    } else if (w.velocity != Vec3::Zero()) {
+      w.displacement += dt_ * w.velocity;
+    }
+  }
+}
+
+template <class Law>
+bool BasicSimulation<Law>::walls_left_reach() const {
+  if (!walls_move_ || wall_disp_built_.size() != walls_.size()) return walls_move_;
+  const double lim2 = 0.25 * skin_ * skin_;
+  for (std::size_t k = 0; k < walls_.size(); ++k)
+    if ((walls_[k].displacement - wall_disp_built_[k]).squaredNorm() > lim2) return true;
+  return false;
+}
+
+template <class Law>
 Vec3 BasicSimulation<Law>::wall_force(int id) const {
   // Summed when asked, in sphere order, from the forces each sphere keeps per wall contact: a serial pass over every
   // sphere in each step would cost every step, for a value most runs never read.
@@ -140,7 +177,8 @@ BodyId BasicSimulation<Law>::add_sphere(const Vec3& position, double radius, int
   r_.push_back(radius); mass_.push_back(m); inv_mass_.push_back(1.0 / m);
   inv_inertia_.push_back(1.0 / (0.4 * m * radius * radius));
   mat_.push_back(material); clump_.push_back(-1);
-  for (int s = 0; s < kWallSlots; ++s) { wall_slot_id_.push_back(-1); wall_slot_s_.push_back(Vec3::Zero()); wall_slot_f_.push_back(Vec3::Zero()); }
+  for (int s = 0; s < kWallSlots; ++s) { wall_slot_id_.push_back(-1); wall_slot_f_.push_back(Vec3::Zero()); }
+  wall_slot_s_.resize(wall_slot_s_.size() + kWallSlots * kHist, 0.0);
   body_ref_.push_back(std::int32_t(x_.size() - 1));
   body_id_.push_back(next_id_);
   sphere_body_.push_back(std::uint32_t(body_ref_.size() - 1));
@@ -172,7 +210,8 @@ BodyId BasicSimulation<Law>::add_clump(int tmpl, int material, const Vec3& com, 
     f_.push_back(Vec3::Zero()); t_.push_back(Vec3::Zero());
     r_.push_back(t.radii[k]); mass_.push_back(t.mass); inv_mass_.push_back(0.0); inv_inertia_.push_back(0.0);
     mat_.push_back(material); clump_.push_back(std::int32_t(c));
-    for (int s = 0; s < kWallSlots; ++s) { wall_slot_id_.push_back(-1); wall_slot_s_.push_back(Vec3::Zero()); wall_slot_f_.push_back(Vec3::Zero()); }
+    for (int s = 0; s < kWallSlots; ++s) { wall_slot_id_.push_back(-1); wall_slot_f_.push_back(Vec3::Zero()); }
+    wall_slot_s_.resize(wall_slot_s_.size() + kWallSlots * kHist, 0.0);
   }
   cmem_start_.push_back(std::uint32_t(cmem_.size()));
   body_ref_.push_back(-std::int32_t(c) - 1);
@@ -208,12 +247,12 @@ void BasicSimulation<Law>::prepare() {
     std::vector<char> used(nm, 0), used_wall(nm, 0);
     for (auto m : mat_) used[m] = 1;
     for (const Wall& w : walls_) used_wall[w.material] = 1;
-    coeffs_.assign(nm * nm, PairCoeffs{});
+    coeffs_.assign(nm * nm, typename Law::Coeffs{});
     for (int a = 0; a < nm; ++a)
       for (int b = 0; b < nm; ++b) {
         const bool needed = used[a] && (used[b] || used_wall[b]);
         if (pair_set_[a * nm + b]) {
-          coeffs_[a * nm + b] = make_pair_coeffs(materials_[a], materials_[b], pair_props_[a * nm + b]);
+          coeffs_[a * nm + b] = Law::mix(materials_[a], materials_[b], pair_props_[a * nm + b]);
         } else if (needed) {
           throw std::logic_error("step: material pair (" + std::to_string(a) + ", " + std::to_string(b) +
                                  ") has no properties: call set_pair()");
@@ -221,6 +260,19 @@ void BasicSimulation<Law>::prepare() {
       }
     nm_coeffs_ = nm;
     prepared_ = true;
+  }
+  walls_move_ = false;
+  for (const Wall& w : walls_) walls_move_ = walls_move_ || w.motion || w.velocity != Vec3::Zero();
+  if constexpr (Law::beyond_contact) {
+    // R* of any contact is at most the largest radius (a wall contact's R* is the sphere's radius)
+    double r_max = 0;
+    for (double r : r_) r_max = std::max(r_max, r);
+    double reach = 0;
+    for (int a = 0; a < nm; ++a)
+      for (int b = 0; b < nm; ++b)
+        if (pair_set_[a * nm + b]) reach = std::max(reach, Law::reach(coeffs_[a * nm + b], r_max));
+    if (reach > law_reach_) nl_.invalidate();  // pairs may now act beyond the list's reach
+    law_reach_ = reach;
   }
   if (skin_ <= 0) {
     double rs = 0;
@@ -405,25 +457,28 @@ void BasicSimulation<Law>::reorder_spheres() {
   for (auto& ref : body_ref_)
     if (ref >= 0) ref = old2new[ref];
   rebuild_body_index();
-  nl_.renumber(old2new, n);
+  nl_.renumber(old2new, n, &Law::swap_history);
 }
 
 template <class Law>
 void BasicSimulation<Law>::rebuild_neighbors() {
-  nl_.build(x_, r_, clump_, skin_, nt());
+  nl_.build(x_, r_, clump_, skin_, nt(), law_reach_);
   find_wall_candidates();  // same positions, same skin: valid until the list is
 }
 
 template <class Law>
 void BasicSimulation<Law>::find_wall_candidates() {
-  // A sphere moves less than skin/2 between two neighbour builds, so only walls closer than r + skin/2 to its
-  // centre now can touch it before the next build. Disabled walls are kept as candidates (enabling one needs no
-  // rebuild); the force loop skips them.
+  // A sphere moves less than skin/2 between two neighbour builds, and so does a moving wall (walls_left_reach), so
+  // only walls closer than r + skin/2 (+ skin/2 when walls move, + the law's reach beyond touching) to its centre
+  // now can touch it before the next build. Disabled walls are kept as candidates (enabling one needs no rebuild);
+  // the force loop skips them.
   const std::int64_t n = std::int64_t(x_.size());
   const int nw = int(walls_.size());
   wall_cand_.assign(std::size_t(n), 0);
+  wall_disp_built_.resize(walls_.size());
+  for (std::size_t k = 0; k < walls_.size(); ++k) wall_disp_built_[k] = walls_[k].displacement;
   if (nw == 0 || nw > kMaxWallCandidates) return;
-  const double reach = 0.5 * skin_;
+  const double reach = 0.5 * skin_ + (walls_move_ ? 0.5 * skin_ : 0.0) + law_reach_;
 #pragma omp parallel for num_threads(nt()) schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     std::uint64_t m = 0;
@@ -450,7 +505,8 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   const int nw = int(walls_.size());
   const std::uint32_t* row = nl_.row.data();
   const std::int32_t* nbr = nl_.nbr.data();
-  Vec3* hist = nl_.hist.data();
+  double* hist = nl_.hist.data();
+  const double law_reach = law_reach_;
   // |omega| once per sphere, not once per contact side (a sphere has several contacts); kick_drift has filled it
   // unless the angular velocities changed otherwise since (a velocity set, bodies added, removed or renumbered)
   const bool fill_omega_norm = Law::uses_omega_norm && !(omega_norm_fresh_ && omega_norm_.size() == std::size_t(n));
@@ -471,14 +527,16 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
       Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
       const Vec3 xi = x_[i], vi = v_[i], wi = w_[i];
       const double ri = r_[i], mi = mass_[i];
-      const PairCoeffs* crow = coeffs_.data() + std::size_t(mat_[i]) * nm;
+      const typename Law::Coeffs* crow = coeffs_.data() + std::size_t(mat_[i]) * nm;
       for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
         const std::int32_t j = nbr[p];
+        double* h = hist + std::size_t(p) * kHist;
         const Vec3 d = xi - x_[j];
         const double rs = ri + r_[j];
         const double d2 = d.squaredNorm();
-        if (d2 >= rs * rs) {
-          hist[p].setZero();
+        const double reach = rs + law_reach;  // (= rs for a law that acts only in contact)
+        if (d2 >= reach * reach) {
+          std::fill_n(h, kHist, 0.0);
           load[p].force_i.setZero();
           load[p].torque_j.setZero();
           continue;
@@ -496,6 +554,15 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         geo.m_star = mi * mj * rs * q;
         geo.lever_i = ri - 0.5 * geo.dn;
         geo.lever_j = r_[j] - 0.5 * geo.dn;
+        const typename Law::Coeffs& coeffs = crow[mat_[j]];
+        if constexpr (Law::beyond_contact) {
+          if (!Law::acts(coeffs, geo, h)) {  // a gap the contact does not (or no longer) bridge
+            std::fill_n(h, kHist, 0.0);
+            load[p].force_i.setZero();
+            load[p].torque_j.setZero();
+            continue;
+          }
+        }
         ContactKinematics kin;
         kin.omega_i = wi;
         kin.omega_j = w_[j];
@@ -504,7 +571,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           kin.omega_j_norm = wnorm[j];
         }
         kin.v_rel = (vi - geo.lever_i * wi.cross(geo.n)) - (v_[j] + geo.lever_j * w_[j].cross(geo.n));
-        const ContactResult res = Law::compute(crow[mat_[j]], geo, kin, hist[p], dt, false);
+        const ContactResult res = Law::compute(coeffs, geo, kin, h, dt, false);
         fi += res.force_i;
         ti += res.torque_i;
         load[p].force_i = res.force_i;
@@ -512,11 +579,13 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
       }
       // walls: up to kWallSlots simultaneous contacts keep a history
       if (nw > 0) {
+        constexpr int kH = kHist > 0 ? kHist : 1;  // (no zero-length arrays)
         std::int32_t* sid = &wall_slot_id_[std::size_t(i) * kWallSlots];
-        Vec3* ss = &wall_slot_s_[std::size_t(i) * kWallSlots];
+        double* ss = wall_slot_s_.data() + std::size_t(i) * kWallSlots * kHist;
         Vec3* sf = &wall_slot_f_[std::size_t(i) * kWallSlots];
         std::int32_t nid[kWallSlots] = {-1, -1, -1};
-        Vec3 ns[kWallSlots], nf[kWallSlots];
+        double ns[kWallSlots][kH];
+        Vec3 nf[kWallSlots];
         int used = 0;
         // only the walls within reach at the last neighbour build (all of them past kMaxWallCandidates walls)
         const bool tracked = nw <= kMaxWallCandidates;
@@ -526,30 +595,34 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           if (!wall.enabled) continue;
           Vec3 nrm;
           double dn, dist;
-          if (!wall.contact(xi, ri, nrm, dn, dist)) continue;
-          Vec3 s = Vec3::Zero();
+          if (!wall.contact(xi, ri + law_reach, nrm, dn, dist)) continue;
+          double s[kH] = {};
           for (int k = 0; k < kWallSlots; ++k)
-            if (sid[k] == wdx) s = ss[k];
+            if (sid[k] == wdx) std::copy_n(ss + k * kHist, kHist, s);
+          const typename Law::Coeffs& coeffs = crow[wall.material];
           ContactGeometry geo;
           geo.n = nrm;
-          geo.dn = dn;
+          geo.dn = dn - law_reach;  // (= dn for a law that acts only in contact)
           geo.radius_i = ri;
           geo.radius_j = 0;
           geo.r_star = ri;
           geo.m_star = mi;
           geo.lever_i = dist;
           geo.lever_j = 0;
+          if constexpr (Law::beyond_contact) {
+            if (!Law::acts(coeffs, geo, s)) continue;
+          }
           ContactKinematics kin;
           kin.omega_i = wi;
           kin.omega_j = Vec3::Zero();
           if (Law::uses_omega_norm) kin.omega_i_norm = wnorm[i];
-          kin.v_rel = vi - dist * wi.cross(nrm);
-          const ContactResult res = Law::compute(crow[wall.material], geo, kin, s, dt, true);
+          kin.v_rel = vi - dist * wi.cross(nrm) - wall.velocity;
+          const ContactResult res = Law::compute(coeffs, geo, kin, s, dt, true);
           fi += res.force_i;
           ti += res.torque_i;
           if (used < kWallSlots) {
             nid[used] = wdx;
-            ns[used] = s;
+            std::copy_n(s, kHist, ns[used]);
             nf[used] = res.force_i;
             ++used;
           }
@@ -557,7 +630,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         if (used > 0 || sid[0] >= 0)  // (slots are filled from the front: sid[0] < 0 means all empty)
           for (int k = 0; k < kWallSlots; ++k) {
             sid[k] = nid[k];
-            ss[k] = k < used ? ns[k] : Vec3::Zero();
+            for (int m = 0; m < kHist; ++m) ss[k * kHist + m] = k < used ? ns[k][m] : 0.0;
             sf[k] = k < used ? nf[k] : Vec3::Zero();
           }
       }
@@ -598,14 +671,17 @@ void BasicSimulation<Law>::step(long nsteps) {
   prepare();
   if (!forces_valid_) {
     // forces of the current state (after an insertion, a removal, a wall toggled, velocities set): time does not
-    // advance, so neither do the tangential springs
+    // advance, so neither do the tangential springs; a wall on a law moves at its velocity of this instant
+    for (Wall& w : walls_)
+      if (w.motion) w.velocity = w.motion->velocity(time_);
     compute_forces(nl_.needs_rebuild(x_, nt()), 0.0);
     forces_valid_ = true;
   }
   // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass
   for (long s = 0; s < nsteps; ++s) {
     const bool moved = kick_drift(s == 0 ? 1.0 : 2.0);
-    compute_forces(moved, dt_);
+    if (walls_move_) move_walls();
+    compute_forces(moved || (walls_move_ && walls_left_reach()), dt_);
     time_ += dt_;
     ++steps_;
   }
@@ -731,7 +807,7 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   body_ref_ = std::move(refs);
   body_id_ = std::move(ids);
   rebuild_body_index();
-  nl_.renumber(s_old2new, ns);
+  nl_.renumber(s_old2new, ns, &Law::swap_history);
   // forces of the remaining spheres are still valid except for the contacts with removed ones; recompute
   forces_valid_ = false;
   return res;
@@ -829,9 +905,12 @@ std::vector<double> BasicSimulation<Law>::configuration_numbers() const {
   auto vec = [&](const Vec3& v) { c.insert(c.end(), {v.x(), v.y(), v.z()}); };
   c.push_back(double(materials_.size()));
   for (const Material& m : materials_) c.insert(c.end(), {m.young, m.poisson, m.density});
+  // a pair's inputs are the sub-models' fields, all doubles
+  static_assert(std::is_trivially_copyable_v<PairParams> && sizeof(PairParams) % sizeof(double) == 0);
   for (std::size_t k = 0; k < pair_props_.size(); ++k) {
-    const PairProperties& p = pair_props_[k];
-    c.insert(c.end(), {double(pair_set_[k]), p.restitution, p.friction, p.rolling_friction});
+    double p[sizeof(PairParams) / sizeof(double) + 1] = {double(pair_set_[k])};
+    std::memcpy(p + 1, &pair_props_[k], sizeof(PairParams));
+    c.insert(c.end(), std::begin(p), std::end(p));
   }
   c.push_back(double(templates_.size()));
   for (const ClumpTemplate& t : templates_) {
@@ -841,26 +920,29 @@ std::vector<double> BasicSimulation<Law>::configuration_numbers() const {
     for (double r : t.radii) c.push_back(r);
   }
   c.push_back(double(walls_.size()));
-  for (const Wall& w : walls_) {
-    c.insert(c.end(), {double(int(w.shape)), double(w.material), w.half_u, w.half_v, w.cx, w.cy, w.r0, w.z0, w.r1, w.z1});
-    vec(w.point); vec(w.normal); vec(w.u); vec(w.v);
-  }
+  for (const Wall& w : walls_) w.append_numbers(c);
   return c;
 }
 
 template <class Law>
 void BasicSimulation<Law>::save_state(std::ostream& os) const {
   StateWriter w(os);
-  w.text("demcal-kernel-state/2");
+  w.text(kStateFormat);
   w.array(configuration_numbers());
   std::vector<char> enabled;
-  for (const Wall& wall : walls_) enabled.push_back(wall.enabled);
+  std::vector<Vec3> wall_motion;  // displacement and velocity of each wall
+  for (const Wall& wall : walls_) {
+    enabled.push_back(wall.enabled);
+    wall_motion.push_back(wall.displacement);
+    wall_motion.push_back(wall.velocity);
+  }
   w.array(enabled);
+  w.array(wall_motion);
   // the for_each lists only hand out references; nothing is modified
   auto* self = const_cast<BasicSimulation*>(this);
   self->for_each_sphere_array([&](auto& a, int) { w.array(a); });
   self->for_each_clump_array([&](auto& a) { w.array(a); });
-  // (the pair loads as two arrays, force then torque: the format of demcal-kernel-state/2)
+  // (the pair loads as two arrays, force then torque)
   std::vector<Vec3> pair_f(pair_load_.size()), pair_tj(pair_load_.size());
   for (std::size_t p = 0; p < pair_load_.size(); ++p) {
     pair_f[p] = pair_load_[p].force_i;
@@ -873,6 +955,7 @@ void BasicSimulation<Law>::save_state(std::ostream& os) const {
   nl_.save(w);
   w.value(gravity_); w.value(dt_); w.value(time_); w.value(skin_); w.value(steps_);
   w.value(reorder_every_); w.value(std::uint64_t(builds_since_reorder_)); w.value(forces_valid_);
+  w.checksum();
   if (!w.ok()) throw std::runtime_error("save_state: the stream failed while writing");
 }
 
@@ -880,10 +963,11 @@ template <class Law>
 void BasicSimulation<Law>::load_state(std::istream& is, const std::string& source) {
   StateReader r(is, source);
   const std::string tag = r.text("format tag");
-  // version 1 also stored the force on each wall (now summed when asked): read and dropped
-  const bool v1 = tag == "demcal-kernel-state/1";
-  if (tag != "demcal-kernel-state/2" && !v1)
-    r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a demcal kernel state (demcal-kernel-state/1 or /2)");
+  if (tag == "demcal-kernel-state/1" || tag == "demcal-kernel-state/2")
+    r.fail("format tag", "written by an older demcal (" + tag + "; this one reads " + kStateFormat +
+                             "): finish that run with the demcal that started it, or start it again");
+  if (tag != kStateFormat)
+    r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a demcal kernel state (" + kStateFormat + ")");
   std::vector<double> saved;
   r.array(saved, "configuration");
   const std::vector<double> now = configuration_numbers();
@@ -894,13 +978,10 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
                              "saved ones (first difference at configuration number " + std::to_string(k) + ")");
   }
   std::vector<char> enabled;
+  std::vector<Vec3> wall_motion;
   r.array(enabled, "wall switches");
-  if (v1) {
-    std::vector<Vec3> dropped;
-    r.array(dropped, "wall forces");
-  }
-  if (enabled.size() != walls_.size()) r.fail("walls", "wrong count");
-  for (std::size_t k = 0; k < walls_.size(); ++k) walls_[k].enabled = enabled[k] != 0;
+  r.array(wall_motion, "wall motion");
+  if (enabled.size() != walls_.size() || wall_motion.size() != 2 * walls_.size()) r.fail("walls", "wrong count");
   for_each_sphere_array([&](auto& a, int) { r.array(a, "sphere arrays"); });
   for_each_clump_array([&](auto& a) { r.array(a, "clump arrays"); });
   std::vector<Vec3> pair_f, pair_tj;
@@ -917,8 +998,15 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   r.value(steps_, "step count"); r.value(reorder_every_, "reorder period");
   builds_since_reorder_ = std::size_t(r.value<std::uint64_t>("builds since the last reorder"));
   r.value(forces_valid_, "force state");
+  r.checksum();  // nothing read is used before the whole state is known to be the one written
+  for (std::size_t k = 0; k < walls_.size(); ++k) {
+    walls_[k].enabled = enabled[k] != 0;
+    walls_[k].displacement = wall_motion[2 * k];
+    walls_[k].velocity = wall_motion[2 * k + 1];
+  }
   const std::size_t n = x_.size(), nc = cx_.size();
-  bool sizes_ok = wall_slot_id_.size() == n * kWallSlots && clump_.size() == n && cq_.size() == nc &&
+  bool sizes_ok = wall_slot_id_.size() == n * kWallSlots && wall_slot_s_.size() == n * kWallSlots * kHist &&
+                  clump_.size() == n && cq_.size() == nc &&
                   (nc == 0 ? cmem_start_.size() <= 1 : cmem_start_.size() == nc + 1) && body_id_.size() == body_ref_.size();
   for (auto t : ctmpl_) sizes_ok = sizes_ok && t >= 0 && t < std::int32_t(templates_.size());
   for (auto m : mat_) sizes_ok = sizes_ok && m >= 0 && m < std::int32_t(materials_.size());
@@ -931,9 +1019,10 @@ template <class Law>
 std::size_t BasicSimulation<Law>::memory_bytes() const {
   const std::size_t n = x_.size();
   std::size_t b = n * (5 * sizeof(Vec3) + 4 * sizeof(double) + 2 * sizeof(std::int32_t) +
-                       kWallSlots * (sizeof(std::int32_t) + 2 * sizeof(Vec3)) + sizeof(std::uint32_t) +
+                       kWallSlots * (sizeof(std::int32_t) + sizeof(Vec3) + kHist * sizeof(double)) + sizeof(std::uint32_t) +
                        sizeof(std::uint64_t));  // the last: the wall mask
-  b += nl_.num_pairs() * (sizeof(std::int32_t) + 3 * sizeof(Vec3) + sizeof(std::uint32_t)) + 2 * (n + 1) * 4;
+  b += nl_.num_pairs() * (sizeof(std::int32_t) + kHist * sizeof(double) + 2 * sizeof(Vec3) + sizeof(std::uint32_t)) +
+       2 * (n + 1) * 4;
   b += omega_norm_.size() * sizeof(double);  // (laws with rolling friction only)
   b += cx_.size() * (7 * sizeof(Vec3) + sizeof(Quat) + sizeof(double) + 3 * 4);
   return b;

@@ -39,8 +39,8 @@ int main(int argc, char** argv) {
   BasicSimulation<HertzMindlin> sim;  // no rolling friction in the peer case
   const int p = sim.add_material({1.0024e9, 0.4, 1430, "particle"});
   const int w = sim.add_material({2.08e9, 0.3, 7500, "wall"});
-  sim.set_pair(p, p, {0.5, 0.3, 0.0});
-  sim.set_pair(p, w, {0.6, 0.25, 0.0});
+  sim.set_pair(p, p, {{0.5}, {0.3}});
+  sim.set_pair(p, w, {{0.6}, {0.25}});
   sim.set_gravity({0, 0, -9.81});
   sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, w));
   sim.add_wall(Wall::cylinder(0, 0, 0.0525, -0.002, 0.20, w));

@@ -3,28 +3,41 @@
 //   beta = ln e / sqrt(ln^2 e + pi^2).
 // The damping term is not clipped (the force may turn slightly attractive at the end of a contact, as in LIGGGHTS
 // without limitForce); with that, a head-on collision returns exactly e (verified in tests/kernel/test_contact.cpp).
+// Acts only in contact (dn > 0); keeps no history.
 #pragma once
 #include <cmath>
+#include <stdexcept>
+#include "kernel/contact/contact_state.hpp"
 #include "kernel/material.hpp"
 
 namespace demcal::kernel {
 
-/// What a normal model hands to the tangential one.
-struct NormalOut {
-  double fn;         ///< normal force along n (positive = repulsive) [N]
-  double sqrt_rdn;   ///< sqrt(R* dn) [m]
-  double sqrt_sn_m;  ///< sqrt(Sn m*) [kg/s]
-};
-
 struct HertzNormal {
+  /// Per material pair, set by the user.
+  struct Params {
+    double restitution = 0.5;  ///< coefficient of restitution e [-], in (0, 1]; 1 = no damping
+    void validate() const { restitution_beta(restitution); }
+  };
+  /// Per pair type, precomputed once.
+  struct Coeffs {
+    double e_star = 0;  ///< effective Young's modulus E* [Pa]
+    double damp = 0;    ///< 2 sqrt(5/6) |beta| (>= 0; 0 for e = 1)
+  };
+  static Coeffs mix(const Material& a, const Material& b, const Params& p) {
+    return {effective_young(a, b), 2.0 * std::sqrt(5.0 / 6.0) * std::abs(restitution_beta(p.restitution))};
+  }
+  static constexpr int history_size = 0;
+  static constexpr bool beyond_contact = false;
+  static void swap_history(double*) {}
+
   /// Normal force for overlap dn > 0 and normal relative velocity vn = v_rel . n (negative while approaching).
-  [[gnu::always_inline]] static inline NormalOut force(const PairCoeffs& c, double dn, double r_star, double m_star,
-                                                       double vn) {
-    NormalOut o;
-    o.sqrt_rdn = std::sqrt(r_star * dn);
-    const double sn = 2.0 * c.e_star * o.sqrt_rdn;  // Fn_el = 2/3 Sn dn
-    o.sqrt_sn_m = std::sqrt(sn * m_star);
-    o.fn = (2.0 / 3.0) * sn * dn - c.damp * o.sqrt_sn_m * vn;
+  [[gnu::always_inline]] static inline NormalState force(const Coeffs& c, const ContactGeometry& g, double vn, double*) {
+    NormalState o;
+    o.contact_radius = std::sqrt(g.r_star * g.dn);
+    const double sn = 2.0 * c.e_star * o.contact_radius;  // Fn_el = 2/3 Sn dn
+    o.damp_prefactor = c.damp * std::sqrt(sn * g.m_star);
+    o.fn = (2.0 / 3.0) * sn * g.dn - o.damp_prefactor * vn;
+    o.fn_crit = std::abs(o.fn);
     return o;
   }
 };

@@ -135,8 +135,8 @@ kernel::Material to_kernel(const silo::Material& m, const char* name) {
     return k;
 }
 
-kernel::PairProperties to_kernel(const PairCoefficients& p) {
-    kernel::PairProperties k;
+Simulation::PairParams to_kernel(const PairCoefficients& p) {
+    Simulation::PairParams k;
     k.restitution = p.restitution;
     k.friction = p.friction;
     k.rolling_friction = p.rolling_friction;
@@ -211,9 +211,11 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
-// Version 2 adds the CPU time; version 1 checkpoints are still read (their sessions' CPU time is not counted).
+// Version 3: each section (tag and settings; the case's state; the kernel's state) closed by a checksum, the kernel's
+// state in its format 3 (contact histories of any size, moving walls). Versions 1 and 2 (no checksums, the kernel's
+// format 2) are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 2;
+constexpr int kCheckpointVersion = 3;
 
 // Every setting that shapes the run, named once: the checkpoint stores the settings through this list.
 template <class S, class F>
@@ -342,9 +344,11 @@ public:
         {
             std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
             if (!os) throw std::runtime_error("checkpoint '" + tmp + "': cannot open for writing");
+            StateWriter head(os);
+            head.text(kCheckpointTagPrefix + std::to_string(kCheckpointVersion));
+            write_settings(head, s_);
+            head.checksum();
             StateWriter w(os);
-            w.text(kCheckpointTagPrefix + std::to_string(kCheckpointVersion));
-            write_settings(w, s_);
             w.value(phase_); w.value(wall_top_); w.value(plate_);
             w.value(lost_); w.value(next_progress_); w.value(vtk_next_step_); w.value(ke_);
             w.value(t_open_); w.value(next_frame_); w.value(mass_out_); w.value(grains_out_); w.value(last_out_time_);
@@ -360,6 +364,7 @@ public:
                 classifier_->save(w);
                 r_.section->save(w);
             }
+            w.checksum();
             sim_.save_state(os);
             os.flush();
             if (!os) throw std::runtime_error("checkpoint '" + tmp + "': write failed (disk full?)");
@@ -389,11 +394,9 @@ public:
         r.value(r_.filled_mass, "filled mass"); r.value(r_.fill_steps, "fill steps");
         r.value(r_.fill_wall_s, "fill wall time"); r.value(r_.sessions, "sessions");
         r.value(r_.checkpoints, "checkpoints"); r.value(r_.vtk_files, "vtk files");
-        r_.cpu_sessions = 0;
-        if (version >= 2) {
-            r.value(cpu_before_, "cpu time");
-            r.value(r_.cpu_sessions, "cpu sessions");
-        }
+        (void)version;  // (one version is read: kCheckpointVersion)
+        r.value(cpu_before_, "cpu time");
+        r.value(r_.cpu_sessions, "cpu sessions");
         r.array(r_.discharge, "discharge record");
         if (phase_ != Phase::filling && phase_ != Phase::discharge) r.fail("phase", "unknown value");
         plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_);
@@ -402,6 +405,7 @@ public:
             classifier_->load(r);
             r_.section->load(r);
         }
+        r.checksum();
         sim_.load_state(is, source);
         ++r_.sessions;
         ++r_.cpu_sessions;
@@ -709,15 +713,18 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string tag = r.text("format tag");
     const std::string prefix = kCheckpointTagPrefix;
     version = 0;
-    if (tag.rfind(prefix, 0) == 0) {
-        const std::string v = tag.substr(prefix.size());
-        for (int k = 1; k <= kCheckpointVersion; ++k)
-            if (v == std::to_string(k)) version = k;
+    const std::string current = prefix + std::to_string(kCheckpointVersion);
+    if (tag == current) {
+        version = kCheckpointVersion;
+    } else if (tag == prefix + "1" || tag == prefix + "2") {
+        r.fail("format tag", "written by an older demcal (" + tag + "; this one reads " + current +
+                                 "): finish that run with the demcal that started it, or start it again");
+    } else {
+        r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + current + ")");
     }
-    if (version == 0)
-        r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + prefix + "1 or " + prefix +
-                                 std::to_string(kCheckpointVersion) + ")");
-    return read_settings(r);
+    SiloCaseSettings settings = read_settings(r);
+    r.checksum();
+    return settings;
 }
 
 }  // namespace

@@ -50,7 +50,7 @@ TEST_CASE("a clump spinning freely about a non-principal axis conserves angular 
           "[kernel][clump]") {
   Simulation sim;
   const int a = sim.add_material({1e9, 0.4, 1430, ""});
-  sim.set_pair(a, a, {0.5, 0.3, 0.01});
+  sim.set_pair(a, a, {{0.5}, {0.3}, {0.01}});
   sim.set_gravity(Vec3::Zero());
   // an asymmetric clump (three moments all different): L-shaped, overlapping spheres
   const ClumpTemplate t = make_clump_template({{0, 0, 0}, {1.5e-3, 0, 0}, {0, 1e-3, 0.5e-3}}, {1e-3, 0.8e-3, 0.7e-3},
@@ -80,7 +80,7 @@ TEST_CASE("a clump spinning freely about a non-principal axis conserves angular 
 TEST_CASE("a clump spinning about a principal axis keeps omega", "[kernel][clump]") {
   Simulation sim;
   const int a = sim.add_material({1e9, 0.4, 1430, ""});
-  sim.set_pair(a, a, {0.5, 0.3, 0.01});
+  sim.set_pair(a, a, {{0.5}, {0.3}, {0.01}});
   sim.set_gravity(Vec3::Zero());
   const int tmpl = sim.add_clump_template(wheat_clump_template());
   const Vec3 w0(0, 0, 50);  // about the template z axis: a transverse principal axis of the wheat grain

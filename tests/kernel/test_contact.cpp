@@ -53,7 +53,7 @@ Collision sphere_sphere(double e, double r1, double r2, double v, double dt_frac
                         Collision* ref) {
   Simulation sim;
   const int a = sim.add_material(kA);
-  sim.set_pair(a, a, {e, 0.3, 0.0});
+  sim.set_pair(a, a, {{e}, {0.3}, {0.0}});
   sim.set_gravity(Vec3::Zero());
   sim.add_sphere({-r1 - 1e-6, 0, 0}, r1, a, {0.5 * v, 0, 0});
   sim.add_sphere({r2 + 1e-6, 0, 0}, r2, a, {-0.5 * v, 0, 0});
@@ -84,8 +84,8 @@ Collision sphere_wall(double e, double r, double v, double dt_fraction, double* 
                       bool rectangle) {
   Simulation sim;
   const int a = sim.add_material(kA), b = sim.add_material(kB);
-  sim.set_pair(a, a, {0.5, 0.3, 0.0});
-  sim.set_pair(a, b, {e, 0.25, 0.0});
+  sim.set_pair(a, a, {{0.5}, {0.3}, {0.0}});
+  sim.set_pair(a, b, {{e}, {0.25}, {0.0}});
   sim.set_gravity(Vec3::Zero());
   if (rectangle)
     sim.add_wall(Wall::rectangle({0, 0, 0}, {0, 0, 1}, {1, 1, 0}, 0.01, 0.02, b));

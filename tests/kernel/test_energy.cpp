@@ -46,8 +46,8 @@ double energy_error(double dt_fraction, long steps) {
   Simulation sim;
   const int a = sim.add_material({1e8, 0.3, 1000, ""});
   const int w = sim.add_material({2e11, 0.3, 7800, ""});
-  sim.set_pair(a, a, {1.0, 0.0, 0.0});
-  sim.set_pair(a, w, {1.0, 0.0, 0.0});
+  sim.set_pair(a, a, {{1.0}, {0.0}, {0.0}});
+  sim.set_pair(a, w, {{1.0}, {0.0}, {0.0}});
   sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, w));
   sim.add_wall(Wall::cylinder(0, 0, 0.006, -0.01, 0.05, w));
   std::mt19937 rng(7);

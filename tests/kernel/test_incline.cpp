@@ -18,8 +18,8 @@ Slide run(double alpha_deg, double mu) {
   Simulation sim;
   const int a = sim.add_material({1e8, 0.3, 1000, ""});
   const int w = sim.add_material({2e11, 0.3, 7800, ""});
-  sim.set_pair(a, a, {0.5, mu, 0.0});
-  sim.set_pair(a, w, {0.5, mu, 0.0});
+  sim.set_pair(a, a, {{0.5}, {mu}, {0.0}});
+  sim.set_pair(a, w, {{0.5}, {mu}, {0.0}});
   const double alpha = alpha_deg * M_PI / 180.0;
   sim.set_gravity(9.81 * Vec3(std::sin(alpha), 0, -std::cos(alpha)));
   sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, w));

@@ -20,19 +20,19 @@ struct Scene {
   explicit Scene(int threads, unsigned seed = 42, int n = 300) {
     const int wheat = sim.add_material({1.0024e9, 0.4, 1430, "wheat"});
     const int steel = sim.add_material({2.08e9, 0.3, 7500, "steel"});
-    sim.set_pair(wheat, wheat, {0.5, 0.3, 0.01});
-    sim.set_pair(wheat, steel, {0.6, 0.25, 0.01});
+    sim.set_pair(wheat, wheat, {{0.5}, {0.3}, {0.01}});
+    sim.set_pair(wheat, steel, {{0.6}, {0.25}, {0.01}});
     const double R = 0.015, ro = 0.006, theta = 30 * M_PI / 180;
     const Wall cone = Wall::cone(0, 0, ro, 0.0, theta, R, steel);
     sim.add_wall(cone);
-    sim.add_wall(Wall::cylinder(0, 0, R, cone.z1, 0.2, steel));
+    sim.add_wall(Wall::cylinder(0, 0, R, std::get<AxisymmetricWall>(cone.shape).z1, 0.2, steel));
     plate = sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, steel));
     const int tmpl = sim.add_clump_template(wheat_clump_template(1430, 60));
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
     for (int k = 0; k < n; ++k) {  // on a 5.6 mm lattice (no initial overlap), 16 per layer, jittered
       const Vec3 p(-0.0084 + 0.0056 * (k % 4) + 2e-4 * u(rng), -0.0084 + 0.0056 * ((k / 4) % 4) + 2e-4 * u(rng),
-                   cone.z1 + 0.003 + 0.0056 * (k / 16));
+                   std::get<AxisymmetricWall>(cone.shape).z1 + 0.003 + 0.0056 * (k / 16));
       if (k % 3 == 0) {
         sim.add_sphere(p, 1.2e-3 + 0.2e-3 * u(rng), wheat, Vec3(0.3 * u(rng), 0.3 * u(rng), -0.5 + 0.3 * u(rng)));
       } else {
@@ -137,8 +137,8 @@ TEST_CASE("a sphere too big for the outlet rests on the cone at the analytic hei
   Simulation sim;
   const int a = sim.add_material({1e8, 0.3, 1000, ""});
   const int w = sim.add_material({2e11, 0.3, 7800, ""});
-  sim.set_pair(a, w, {0.3, 0.5, 0.0});
-  sim.set_pair(a, a, {0.3, 0.5, 0.0});
+  sim.set_pair(a, w, {{0.3}, {0.5}, {0.0}});
+  sim.set_pair(a, a, {{0.3}, {0.5}, {0.0}});
   const double ro = 0.004, theta = 25 * M_PI / 180, R = 0.005;
   sim.add_wall(Wall::cone(0.01, -0.02, ro, 0.1, theta, 0.02, w));
   sim.add_sphere({0.01, -0.02, 0.15}, R, a);

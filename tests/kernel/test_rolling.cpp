@@ -22,8 +22,8 @@ Roll roll(double mu_roll, double v0, double duration) {
   Simulation sim;
   const int grain = sim.add_material({1e8, 0.3, 2500, "grain"});
   const int steel = sim.add_material({2e11, 0.3, 7800, "steel"});
-  sim.set_pair(grain, grain, {0.5, 0.5, mu_roll});
-  sim.set_pair(grain, steel, {0.5, 0.5, mu_roll});
+  sim.set_pair(grain, grain, {{0.5}, {0.5}, {mu_roll}});
+  sim.set_pair(grain, steel, {{0.5}, {0.5}, {mu_roll}});
   sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, steel));
   const double R = 2e-3;
   sim.add_sphere({0, 0, R}, R, grain);

@@ -1,6 +1,7 @@
-// What a contact law sees of one contact: geometry and kinematics, built by the kernel for sphere-sphere and
-// sphere-wall contacts alike. Sub-models (normal, tangential, rolling) are small structs with static inline
-// functions; a law composes them at compile time (contact_law.hpp), so the inner loop has no virtual calls.
+// What a contact law sees of one contact, and what its sub-models hand each other. The kernel builds the geometry and
+// kinematics for sphere-sphere and sphere-wall contacts alike; the sub-models (normal, tangential, rolling; one
+// header each) are small structs with static inline functions, composed at compile time (contact_law.hpp), so the
+// inner loop has no virtual calls.
 #pragma once
 #include "kernel/types.hpp"
 
@@ -8,7 +9,7 @@ namespace demcal::kernel {
 
 struct ContactGeometry {
   Vec3 n;          ///< unit normal, pointing from j (or the wall) towards i
-  double dn;       ///< overlap (> 0 in contact) [m]
+  double dn;       ///< overlap [m]: > 0 in contact; < 0 is a gap, seen only by laws that act beyond contact
   double r_star;   ///< effective radius R* (1/R* = 1/R_i + 1/R_j; wall: R_i) [m]
   double m_star;   ///< effective mass m* (1/m* = 1/m_i + 1/m_j; wall: m_i; clump member: whole clump's mass) [kg]
   double radius_i; ///< radius of sphere i [m]
@@ -23,6 +24,15 @@ struct ContactKinematics {
   Vec3 omega_j; ///< angular velocity of j (zero for a wall) [rad/s]
   double omega_i_norm = 0; ///< |omega_i|, computed once per sphere and force evaluation (not per contact) [rad/s]
   double omega_j_norm = 0; ///< |omega_j| (zero for a wall) [rad/s]
+};
+
+/// What the normal sub-model hands to the tangential and rolling ones: model-neutral quantities (as LAMMPS GRANULAR's
+/// GranularModel fields), so that any normal model composes with any tangential or rolling model.
+struct NormalState {
+  double fn = 0;              ///< normal force along n (positive = repulsive) [N]
+  double fn_crit = 0;         ///< the normal load that bounds friction and rolling resistance (|fn| without adhesion) [N]
+  double contact_radius = 0;  ///< radius a of the contact area [m] (Hertz: sqrt(R* dn))
+  double damp_prefactor = 0;  ///< normal viscous damping coefficient [kg/s]; the tangential damping scales it
 };
 
 /// What a law returns: force on i (j gets -force_i), torques about the two sphere centres.

@@ -1,0 +1,62 @@
+// Prescribed motions of a wall: its displacement d(t) from the position it was built at (translation only), a pure
+// function of time, so that a checkpointed run resumes on the same path. A wall without one moves at the velocity a
+// driver sets (BasicSimulation::set_wall_velocity: a servo-held lid, a shear frame), zero unless set.
+#pragma once
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+#include "kernel/types.hpp"
+
+namespace demcal::kernel {
+
+class WallMotion {
+ public:
+  virtual ~WallMotion() = default;
+  /// Displacement from the built position at time t [m].
+  virtual Vec3 displacement(double t) const = 0;
+  /// Velocity at time t [m/s] (right-continuous: at a start, the velocity just after it). Contacts see it when forces
+  /// are evaluated at an instant (after a state was set); over a step they see the mean velocity of the step.
+  virtual Vec3 velocity(double t) const = 0;
+  /// The law's kind and numbers, for the checkpoint's configuration check.
+  virtual void append_numbers(std::vector<double>& c) const = 0;
+};
+
+/// d(t) = A sin(2 pi f (t - t0)) e for t >= t0, 0 before: a vibrator (the seed's eccentric vibrator on the bin).
+class SinusoidalMotion final : public WallMotion {
+ public:
+  /// direction: any nonzero vector (normalised); amplitude A [m] >= 0; frequency f [Hz] >= 0; start t0 [s].
+  SinusoidalMotion(const Vec3& direction, double amplitude, double frequency, double start)
+      : amplitude_(amplitude), frequency_(frequency), start_(start) {
+    if (!(direction.allFinite() && direction.norm() > 0))
+      throw std::invalid_argument("vibration direction must be a finite nonzero vector");
+    if (!(amplitude >= 0 && std::isfinite(amplitude)))
+      throw std::invalid_argument("vibration amplitude must be finite and >= 0 m, got " + std::to_string(amplitude));
+    if (!(frequency >= 0 && std::isfinite(frequency)))
+      throw std::invalid_argument("vibration frequency must be finite and >= 0 Hz, got " + std::to_string(frequency));
+    if (!std::isfinite(start)) throw std::invalid_argument("vibration start must be finite");
+    direction_ = direction.normalized();
+  }
+  Vec3 displacement(double t) const override {
+    if (t <= start_) return Vec3::Zero();
+    return (amplitude_ * std::sin(2.0 * M_PI * frequency_ * (t - start_))) * direction_;
+  }
+  Vec3 velocity(double t) const override {
+    if (t < start_) return Vec3::Zero();
+    const double w = 2.0 * M_PI * frequency_;
+    return (amplitude_ * w * std::cos(w * (t - start_))) * direction_;
+  }
+  void append_numbers(std::vector<double>& c) const override {
+    c.insert(c.end(), {1.0, direction_.x(), direction_.y(), direction_.z(), amplitude_, frequency_, start_});
+  }
+  double amplitude() const { return amplitude_; }
+  double frequency() const { return frequency_; }
+  /// Peak acceleration A (2 pi f)^2 [m/s^2].
+  double peak_acceleration() const { const double w = 2.0 * M_PI * frequency_; return amplitude_ * w * w; }
+
+ private:
+  Vec3 direction_;
+  double amplitude_, frequency_, start_;
+};
+
+}  // namespace demcal::kernel
