@@ -17,15 +17,17 @@ YADE's integrator and its local damping.
 
 The engines are those of shear_box.py (same Ig2/Ip2/Law2 functors, same order), with two PyRunners around them:
   [pre PyRunner, ForceResetter, InsertionSortCollider, InteractionLoop, NewtonIntegrator(damping), post PyRunner]
-pre  records the kinematics the InteractionLoop of this step sees (positions x^n, velocities v^{n-1/2});
+pre  records the kinematics the InteractionLoop of this step sees (positions x^n, the velocities state.vel/angVel);
 post records the interaction (normal, penetration, forces, bond state) and O.forces on both bodies (forces of step n),
      then sets the moving body's velocity for the next step from the path, and arms setCohesionNow so that bonds are
      created in the InteractionLoop of step bond_at_step.
 
 Path (params "path": a list of segments, each {"steps": N, "vel": [vx, vy, vz], "angvel": [wx, wy, wz]}): the segments
 are laid end to end; step n (0-based) of the run belongs to the segment that covers it, and that segment's vel/angvel is
-the velocity NewtonIntegrator uses in step n to move the moving body from x^n to x^{n+1}. Hence the InteractionLoop of
-step n sees the velocity of step n-1 (YADE's leapfrog: v^{n-1/2}), except step 0, which sees the velocity of step 0.
+the velocity NewtonIntegrator uses in step n to move the moving body from x^n to x^{n+1}. A non-dynamic body's velocity
+is never changed by NewtonIntegrator, so the InteractionLoop of step n sees that same velocity: the shear increment of
+step n is computed from the move the body is about to make (x^{n+1} - x^n) / dt, while the geometry is that of x^n.
+(A dynamic body's InteractionLoop sees v^{n-1/2} = (x^n - x^{n-1}) / dt instead; see YADE_LAWS.md, step order.)
 The run lasts sum(steps) steps.
 """
 import json
