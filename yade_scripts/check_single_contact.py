@@ -314,6 +314,156 @@ def replay(p):
     return out, mass, inertia
 
 
+# --- rigid clumps (NewtonIntegrator's aspherical integrator); quaternions as [x, y, z, w] like Eigen's coeffs() -------
+def q_rotate(q, v):
+    """Eigen's Quaternion * Vector3 (_transformVector), also for a quaternion that is not exactly unit."""
+    u, w = q[:3], q[3]
+    uv = cross(u, v)
+    uv = add(uv, uv)
+    return add(add(v, mul(w, uv)), cross(u, uv))
+
+
+def q_matrix_apply(q, v):
+    """Eigen's q.toRotationMatrix() * v."""
+    x, y, z, w = q
+    tx, ty, tz = 2 * x, 2 * y, 2 * z
+    twx, twy, twz = tx * w, ty * w, tz * w
+    txx, txy, txz = tx * x, ty * x, tz * x
+    tyy, tyz, tzz = ty * y, tz * y, tz * z
+    m = [[1 - (tyy + tzz), txy - twz, txz + twy], [txy + twz, 1 - (txx + tzz), tyz - twx],
+         [txz - twy, tyz + twx, 1 - (txx + tyy)]]
+    return [dot(m[i], v) for i in range(3)]
+
+
+def dot_q(wb, q):
+    """NewtonIntegrator::DotQ (pkg/dem/NewtonIntegrator.cpp:392-400): dq/dt for a body-frame angular velocity."""
+    x, y, z, w = q
+    return [(w * wb[0] - z * wb[1] + y * wb[2]) / 2, (z * wb[0] + w * wb[1] - x * wb[2]) / 2,
+            (-y * wb[0] + x * wb[1] + w * wb[2]) / 2, (-x * wb[0] - y * wb[1] - z * wb[2]) / 2]
+
+
+def replay_clump(p, meta):
+    """A free clump whose members touch the fixed box (CundallStrack contacts), NewtonIntegrator with damping:
+    clump force/torque from the members, translation with cundallDamp2nd, rotation by the aspherical leapfrog with the
+    torque damped by cundallDamp1st, members moved rigidly. Mass, principal inertia, initial orientation and members'
+    local positions are YADE's (appendClumped's grid integration), read from the meta file."""
+    dt, d = p["dt"], p.get("damping", 0.0)
+    mats, fixed, moving = p["materials"], p["fixed"], p["moving"]
+    mat0, mat1 = mats[fixed["material"]], mats[moving["material"]]
+    xb = list(map(float, fixed["center"]))
+    mass, inertia = meta["clump_mass"], meta["clump_inertia"]
+    X, q = list(meta["clump_pos0"]), list(meta["clump_ori0"])
+    sub_pos = meta["member_local_pos"]
+    radii = [m[3] for m in moving["clump"]]
+    xs = [list(map(float, m[:3])) for m in moving["clump"]]
+    for xi, sp in zip(xs, sub_pos):  # the quaternion convention: X + q * local = the members' initial centres
+        assert norm(sub(add(X, q_rotate(q, sp)), xi)) < 1e-15, "clump quaternion convention"
+    V = list(map(float, moving["vel0"]))
+    W, L = list(ZERO), list(ZERO)
+    vs = [list(V) for _ in xs]
+    ws = [list(ZERO) for _ in xs]
+    geoms = [None] * len(xs)
+    phys = [None] * len(xs)
+    out = {}
+    for n in range(p["steps"]):
+        row = {"c_pos": list(X), "c_vel": list(V), "c_angvel": list(W), "c_angmom": list(L), "c_ori": list(q),
+               "members": []}
+        F, T = list(ZERO), list(ZERO)
+        for k in range(len(xs)):
+            g = geoms[k] or Geom()
+            real = phys[k] is not None
+            f, t, mrow = list(ZERO), list(ZERO), {"real": False}
+            if sphere_box(g, real, xb, fixed["extents"], xs[k], radii[k], ZERO, ZERO, vs[k], ws[k], dt):
+                if phys[k] is None:
+                    phys[k] = frict_phys(mat0, mat1, g.r1, g.r2)
+                f1 = cundall_strack(g, phys[k])
+                if f1 is None:
+                    geoms[k], phys[k] = None, None
+                else:
+                    geoms[k] = g
+                    f = mul(-1.0, f1)
+                    t = mul(g.r2 - 0.5 * g.pen, cross(g.normal, f1))
+                    mrow = {"real": True, "pen": g.pen, "normal": g.normal, "fn": phys[k]["fn"], "fs": phys[k]["fs"]}
+            else:
+                geoms[k] = None
+            mrow.update({"f": f, "t": t})
+            row["members"].append(mrow)
+            F = add(F, f)  # Clump::addForceTorqueFromMembers
+            T = add(T, add(t, cross(sub(xs[k], X), f)))
+        row["c_f"], row["c_t"] = F, T
+        out[n] = row
+        # NewtonIntegrator, clump body
+        a = [F[i] / mass for i in range(3)]
+        a = [a[i] * (1 - d * sign(a[i] * (V[i] + 0.5 * dt * a[i]))) for i in range(3)]
+        V = [V[i] + dt * a[i] for i in range(3)]
+        M = [T[i] * (1 - d * sign(T[i] * W[i])) for i in range(3)]  # cundallDamp1st on the torque
+        X = [X[i] + V[i] * dt for i in range(3)]
+        # leapfrogAsphericalRotate (pkg/dem/NewtonIntegrator.cpp:339-358)
+        qc = [-q[0], -q[1], -q[2], q[3]]
+        l_n = add(L, mul(dt / 2.0, M))
+        l_b_n = q_matrix_apply(qc, l_n)
+        w_b_n = [l_b_n[i] / inertia[i] for i in range(3)]
+        dq = dot_q(w_b_n, q)
+        q_half = [q[i] + dt / 2.0 * dq[i] for i in range(4)]
+        L = add(L, mul(dt, M))
+        l_b_half = q_matrix_apply(qc, L)
+        w_b_half = [l_b_half[i] / inertia[i] for i in range(3)]
+        dq = dot_q(w_b_half, q_half)
+        q = [q[i] + dt * dq[i] for i in range(4)]
+        W = q_rotate(q, w_b_half)
+        qn = math.sqrt(sum(c * c for c in q))
+        q = [c / qn for c in q]
+        # Clump::moveMembers
+        for k in range(len(xs)):
+            xs[k] = add(X, q_rotate(q, sub_pos[k]))
+            vs[k] = add(V, cross(W, sub(xs[k], X)))
+            ws[k] = list(W)
+    return out
+
+
+def check_clump(case, p, rows, meta, tol):
+    sim = replay_clump(p, meta)
+    problems = []
+    quantities = {}  # name -> list of (step, python vector, yade vector)
+
+    def yv(r, prefix, comps="xyz"):
+        return [float(r[prefix + c]) for c in comps]
+
+    for r in rows:
+        n = int(r["step"])
+        s = sim[n]
+        for name, key, comps in (("c_pos", "c_pos_", "xyz"), ("c_vel", "c_vel_", "xyz"), ("c_angvel", "c_angvel_", "xyz"),
+                                 ("c_angmom", "c_angmom_", "xyz"), ("c_ori", "c_ori_", "xyzw"), ("c_f", "c_f_", "xyz"),
+                                 ("c_t", "c_t_", "xyz")):
+            quantities.setdefault(name, []).append((n, s[name], yv(r, key, comps)))
+        for k, m in enumerate(s["members"]):
+            pre = "m%d_" % (k + 1)
+            if (r[pre + "real"] == "1") != m["real"]:
+                problems.append("step %d member %d: YADE real=%s, replay %s" % (n, k + 1, r[pre + "real"], m["real"]))
+                continue
+            for name in ("f", "t") + (("fn", "fs", "normal") if m["real"] else ()):
+                key = pre + ("n_" if name == "normal" else name + "_")
+                quantities.setdefault("m_" + name, []).append((n, m[name], yv(r, key)))
+    worst = {}
+    for name, triples in quantities.items():
+        peak = max(norm(y) for _, _, y in triples)
+        e_max, at = 0.0, None
+        for n, a, y in triples:
+            diff = math.sqrt(sum((ai - yi) ** 2 for ai, yi in zip(a, y)))
+            e = diff / max(math.sqrt(sum(yi * yi for yi in y)), 1e-9 * peak, 1e-300)
+            if e > e_max:
+                e_max, at = e, n
+        worst[name] = (e_max, at)
+    max_err = max(e for e, _ in worst.values())
+    ok = not problems and max_err <= tol
+    print("%-24s %s  max rel error %.3g  (%d rows, %d steps)" % (case, "OK  " if ok else "FAIL", max_err, len(rows),
+                                                                 len(sim)))
+    print("    " + ", ".join("%s %.2g@%s" % (k, e, n) for k, (e, n) in worst.items()))
+    for msg in problems[:10]:
+        print("    " + msg)
+    return ok, max_err
+
+
 VECTORS = {"fn": "fn_", "fs": "fs_", "f0": "b0_f_", "f1": "b1_f_", "t0": "b0_t_", "t1": "b1_t_", "x1": "b1_pos_",
            "v1": "b1_vel_", "w1": "b1_angvel_", "normal": "n_"}
 SCALARS = {"pen": "pen", "kn": "kn", "ks": "ks"}
@@ -326,6 +476,8 @@ def check(case, tol):
         rows = list(csv.DictReader(f))
     with open(os.path.join(DATA, case + ".csv.meta.json")) as f:
         meta = json.load(f)
+    if "clump" in p["moving"]:
+        return check_clump(case, p, rows, meta, tol)
     sim, mass, inertia = replay(p)
     problems = []
     if meta.get("interaction_ids") not in (None, [0, 1]):

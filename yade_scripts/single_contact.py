@@ -86,6 +86,8 @@ def main():
     else:
         b0 = utils.box(center=vec(fixed["center"], "fixed.center"), extents=vec(fixed["extents"], "fixed.extents"),
                        fixed=True, material=mats[fixed["material"]])
+    if "clump" in moving:
+        return run_clump(p, mats, b0, out_path)
     dynamic = bool(moving.get("dynamic", False))
     b1 = utils.sphere(vec(moving["pos"], "moving.pos"), float(moving["radius"]), material=mats[moving["material"]],
                       fixed=not dynamic)
@@ -206,6 +208,91 @@ def main():
     print("single_contact: %d steps, %d rows -> %s; first real step %s, bonds at %s, erased at %s, phys %s" %
           (total_steps, len(rows), out_path, meta["first_real_step"], meta["bond_steps"], meta["erased_steps"],
            meta["phys_class"]))
+
+
+
+def run_clump(p, mats, b0, out_path):
+    """A free rigid clump of spheres (O.bodies.appendClumped(..., discretization=10), as shear_box.py makes them) thrown
+    with velocity vel0 onto the fixed body; no gravity, NewtonIntegrator(damping). Params: moving = {"clump": [[x, y, z,
+    r], ...] (member centres and radii), "material", "vel0"}; "steps". The clump starts without spin (its angular
+    momentum is 0); members get the clump's velocity. Ids: 0 fixed body, 1..m members, m+1 the clump.
+    One row per sampled step: the clump's kinematics at the start of the step (pos, vel, angVel, angMom, ori as x y z w),
+    for each member k its interaction with body 0 (real, pen, normal, normal and shear force) and O.forces on it, and
+    O.forces on the clump read after the step (NewtonIntegrator has added the members' sum to it)."""
+    moving = p["moving"]
+    O.bodies.append(b0)
+    members = [utils.sphere(Vector3(m[0], m[1], m[2]), float(m[3]), material=mats[moving["material"]])
+               for m in moving["clump"]]
+    clump_id, member_ids = O.bodies.appendClumped(members, discretization=10)
+    assert member_ids == list(range(1, len(members) + 1)) and clump_id == len(members) + 1
+    cs = O.bodies[clump_id].state
+    cs.vel = vec(moving["vel0"], "moving.vel0")
+    for i in member_ids:
+        O.bodies[i].state.vel = cs.vel
+    total_steps = int(p["steps"])
+    O.engines = [
+        PyRunner(iterPeriod=1, initRun=True, command="pre_step()"),
+        ForceResetter(),
+        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
+        InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys(), Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
+            [Law2_ScGeom_FrictPhys_CundallStrack(), Law2_ScGeom6D_CohFrictPhys_CohesionMoment()]),
+        NewtonIntegrator(damping=float(p.get("damping", 0.0)), gravity=Vector3(0, 0, 0)),
+        PyRunner(iterPeriod=1, initRun=True, command="post_step()"),
+    ]
+    O.dt = float(p["dt"])
+    sample_every = int(p["sample_every"])
+    columns = ["step", "time"] + ["c_%s%s" % (q, c) for q in ("pos_", "vel_", "angvel_", "angmom_") for c in "xyz"] + \
+        ["c_ori_%s" % c for c in "xyzw"]
+    for k in range(1, len(members) + 1):
+        columns += ["m%d_%s" % (k, q) for q in ("real", "pen", "n_x", "n_y", "n_z", "fn_x", "fn_y", "fn_z", "fs_x",
+                                                "fs_y", "fs_z", "f_x", "f_y", "f_z", "t_x", "t_y", "t_z")]
+    columns += ["c_f_x", "c_f_y", "c_f_z", "c_t_x", "c_t_y", "c_t_z"]
+    rows, pre = [], []
+
+    def pre_step():
+        del pre[:]
+        pre.extend(list(cs.pos) + list(cs.vel) + list(cs.angVel) + list(cs.angMom) +
+                   [cs.ori[0], cs.ori[1], cs.ori[2], cs.ori[3]])
+
+    def post_step():
+        n = O.iter
+        if not (n % sample_every == 0 or n == total_steps - 1):
+            return
+        row = [n, n * O.dt] + pre
+        for i in member_ids:
+            inter = O.interactions[0, i] if O.interactions.has(0, i) else None
+            if inter is not None and inter.isReal:
+                assert (inter.id1, inter.id2) == (0, i)
+                row += [1, inter.geom.penetrationDepth] + list(inter.geom.normal) + list(inter.phys.normalForce) + \
+                    list(inter.phys.shearForce)
+            else:
+                row += [0] + [0.0] * 10
+            row += list(O.forces.f(i)) + list(O.forces.t(i))
+        row += list(O.forces.f(clump_id)) + list(O.forces.t(clump_id))
+        rows.append(row)
+
+    globals()["pre_step"] = pre_step
+    globals()["post_step"] = post_step
+    sub = O.bodies[clump_id].shape.members
+    meta = {"yade_version": str(version), "dt": O.dt, "steps": total_steps, "sample_every": sample_every,
+            "clump_id": clump_id, "member_ids": member_ids, "clump_mass": cs.mass, "clump_inertia": list(cs.inertia),
+            "clump_pos0": list(cs.pos), "clump_ori0": [cs.ori[0], cs.ori[1], cs.ori[2], cs.ori[3]],
+            "clump_aspherical": O.bodies[clump_id].aspherical,
+            "member_local_pos": [list(sub[i][0]) for i in member_ids],
+            "member_mass": [O.bodies[i].state.mass for i in member_ids], "params": p}
+    O.run(total_steps, True)
+    tmp = out_path + ".tmp%d" % os.getpid()
+    with open(tmp, "w") as f:
+        f.write(",".join(columns) + "\n")
+        for row in rows:
+            f.write(",".join(str(x) if isinstance(x, int) else repr(float(x)) for x in row) + "\n")
+    os.replace(tmp, out_path)
+    with open(out_path + ".meta.json", "w") as f:
+        json.dump(meta, f, indent=1)
+        f.write("\n")
+    print("single_contact: clump of %d, %d steps, %d rows -> %s" % (len(members), total_steps, len(rows), out_path))
 
 
 main()

@@ -123,3 +123,13 @@ write("sb_dynamic_damped", "a free (dynamic) sand sphere thrown with spin onto t
           "materials": {"wall": WALL, "b": PART_A}, "fixed": box,
           "moving": {"pos": [0.002, 0.001, 0.0035 + 2.5e-6], "radius": 0.0035, "material": "b", "dynamic": True,
                      "vel0": [0.05, -0.02, -0.1], "angvel0": [5.0, -30.0, 10.0]}})
+
+write("cb_clump_damped", "a free rigid clump of two sand spheres (aspect ratio 1.5: r = 3.5 mm, centres 3.5 mm apart, "
+      "appendClumped(discretization=10) as shear_box.py) thrown tilted onto the fixed box wall, no gravity, "
+      "NewtonIntegrator(damping=0.2): one member hits first, the clump spins (aspherical integrator, torque damping), "
+      "the second member hits while the first is still in contact", {
+          "case": "sphere_box", "law": "frict", "dt": DT, "sample_every": 1, "damping": 0.2, "steps": 100,
+          "materials": {"wall": WALL, "b": PART_A}, "fixed": box,
+          "moving": {"clump": [[0.002, 0.001, 0.0035 + 2.5e-6, 0.0035],
+                               [0.002 + 0.0035 * 0.95, 0.001 + 0.0035 * 0.3, 0.0035 + 2.5e-6 + 6e-6, 0.0035]],
+                     "material": "b", "vel0": [0.05, -0.02, -0.1]}})
