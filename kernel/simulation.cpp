@@ -6,4 +6,5 @@ namespace demcal::kernel {
 template class BasicSimulation<HertzMindlinEdem>;
 template class BasicSimulation<HertzMindlin>;
 template class BasicSimulation<JkrMindlinEdem>;
+template class BasicSimulation<YadeCohesiveFrictional>;
 }  // namespace demcal::kernel

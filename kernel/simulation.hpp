@@ -102,6 +102,16 @@ class BasicSimulation {
   int add_wall(const Wall& w);
   /// Enables/disables a wall (e.g. opens the outlet plate). A disabled wall exerts no force.
   void set_wall_enabled(int id, bool enabled);
+  /// YADE's non-viscous local damping (NewtonIntegrator(damping = d)), d in [0, 1); default 0 (none). For matching
+  /// YADE's quasi-static tests; it is not a physical dissipation.
+  void set_local_damping(double damping);
+  double local_damping() const { return local_damping_; }
+  /// Laws with bonds (YadeCohesiveFrictional): the contacts acting at the next force evaluation are bonded, where
+  /// their pair has a cohesion (YADE's setCohesionNow). Forces are evaluated again at the next step() without
+  /// advancing time (as after any state change).
+  void bond_contacts_now()
+    requires Law::has_bonds;
+
   /// Sets the velocity [m/s] of a wall without a prescribed motion law (a driver's servo or a shear frame): it moves by
   /// velocity * dt each step from then on. Throws for a wall that follows a law.
   void set_wall_velocity(int id, const Vec3& velocity);
@@ -199,6 +209,7 @@ class BasicSimulation {
   void rebuild_neighbors();  // the neighbour list and the wall candidates, always together
   void find_wall_candidates();
   void move_walls();  // to the current time: displacement and velocity over the step
+  void apply_local_damping();
   bool walls_left_reach() const;  // a wall moved more than skin/2 since the last neighbour build
 
   // materials
@@ -211,6 +222,8 @@ class BasicSimulation {
   std::vector<Wall> walls_;
   std::vector<Vec3> wall_disp_built_;  // each wall's displacement at the last neighbour build
   bool walls_move_ = false;            // some wall has a motion law or a velocity
+  double local_damping_ = 0;           // YADE's non-viscous damping coefficient
+  bool bond_next_evaluation_ = false;  // bond the contacts of the next force evaluation
   std::vector<ClumpTemplate> templates_;
 
   // per sphere (structure of arrays)
@@ -259,10 +272,13 @@ class BasicSimulation {
 extern template class BasicSimulation<HertzMindlinEdem>;
 extern template class BasicSimulation<HertzMindlin>;
 extern template class BasicSimulation<JkrMindlinEdem>;
+extern template class BasicSimulation<YadeCohesiveFrictional>;
 
 /// The seed's model: Hertz-Mindlin (no slip) + EDEM constant directional torque rolling friction.
 using Simulation = BasicSimulation<HertzMindlinEdem>;
 /// The seed's model with JKR adhesion (cohesive powders).
 using CohesiveSimulation = BasicSimulation<JkrMindlinEdem>;
+/// YADE's shear-box laws (linear, fragile bonds) for cross-checks with YADE.
+using YadeLawSimulation = BasicSimulation<YadeCohesiveFrictional>;
 
 }  // namespace demcal::kernel

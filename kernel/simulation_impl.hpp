@@ -507,6 +507,8 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   const std::int32_t* nbr = nl_.nbr.data();
   double* hist = nl_.hist.data();
   const double law_reach = law_reach_;
+  const bool bond_now = bond_next_evaluation_;  // (YADE's setCohesionNow: the contacts acting in this evaluation)
+  bond_next_evaluation_ = false;
   // |omega| once per sphere, not once per contact side (a sphere has several contacts); kick_drift has filled it
   // unless the angular velocities changed otherwise since (a velocity set, bodies added, removed or renumbered)
   const bool fill_omega_norm = Law::uses_omega_norm && !(omega_norm_fresh_ && omega_norm_.size() == std::size_t(n));
@@ -571,7 +573,9 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           kin.omega_j_norm = wnorm[j];
         }
         kin.v_rel = (vi - geo.lever_i * wi.cross(geo.n)) - (v_[j] + geo.lever_j * w_[j].cross(geo.n));
-        const ContactResult res = Law::compute(coeffs, geo, kin, h, dt, false);
+        kin.v_i = vi;
+        kin.v_j = v_[j];
+        const ContactResult res = Law::compute(coeffs, geo, kin, h, dt, false, bond_now);
         fi += res.force_i;
         ti += res.torque_i;
         load[p].force_i = res.force_i;
@@ -607,7 +611,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           geo.radius_j = 0;
           geo.r_star = ri;
           geo.m_star = mi;
-          geo.lever_i = dist;
+          geo.lever_i = Law::lever_at_overlap_middle ? ri - 0.5 * geo.dn : dist;
           geo.lever_j = 0;
           if constexpr (Law::beyond_contact) {
             if (!Law::acts(coeffs, geo, s)) continue;
@@ -616,8 +620,10 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           kin.omega_i = wi;
           kin.omega_j = Vec3::Zero();
           if (Law::uses_omega_norm) kin.omega_i_norm = wnorm[i];
-          kin.v_rel = vi - dist * wi.cross(nrm) - wall.velocity;
-          const ContactResult res = Law::compute(coeffs, geo, kin, s, dt, true);
+          kin.v_rel = vi - geo.lever_i * wi.cross(nrm) - wall.velocity;
+          kin.v_i = vi;
+          kin.v_j = wall.velocity;
+          const ContactResult res = Law::compute(coeffs, geo, kin, s, dt, true, bond_now);
           fi += res.force_i;
           ti += res.torque_i;
           if (used < kWallSlots) {
@@ -664,6 +670,57 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
       cT_[c] = T;
     }
   }
+  if (local_damping_ > 0) apply_local_damping();
+}
+
+template <class Law>
+void BasicSimulation<Law>::apply_local_damping() {
+  // YADE's NewtonIntegrator(damping = d), per component, with the velocities of the move that led here (v^{k-1/2},
+  // which is what the state holds at a force evaluation): a_i *= 1 - d sign(a_i (v_i + dt/2 a_i)), gravity included
+  // (dampGravity); spheres' angular accelerations likewise; clumps damp the torque, T_i *= 1 - d sign(T_i w_i). The
+  // damped force replaces the force, so both half kicks of velocity Verlet use it (= YADE's leapfrog).
+  const double d = local_damping_, h = 0.5 * dt_;
+  const Vec3 g = gravity_;
+  auto sgn = [](double x) { return double((x > 0) - (x < 0)); };
+  const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
+#pragma omp parallel num_threads(nt())
+  {
+#pragma omp for schedule(static) nowait
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (clump_[i] >= 0) continue;
+      const double m = mass_[i];
+      for (int k = 0; k < 3; ++k) {
+        double a = f_[i][k] / m + g[k];
+        a *= 1 - d * sgn(a * (v_[i][k] + h * a));
+        f_[i][k] = (a - g[k]) * m;
+        const double al = t_[i][k] * inv_inertia_[i];
+        t_[i][k] *= 1 - d * sgn(al * (w_[i][k] + h * al));
+      }
+    }
+#pragma omp for schedule(static)
+    for (std::int64_t c = 0; c < nc; ++c)
+      for (int k = 0; k < 3; ++k) {
+        double a = cF_[c][k] / cm_[c] + g[k];
+        a *= 1 - d * sgn(a * (cv_[c][k] + h * a));
+        cF_[c][k] = (a - g[k]) * cm_[c];
+        cT_[c][k] *= 1 - d * sgn(cT_[c][k] * cw_[c][k]);
+      }
+  }
+}
+
+template <class Law>
+void BasicSimulation<Law>::set_local_damping(double damping) {
+  if (!(damping >= 0 && damping < 1)) throw std::invalid_argument("set_local_damping: damping must be in [0, 1)");
+  local_damping_ = damping;
+  forces_valid_ = false;
+}
+
+template <class Law>
+void BasicSimulation<Law>::bond_contacts_now()
+  requires Law::has_bonds
+{
+  bond_next_evaluation_ = true;
+  forces_valid_ = false;
 }
 
 template <class Law>

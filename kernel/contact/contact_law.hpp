@@ -13,6 +13,8 @@
 #include "kernel/contact/jkr_normal.hpp"
 #include "kernel/contact/mindlin_tangential.hpp"
 #include "kernel/contact/rolling_edem_cdt.hpp"
+#include "kernel/contact/yade_cohesive_normal.hpp"
+#include "kernel/contact/yade_incremental_tangential.hpp"
 
 namespace demcal::kernel {
 
@@ -63,15 +65,31 @@ struct ComposedLaw {
 
   /// Whether compute() reads ContactKinematics::omega_i_norm / omega_j_norm (the kernel skips that pass if not).
   static constexpr bool uses_omega_norm = Rolling::uses_omega_norm;
-  /// One contact: c (pair constants), g (geometry), k (kinematics), h (history, history_size doubles, in/out).
+  /// Where a wall contact's tangential force acts: at the middle of the overlap (YADE) or at the wall (default).
+  static constexpr bool lever_at_overlap_middle = [] {
+    if constexpr (requires { Tangential::lever_at_overlap_middle; }) return Tangential::lever_at_overlap_middle;
+    else return false;
+  }();
+  /// Whether the law has bonds that a driver sets (bond_now below).
+  static constexpr bool has_bonds =
+      requires(const typename Normal::Coeffs& nc, const ContactGeometry& g, double* h) { Normal::bond(nc, g, h); };
+
+  /// One contact: c (pair constants), g (geometry), k (kinematics), h (history, history_size doubles, in/out);
+  /// bond_now: bond this contact now (laws with bonds; YADE's setCohesionNow).
   [[gnu::always_inline]] static inline ContactResult compute(const Coeffs& c, const ContactGeometry& g,
                                                              const ContactKinematics& k, double* h, double dt,
-                                                             bool wall) {
+                                                             bool wall, bool bond_now = false) {
     ContactResult r;
+    if constexpr (has_bonds) {
+      if (bond_now) Normal::bond(c.normal, g, h);
+    }
     const double vn = k.v_rel.dot(g.n);
-    const NormalState nrm = Normal::force(c.normal, g, vn, h);
+    NormalState nrm = Normal::force(c.normal, g, vn, h);
     const Vec3 vt = k.v_rel - vn * g.n;
-    const Vec3 ft = Tangential::force(c.tangential, g.n, vt, nrm, h + normal_history, dt);
+    const Vec3 ft = Tangential::force(c.tangential, g, k, vt, nrm, h + normal_history, dt, wall);
+    if constexpr (has_bonds) {
+      if (nrm.bond_failed) Normal::break_bond(h);
+    }
     r.force_i = nrm.fn * g.n + ft;
     // tangential force acts at the contact point: lever -lever_i n from i, +lever_j n from j (force -ft)
     const Vec3 nxft = g.n.cross(ft);
@@ -88,5 +106,8 @@ using HertzMindlinEdem = ComposedLaw<HertzNormal, MindlinTangential, EdemCdtRoll
 using HertzMindlin = ComposedLaw<HertzNormal, MindlinTangential, NoRolling>;
 /// JKR adhesion (EDEM "Hertz-Mindlin with JKR cohesion") with Mindlin friction and EDEM rolling friction.
 using JkrMindlinEdem = ComposedLaw<JkrNormal, MindlinTangential, EdemCdtRolling>;
+/// YADE's linear law with fragile cohesive bonds, as its shear box uses it (CohesionMoment for particle pairs;
+/// CundallStrack for walls, the same without a bond). No rolling resistance (momentRotationLaw = False).
+using YadeCohesiveFrictional = ComposedLaw<YadeCohesiveNormal, YadeIncrementalTangential, NoRolling>;
 
 }  // namespace demcal::kernel

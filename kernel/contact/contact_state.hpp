@@ -20,6 +20,8 @@ struct ContactGeometry {
 
 struct ContactKinematics {
   Vec3 v_rel;   ///< velocity of i's contact point relative to j's (or the wall's) [m/s]
+  Vec3 v_i;     ///< velocity of i's centre [m/s]
+  Vec3 v_j;     ///< velocity of j's centre, or the wall's [m/s]
   Vec3 omega_i; ///< angular velocity of i (its body) [rad/s]
   Vec3 omega_j; ///< angular velocity of j (zero for a wall) [rad/s]
   double omega_i_norm = 0; ///< |omega_i|, computed once per sphere and force evaluation (not per contact) [rad/s]
@@ -33,6 +35,10 @@ struct NormalState {
   double fn_crit = 0;         ///< the normal load that bounds friction and rolling resistance (|fn| without adhesion) [N]
   double contact_radius = 0;  ///< radius a of the contact area [m] (Hertz: sqrt(R* dn))
   double damp_prefactor = 0;  ///< normal viscous damping coefficient [kg/s]; the tangential damping scales it
+  // bonded contacts (models with a bond; zero/false otherwise)
+  double shear_adhesion = 0;  ///< the bond's shear strength, added to the friction cap [N]
+  bool bonded = false;        ///< the contact carries an intact bond
+  bool bond_failed = false;   ///< set by the tangential model when the bond fails in shear this step
 };
 
 /// What a law returns: force on i (j gets -force_i), torques about the two sphere centres.

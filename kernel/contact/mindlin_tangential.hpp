@@ -37,9 +37,10 @@ struct MindlinTangential {
   /// When i and j trade places the displacement of i relative to j changes sign.
   static void swap_history(double* h) { h[0] = -h[0]; h[1] = -h[1]; h[2] = -h[2]; }
 
-  /// n: unit normal, vt: tangential relative velocity, nrm: the normal model's output, h: history (in/out).
-  [[gnu::always_inline]] static inline Vec3 force(const Coeffs& c, const Vec3& n, const Vec3& vt, const NormalState& nrm,
-                                                  double* h, double dt) {
+  /// g, k: the contact; vt: tangential relative velocity; nrm: the normal model's output; h: history (in/out).
+  [[gnu::always_inline]] static inline Vec3 force(const Coeffs& c, const ContactGeometry& g, const ContactKinematics&,
+                                                  const Vec3& vt, NormalState& nrm, double* h, double dt, bool) {
+    const Vec3& n = g.n;
     Vec3 s(h[0], h[1], h[2]);
     // rotate the history into the current tangent plane, keeping its magnitude
     const double s2_old = s.squaredNorm();
