@@ -200,3 +200,55 @@ TEST_CASE("YADE laws: a free sphere thrown on a box wall with local damping foll
   CHECK(worst_x < 1e-9);
   CHECK(worst_f < 1e-6);
 }
+
+TEST_CASE("YADE laws in the kernel's loops: bonds set on the contacts present hold tension up to cohesion R^2, then "
+          "end for good", "[kernel][yade-laws]") {
+  const double r = 2e-3, sigma = 3e4, V = 1e-3;
+  YadeLawSimulation sim;
+  Material heavy{2e7, 0.3, 1e12, "sand"};  // heavy: the bond cannot change the path, only the momentum a little
+  const int a = sim.add_material(heavy);
+  Law::Params p;
+  p.friction = 0.5;
+  p.normal_cohesion = sigma;
+  p.shear_cohesion = sigma;
+  sim.set_pair(a, a, p);
+  sim.set_gravity(Vec3::Zero());
+  sim.add_sphere({-r + 1e-7, 0, 0}, r, a);
+  sim.add_sphere({r - 1e-7, 0, 0}, r, a);
+  sim.add_sphere({0, 0.1, 0}, r, a);  // far away: no contact, no bond
+  sim.set_timestep(1e-5);
+  sim.step(1);
+  sim.bond_contacts_now();
+  sim.step(1);
+  sim.set_body_velocity(0, {-0.5 * V, 0, 0}, Vec3::Zero());
+  sim.set_body_velocity(1, {0.5 * V, 0, 0}, Vec3::Zero());
+  const double m = sim.body(1).mass, kn = 2e7 * r;  // kn = E R for equal spheres
+  double max_pull = 0, gap_at_end = 0, v_prev = sim.body(1).velocity.x();
+  for (int k = 0; k < 2000; ++k) {
+    sim.step(1);
+    const double v = sim.body(1).velocity.x(), f = m * (v - v_prev) / sim.timestep();
+    v_prev = v;
+    const double gap = sim.body(1).position.x() - sim.body(0).position.x() - 2 * r;
+    if (f < 0) max_pull = std::max(max_pull, -f);
+    if (max_pull > 0 && f == 0.0 && gap_at_end == 0.0) gap_at_end = gap;
+  }
+  // tension up to the strength sigma R^2, reached at the gap sigma R^2 / kn, and nothing after
+  CHECK(max_pull <= sigma * r * r * (1 + 1e-9));
+  CHECK(max_pull > 0.99 * sigma * r * r);
+  CHECK(gap_at_end == Approx(sigma * r * r / kn).epsilon(0.02));
+  // pushed back together, the pair touches again unbonded: no tension any more
+  sim.set_body_velocity(0, {0.5 * V, 0, 0}, Vec3::Zero());
+  sim.set_body_velocity(1, {-0.5 * V, 0, 0}, Vec3::Zero());
+  sim.step(long(2 * gap_at_end / V / sim.timestep()) + 20);
+  sim.set_body_velocity(0, {-0.5 * V, 0, 0}, Vec3::Zero());
+  sim.set_body_velocity(1, {0.5 * V, 0, 0}, Vec3::Zero());
+  double pull_after = 0;
+  v_prev = sim.body(1).velocity.x();
+  for (int k = 0; k < 200; ++k) {
+    sim.step(1);
+    const double v = sim.body(1).velocity.x(), f = m * (v - v_prev) / sim.timestep();
+    v_prev = v;
+    pull_after = std::max(pull_after, -f);
+  }
+  CHECK(pull_after <= 1e-12 * sigma * r * r);
+}
