@@ -536,7 +536,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         const Vec3 d = xi - x_[j];
         const double rs = ri + r_[j];
         const double d2 = d.squaredNorm();
-        const double reach = rs + law_reach;  // (= rs for a law that acts only in contact)
+        const double reach = Law::beyond_contact ? rs + law_reach : rs;
         if (d2 >= reach * reach) {
           std::fill_n(h, kHist, 0.0);
           load[p].force_i.setZero();
@@ -599,14 +599,14 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           if (!wall.enabled) continue;
           Vec3 nrm;
           double dn, dist;
-          if (!wall.contact(xi, ri + law_reach, nrm, dn, dist)) continue;
+          if (!wall.contact(xi, Law::beyond_contact ? ri + law_reach : ri, nrm, dn, dist)) continue;
           double s[kH] = {};
           for (int k = 0; k < kWallSlots; ++k)
             if (sid[k] == wdx) std::copy_n(ss + k * kHist, kHist, s);
           const typename Law::Coeffs& coeffs = crow[wall.material];
           ContactGeometry geo;
           geo.n = nrm;
-          geo.dn = dn - law_reach;  // (= dn for a law that acts only in contact)
+          geo.dn = Law::beyond_contact ? dn - law_reach : dn;
           geo.radius_i = ri;
           geo.radius_j = 0;
           geo.r_star = ri;
