@@ -573,8 +573,10 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           kin.omega_j_norm = wnorm[j];
         }
         kin.v_rel = (vi - geo.lever_i * wi.cross(geo.n)) - (v_[j] + geo.lever_j * w_[j].cross(geo.n));
-        kin.v_i = vi;
-        kin.v_j = v_[j];
+        if constexpr (Law::uses_centre_velocities) {
+          kin.v_i = vi;
+          kin.v_j = v_[j];
+        }
         const ContactResult res = Law::compute(coeffs, geo, kin, h, dt, false, bond_now);
         fi += res.force_i;
         ti += res.torque_i;
@@ -621,8 +623,10 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
           kin.omega_j = Vec3::Zero();
           if (Law::uses_omega_norm) kin.omega_i_norm = wnorm[i];
           kin.v_rel = vi - geo.lever_i * wi.cross(nrm) - wall.velocity;
-          kin.v_i = vi;
-          kin.v_j = wall.velocity;
+          if constexpr (Law::uses_centre_velocities) {
+            kin.v_i = vi;
+            kin.v_j = wall.velocity;
+          }
           const ContactResult res = Law::compute(coeffs, geo, kin, s, dt, true, bond_now);
           fi += res.force_i;
           ti += res.torque_i;

@@ -70,6 +70,11 @@ struct ComposedLaw {
     if constexpr (requires { Tangential::lever_at_overlap_middle; }) return Tangential::lever_at_overlap_middle;
     else return false;
   }();
+  /// Whether the tangential model reads the centres' velocities (ContactKinematics::v_i, v_j; skipped otherwise).
+  static constexpr bool uses_centre_velocities = [] {
+    if constexpr (requires { Tangential::uses_centre_velocities; }) return Tangential::uses_centre_velocities;
+    else return false;
+  }();
   /// Whether the law has bonds that a driver sets (bond_now below).
   static constexpr bool has_bonds =
       requires(const typename Normal::Coeffs& nc, const ContactGeometry& g, double* h) { Normal::bond(nc, g, h); };

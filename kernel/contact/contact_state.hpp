@@ -20,8 +20,8 @@ struct ContactGeometry {
 
 struct ContactKinematics {
   Vec3 v_rel;   ///< velocity of i's contact point relative to j's (or the wall's) [m/s]
-  Vec3 v_i;     ///< velocity of i's centre [m/s]
-  Vec3 v_j;     ///< velocity of j's centre, or the wall's [m/s]
+  Vec3 v_i;     ///< velocity of i's centre [m/s] (filled for laws that ask: uses_centre_velocities)
+  Vec3 v_j;     ///< velocity of j's centre, or the wall's [m/s] (likewise)
   Vec3 omega_i; ///< angular velocity of i (its body) [rad/s]
   Vec3 omega_j; ///< angular velocity of j (zero for a wall) [rad/s]
   double omega_i_norm = 0; ///< |omega_i|, computed once per sphere and force evaluation (not per contact) [rad/s]

@@ -39,6 +39,7 @@ struct YadeIncrementalTangential {
     for (int k = 0; k < 6; ++k) h[k] = -h[k];
   }
   static constexpr bool lever_at_overlap_middle = true;
+  static constexpr bool uses_centre_velocities = true;
 
   [[gnu::always_inline]] static inline Vec3 force(const Coeffs& c, const ContactGeometry& g, const ContactKinematics& k,
                                                   const Vec3&, NormalState& nrm, double* h, double dt, bool wall) {
