@@ -1,9 +1,13 @@
 #include "analytics/measured_data.hpp"
 
+#include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
+
 #include <algorithm>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
-#include <fstream>
+#include <cstdlib>
 #include <istream>
 #include <limits>
 #include <optional>
@@ -33,6 +37,18 @@ std::optional<double> parse_number(const std::string& cell) {
     const auto [end, ec] = std::from_chars(begin, cell.data() + cell.size(), v);
     if (ec != std::errc() || end != cell.data() + cell.size() || !std::isfinite(v)) return std::nullopt;
     return v;
+}
+
+// Why a cell that reads as a number cannot be used (analytics::number_defect), or nothing: a text cell, or a good
+// number. strtod reads what from_chars does not ("nan", "inf", out-of-range exponents), so those are named too.
+std::optional<std::string> number_cell_defect(const std::string& cell) {
+    if (cell.empty()) return std::nullopt;
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(cell.c_str(), &end);
+    if (end != cell.c_str() + cell.size()) return std::nullopt;
+    if (errno == ERANGE && std::isinf(v)) return "is too large for a double";
+    return number_defect(v);
 }
 
 std::vector<std::string> split_csv_line(const std::string& line, const std::string& source, int line_no) {
@@ -69,7 +85,12 @@ std::vector<std::string> split_csv_line(const std::string& line, const std::stri
 // Cells that may be empty: the geometry-specific sizes (they apply to one geometry only).
 bool may_be_empty(const std::string& column) { return column == "D_m" || column == "b_m" || column == "c_m"; }
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+std::string quote(const std::string& s) {
+    std::string quoted = "'";  // appended, not "'" + ... + "'": GCC 12 warns falsely (-Wrestrict) on the latter
+    quoted += shortened_text(s);
+    quoted += '\'';
+    return quoted;
+}
 
 std::string num(double v) {
     std::ostringstream s;
@@ -92,7 +113,7 @@ const DataColumn& MeasuredData::at(std::string_view name) const {
 }
 
 std::string MeasuredData::where(std::size_t row, std::string_view column) const {
-    return source + ": line " + std::to_string(lines.at(row)) + ", column " + std::string(column);
+    return source + ": line " + std::to_string(lines.at(row)) + ", column " + shortened_text(column);
 }
 
 const std::vector<std::string>& reserved_columns(MeasuredKind kind) {
@@ -120,7 +141,7 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
                 for (const auto& c : data.columns)
                     if (c.name == name)
                         throw std::invalid_argument(source + ": line " + std::to_string(line_no) +
-                                                    ": duplicate column " + name);
+                                                    ": duplicate column " + shortened_text(name));
                 data.columns.push_back(DataColumn{name, true, {}, {}});
             }
             have_header = true;
@@ -144,6 +165,8 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
                 if (!may_be_empty(col.name)) throw std::invalid_argument(data.where(r, col.name) + ": missing value");
                 continue;
             }
+            if (const auto defect = number_cell_defect(cell))
+                throw std::invalid_argument(data.where(r, col.name) + ": " + quote(cell) + " " + *defect);
             if (parse_number(cell)) {
                 ++numbers;
             } else if (texts++ == 0) {
@@ -234,8 +257,7 @@ void validate_measured(const MeasuredData& data, MeasuredKind kind) {
 }
 
 MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind) {
-    std::ifstream in(path);
-    if (!in) throw std::invalid_argument("cannot open data file " + path);
+    std::istringstream in(read_input_file(path, "data file " + shortened_text(path, 200), kMaxMeasuredDataBytes));
     auto data = parse_csv(in, path);
     validate_measured(data, kind);
     return data;

@@ -1,6 +1,7 @@
 #include "app/cli_support.hpp"
 
 #include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
 #include "app/commands.hpp"
 
 #include <cmath>
@@ -11,12 +12,10 @@
 namespace demcal {
 
 nlohmann::json read_json_file(const std::string& path, const std::string& field) {
-    std::ifstream f(path);
-    if (!f) throw UserError(field + " = '" + path + "' cannot be read");
     try {
-        return nlohmann::json::parse(f);
-    } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number too large for a double
-        throw UserError(field + " = '" + path + "' is not valid JSON: " + e.what());
+        return analytics::read_json_input(path, field);
+    } catch (const analytics::InputError& e) {
+        throw UserError(e.what());
     }
 }
 

@@ -7,7 +7,8 @@
 
 namespace demcal {
 
-// Parses the JSON file at `path`; a missing file or bad JSON is a UserError naming `field` and the path.
+// Reads the JSON file at `path` through analytics::read_json_input; any refusal is a UserError naming `field`, the
+// path and the rule.
 nlohmann::json read_json_file(const std::string& path, const std::string& field);
 
 // Checks of number options. CLI11's own Range and PositiveNumber let NaN through and print their bounds with 300

@@ -1,5 +1,7 @@
 #include "orchestrator/campaign_store.hpp"
 
+#include "analytics/user_input.hpp"
+
 #include <sqlite3.h>
 
 #include <chrono>
@@ -98,13 +100,18 @@ const char* kRunColumns =
     "r.hash, r.params, r.state, r.attempts, r.result, r.cause, r.message, r.exit_code, r.wall_s, r.cpu_s, r.run_dir, "
     "r.pgid, r.owner_pid";
 
+// A JSON column as the store holds it, read under the same rules as every JSON input (a damaged store is bad input).
+nlohmann::json stored_json(const Statement& st, int column, const char* name) {
+    return analytics::parse_json_text(st.text(column), std::string("campaign store column ") + name);
+}
+
 RunRecord read_run(const Statement& st, bool with_label) {
     RunRecord r;
     r.hash = st.text(0);
-    r.params = nlohmann::json::parse(st.text(1));
+    r.params = stored_json(st, 1, "runs.params");
     r.state = run_state_from_string(st.text(2));
     r.attempts = static_cast<int>(st.integer(3));
-    if (!st.is_null(4)) r.result = nlohmann::json::parse(st.text(4));
+    if (!st.is_null(4)) r.result = stored_json(st, 4, "runs.result");
     r.cause = st.text(5);
     r.message = st.text(6);
     r.exit_code = static_cast<int>(st.integer(7));
@@ -113,7 +120,7 @@ RunRecord read_run(const Statement& st, bool with_label) {
     r.run_dir = st.text(10);
     r.pgid = static_cast<long>(st.integer(11));
     r.owner_pid = static_cast<long>(st.integer(12));
-    if (with_label) r.label = nlohmann::json::parse(st.text(13));
+    if (with_label) r.label = stored_json(st, 13, "campaign_runs.label");
     return r;
 }
 
@@ -181,7 +188,7 @@ CampaignRecord read_campaign(const Statement& st) {
     c.id = st.integer(0);
     c.name = st.text(1);
     c.kind = st.text(2);
-    c.spec = nlohmann::json::parse(st.text(3));
+    c.spec = stored_json(st, 3, "campaigns.spec");
     c.status = st.text(4);
     c.created_at = st.real(5);
     return c;

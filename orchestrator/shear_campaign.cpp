@@ -1,5 +1,7 @@
 #include "orchestrator/shear_campaign.hpp"
 
+#include "analytics/user_input.hpp"
+
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_params.hpp"
 #include "orchestrator/slurm_executor.hpp"
@@ -148,7 +150,7 @@ std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
     const fs::path file = run_dir / "result.json";
     if (!fs::exists(file)) return std::nullopt;
     try {
-        auto result = nlohmann::json::parse(read_text_file(file));
+        auto result = analytics::read_json_input(file, "result");
         if (result.contains("peak_shear_stress") && result["peak_shear_stress"].is_number()) return result;
     } catch (const std::exception&) {
     }
@@ -272,7 +274,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         nlohmann::json result;
         if (o.succeeded()) {
             try {
-                result = nlohmann::json::parse(read_text_file(job.dir / "result.json"));
+                result = analytics::read_json_input(job.dir / "result.json", "result");
                 if (!result.contains("peak_shear_stress") || !result["peak_shear_stress"].is_number())
                     throw std::runtime_error("no number 'peak_shear_stress'");
             } catch (const std::exception& e) {

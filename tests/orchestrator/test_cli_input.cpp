@@ -103,3 +103,42 @@ TEST_CASE("demcal enlarge fits both laws and draws them, and refuses an output i
     CHECK(fs::exists(dir / "e.dat"));
     fs::remove_all(dir);
 }
+
+TEST_CASE("every JSON input goes through one reader: deep nesting, duplicates and subnormals end in exit 2",
+          "[cli][input]") {
+    const fs::path dir = test::fresh_test_dir("cli-json-input");
+    const fs::path campaign = dir / "never";
+    const std::string deep = "{\"density\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+    struct Case {
+        std::string text;
+        std::string expect;
+    };
+    const std::vector<Case> cases{
+        {deep, "nests deeper than 64 levels"},  // was a segmentation fault
+        {R"({"density": 2600, "density": 1})", "field 'density' appears twice"},
+        {R"({"timestep_fraction": 1e-320})", "field 'timestep_fraction' = 1e-320 is subnormal"},
+    };
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    for (const auto& c : cases) {
+        std::ofstream(dir / "bad.json") << c.text;
+        for (const std::vector<std::string>& args :
+             {std::vector<std::string>{"shear", (dir / "bad.json").string(), "-s", "5e3"},
+              std::vector<std::string>{"sensitivity", (dir / "bad.json").string(), "-s", "5e3,1e4"},
+              std::vector<std::string>{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--sensitivity",
+                                       (dir / "bad.json").string()},
+              std::vector<std::string>{"predict", (dir / "bad.json").string()}}) {
+            auto full = args;
+            full.insert(full.end(), {"--campaign", campaign.string()});
+            if (args[0] == "predict") full.resize(2);
+            INFO(args[0] + ": " + c.expect);
+            const int rc = test::run_demcal(full, dir / "out.log");
+            const std::string log = test::read_file(dir / "out.log");
+            INFO(log.substr(0, 500));
+            CHECK(rc == 2);
+            CHECK_THAT(log, Contains(c.expect));
+            CHECK(log.size() < 1000);
+            CHECK_FALSE(fs::exists(campaign));
+        }
+    }
+    fs::remove_all(dir);
+}
