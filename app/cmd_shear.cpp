@@ -176,6 +176,11 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
         std::cout << "no failure line: fewer than 3 finished runs on 2 normal stresses\n";
     }
     if (outcome.interrupted) return 130;
+    if (!outcome.infrastructure_failure.empty()) {
+        std::cout << "the simulator could not be started (" << outcome.infrastructure_failure
+                  << "); the runs it hit stay pending: fix --yade, then `demcal resume " << dir.string() << "`\n";
+        return kExitResumeLater;
+    }
     return outcome.failed > 0 ? 1 : 0;
 }
 
@@ -265,6 +270,7 @@ void add_shear_commands(CLI::App& app) {
     resume->callback([resume_opt] {
         if (!fs::exists(fs::path(resume_opt->campaign_dir) / "campaign.sqlite"))
             throw UserError("campaign = '" + resume_opt->campaign_dir + "' holds no campaign.sqlite");
+        find_yade(resume_opt->exec.yade);  // before the store is opened: a bad --yade costs nothing
         ShearCampaignRunner runner(resume_opt->campaign_dir, resume_opt->exec);
         const auto outs = runner.resume(print_progress);
         if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";

@@ -1,5 +1,6 @@
 #include "orchestrator/campaign_store.hpp"
 
+#include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
 
 #include <sqlite3.h>
@@ -105,7 +106,22 @@ nlohmann::json stored_json(const Statement& st, int column, const char* name) {
     return analytics::parse_json_text(st.text(column), std::string("campaign store column ") + name);
 }
 
-RunRecord read_run(const Statement& st, bool with_label) {
+// Run folders are stored relative to the store's directory, so a campaign moved or copied (cluster to laptop) finds
+// its own runs. Rows of older stores hold absolute paths; every demcal run folder is CAMPAIGN/runs/<name>, so such a
+// row is read as that layout under the store's directory, never as a folder of the campaign it was copied from.
+std::filesystem::path resolved_run_dir(const std::filesystem::path& stored, const std::filesystem::path& base_dir) {
+    if (stored.is_relative()) return base_dir / stored;
+    if (stored.parent_path().filename() == "runs") return base_dir / "runs" / stored.filename();
+    return stored;
+}
+
+std::string stored_run_dir(const std::filesystem::path& run_dir, const std::filesystem::path& base_dir) {
+    const auto relative = std::filesystem::absolute(run_dir).lexically_normal().lexically_relative(base_dir);
+    const bool inside = !relative.empty() && *relative.begin() != "..";
+    return inside ? relative.string() : run_dir.string();
+}
+
+RunRecord read_run(const Statement& st, bool with_label, const std::filesystem::path& base_dir) {
     RunRecord r;
     r.hash = st.text(0);
     r.params = stored_json(st, 1, "runs.params");
@@ -117,7 +133,7 @@ RunRecord read_run(const Statement& st, bool with_label) {
     r.exit_code = static_cast<int>(st.integer(7));
     r.wall_s = st.real(8);
     r.cpu_s = st.real(9);
-    r.run_dir = st.text(10);
+    r.run_dir = resolved_run_dir(st.text(10), base_dir);
     r.pgid = static_cast<long>(st.integer(11));
     r.owner_pid = static_cast<long>(st.integer(12));
     if (with_label) r.label = stored_json(st, 13, "campaign_runs.label");
@@ -126,16 +142,76 @@ RunRecord read_run(const Statement& st, bool with_label) {
 
 }  // namespace
 
-CampaignStore::CampaignStore(const std::filesystem::path& db_path) : path_(db_path) {
-    if (sqlite3_open_v2(db_path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
+namespace {
+
+constexpr int kDemcalApplicationId = 0x64656d63;  // "demc" in the SQLite header: marks a file as a demcal store
+
+// Refuses, reading only, a file that is not an intact demcal store: nothing may be written into a file that is not
+// ours (status and resume wrote demcal's tables into any SQLite file), and a damaged store must not be resumed as if
+// it were whole.
+void check_existing_store(sqlite3* db, const std::string& name) {
+    const std::string store = "campaign store '" + name + "'";
+    std::int64_t application_id = 0;
+    bool has_demcal_tables = false;
+    try {
+        Statement id(db, "PRAGMA application_id");
+        if (id.step()) application_id = id.integer(0);
+        Statement tables(db,
+                         "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name IN "
+                         "('meta', 'campaigns', 'runs', 'campaign_runs', 'attempts')");
+        has_demcal_tables = tables.step() && tables.integer(0) == 5;
+    } catch (const std::runtime_error& e) {  // not a database at all, or its first page is damaged
+        throw std::invalid_argument(store + " is not a readable SQLite database (" + e.what() +
+                                    "); nothing was written to it");
+    }
+    // stores written before demcal set application_id (0) are recognised by their tables
+    if (application_id != kDemcalApplicationId && !(application_id == 0 && has_demcal_tables))
+        throw std::invalid_argument(store + " is a SQLite database but not a demcal campaign store (application_id " +
+                                    std::to_string(application_id) + ", " + (has_demcal_tables ? "" : "no ") +
+                                    "demcal tables); nothing was written to it");
+    std::string verdict;
+    try {
+        Statement check(db, "PRAGMA quick_check(1)");
+        verdict = check.step() ? check.text(0) : "no answer";
+    } catch (const std::runtime_error& e) {
+        verdict = e.what();
+    }
+    if (verdict != "ok")
+        throw std::invalid_argument(store + " is damaged (SQLite quick_check: " + analytics::shortened_text(verdict, 200) +
+                                    "); restore it from a copy, or move it away to start the campaign afresh");
+}
+
+}  // namespace
+
+CampaignStore::CampaignStore(const std::filesystem::path& db_path)
+    : path_(db_path), base_dir_(std::filesystem::absolute(db_path).lexically_normal().parent_path()) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(db_path, ec);
+    const bool existed = std::filesystem::exists(status);
+    if (existed && !std::filesystem::is_regular_file(status))
+        throw std::invalid_argument("campaign store '" + db_path.string() + "' is not a regular file");
+    if (existed && std::filesystem::file_size(db_path, ec) == 0)
+        throw std::invalid_argument("campaign store '" + db_path.string() +
+                                    "' is empty (0 bytes), not a demcal campaign store; nothing was written to it");
+    const int flags = SQLITE_OPEN_READWRITE | (existed ? 0 : SQLITE_OPEN_CREATE);
+    if (sqlite3_open_v2(db_path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
         std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
         sqlite3_close(db_);
         throw std::runtime_error("store: cannot open " + db_path.string() + ": " + m);
     }
     sqlite3_busy_timeout(db_, 10000);
+    if (existed) {
+        try {
+            check_existing_store(db_, db_path.string());
+        } catch (...) {
+            sqlite3_close(db_);
+            throw;
+        }
+    }
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=FULL");
     exec("PRAGMA foreign_keys=ON");
+    exec("PRAGMA application_id=" + std::to_string(kDemcalApplicationId));
     exec(R"sql(
 CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);
 INSERT OR IGNORE INTO meta VALUES('schema_version', '1');
@@ -222,7 +298,7 @@ RunRecord CampaignStore::ensure_run(std::int64_t campaign_id, const std::string&
         Statement ins(db_,
                       "INSERT OR IGNORE INTO runs(hash, params, state, run_dir, created_at, updated_at) "
                       "VALUES(?,?,'pending',?,?,?)");
-        ins.bind(1, hash).bind(2, params.dump()).bind(3, run_dir.string()).bind(4, t).bind(5, t).step();
+        ins.bind(1, hash).bind(2, params.dump()).bind(3, stored_run_dir(run_dir, base_dir_)).bind(4, t).bind(5, t).step();
         if (sqlite3_changes(db_) > 0) {
             for (const auto& [k, v] : params.items())
                 if (v.is_number())
@@ -240,7 +316,7 @@ RunRecord CampaignStore::ensure_run(std::int64_t campaign_id, const std::string&
 std::optional<RunRecord> CampaignStore::run(const std::string& hash) {
     Statement st(db_, std::string("SELECT ") + kRunColumns + " FROM runs r WHERE r.hash = ?");
     st.bind(1, hash);
-    if (st.step()) return read_run(st, false);
+    if (st.step()) return read_run(st, false, base_dir_);
     return std::nullopt;
 }
 
@@ -250,7 +326,7 @@ std::vector<RunRecord> CampaignStore::campaign_runs(std::int64_t campaign_id) {
                           "ORDER BY c.position");
     st.bind(1, campaign_id);
     std::vector<RunRecord> out;
-    while (st.step()) out.push_back(read_run(st, true));
+    while (st.step()) out.push_back(read_run(st, true, base_dir_));
     return out;
 }
 
@@ -258,7 +334,7 @@ std::vector<RunRecord> CampaignStore::runs_in_state(RunState s) {
     Statement st(db_, std::string("SELECT ") + kRunColumns + " FROM runs r WHERE r.state = ?");
     st.bind(1, to_string(s));
     std::vector<RunRecord> out;
-    while (st.step()) out.push_back(read_run(st, false));
+    while (st.step()) out.push_back(read_run(st, false, base_dir_));
     return out;
 }
 

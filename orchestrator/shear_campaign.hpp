@@ -57,7 +57,10 @@ struct ShearCampaignOutcome {
     int failed = 0;
     double cpu_s = 0;             // CPU seconds of all the campaign's successful runs (also the reused ones)
     bool interrupted = false;
-    bool complete() const { return !interrupted && failed == 0; }
+    // Why the simulator could not be started (empty when it could): an infrastructure failure, not a run's. The
+    // runs it hit stay pending, so a resume with a working simulator runs them.
+    std::string infrastructure_failure;
+    bool complete() const { return !interrupted && failed == 0 && infrastructure_failure.empty(); }
 };
 
 std::filesystem::path default_shear_template();

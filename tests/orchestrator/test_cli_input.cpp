@@ -142,3 +142,61 @@ TEST_CASE("every JSON input goes through one reader: deep nesting, duplicates an
     }
     fs::remove_all(dir);
 }
+
+TEST_CASE("status and resume refuse a file that is not a demcal store without writing to it", "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("cli-foreign-store");
+    std::ofstream(dir / "campaign.sqlite").close();  // zero bytes: status said "nothing to do" and wrote tables
+    for (const std::string command : {"status", "resume"}) {
+        INFO(command);
+        CHECK(test::run_demcal({command, dir.string()}, dir / "out.log") == 2);
+        const std::string log = test::read_file(dir / "out.log");
+        CHECK_THAT(log, Contains((dir / "campaign.sqlite").string()) && Contains("is empty (0 bytes)"));
+        CHECK(fs::file_size(dir / "campaign.sqlite") == 0);
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a YADE path that is a folder, empty or not executable is refused before anything is written", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-bad-yade");
+    const fs::path campaign = dir / "never";
+    std::ofstream(dir / "not-executable") << "#!/bin/sh\n";
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::vector<std::pair<std::string, std::string>> cases{
+        {dir.string(), "is a folder, not a program"}, {"", "yade = '': empty"},
+        {(dir / "not-executable").string(), "is not executable"}, {(dir / "none").string(), "does not exist"}};
+    for (const auto& [yade, expect] : cases) {
+        INFO(yade);
+        CHECK(test::run_demcal({"shear", tiny, "-s", "5e3", "--yade", yade, "--campaign", campaign.string()},
+                               dir / "out.log") == 2);
+        CHECK_THAT(test::read_file(dir / "out.log"), Contains(expect));
+        CHECK_FALSE(fs::exists(campaign));
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume with a working one runs them",
+          "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("cli-yade-not-started");
+    const fs::path campaign = dir / "campaign";
+    // executable, but its interpreter does not exist: execvp fails, as for a launcher of a broken installation
+    std::ofstream(dir / "broken-yade") << "#!/nonexistent/interpreter\n";
+    // a stand-in simulator: writes the result file named by its last argument
+    std::ofstream(dir / "stand-in-yade") << "#!/bin/sh\nfor last; do :; done\n"
+                                            "echo '{\"peak_shear_stress\": 1000, \"residual_shear_stress\": 800}' > "
+                                            "\"$last\"\n";
+    fs::permissions(dir / "broken-yade", fs::perms::owner_all);
+    fs::permissions(dir / "stand-in-yade", fs::perms::owner_all);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4", "--yade", (dir / "broken-yade").string(),
+                                     "--campaign", campaign.string(), "--retries", "0"},
+                                    dir / "out.log");
+    INFO(test::read_file(dir / "out.log"));
+    CHECK(rc == 75);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("could not be started"));
+    for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::pending);
+    CHECK(test::run_demcal({"resume", campaign.string(), "--yade", (dir / "stand-in-yade").string()},
+                           dir / "resume.log") == 0);
+    INFO(test::read_file(dir / "resume.log"));
+    for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::done);
+    fs::remove_all(dir);
+}
