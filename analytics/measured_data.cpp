@@ -5,9 +5,7 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <istream>
 #include <limits>
 #include <optional>
@@ -37,18 +35,6 @@ std::optional<double> parse_number(const std::string& cell) {
     const auto [end, ec] = std::from_chars(begin, cell.data() + cell.size(), v);
     if (ec != std::errc() || end != cell.data() + cell.size() || !std::isfinite(v)) return std::nullopt;
     return v;
-}
-
-// Why a cell that reads as a number cannot be used (analytics::number_defect), or nothing: a text cell, or a good
-// number. strtod reads what from_chars does not ("nan", "inf", out-of-range exponents), so those are named too.
-std::optional<std::string> number_cell_defect(const std::string& cell) {
-    if (cell.empty()) return std::nullopt;
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(cell.c_str(), &end);
-    if (end != cell.c_str() + cell.size()) return std::nullopt;
-    if (errno == ERANGE && std::isinf(v)) return "is too large for a double";
-    return number_defect(v);
 }
 
 std::vector<std::string> split_csv_line(const std::string& line, const std::string& source, int line_no) {
@@ -165,8 +151,9 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
                 if (!may_be_empty(col.name)) throw std::invalid_argument(data.where(r, col.name) + ": missing value");
                 continue;
             }
-            if (const auto defect = number_cell_defect(cell))
-                throw std::invalid_argument(data.where(r, col.name) + ": " + quote(cell) + " " + *defect);
+            // a cell that reads as a number must be a usable one ("nan", "inf", "1e-320" are not categories)
+            if (const auto n = read_typed_number(cell); n.is_number && n.defect)
+                throw std::invalid_argument(data.where(r, col.name) + ": " + quote(cell) + " " + *n.defect);
             if (parse_number(cell)) {
                 ++numbers;
             } else if (texts++ == 0) {

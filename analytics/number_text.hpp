@@ -1,7 +1,10 @@
 // How a value given by a user shows in a message, and the rule every number read from a user follows (JSON inputs,
 // CSV data, command-line options): one place, so every reader refuses the same numbers with the same words.
 #pragma once
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -36,6 +39,27 @@ inline std::optional<std::string> number_defect(double value) {
     if (std::fabs(value) > kLargestPlausibleNumber)
         return "is implausibly large (|value| > " + number_text(kLargestPlausibleNumber) + ")";
     return std::nullopt;
+}
+
+// A number typed by a user (an option, a CSV cell, a target), read whole by strtod: `is_number` is false when the
+// text is no number at all; otherwise `value`, and `defect` says why it cannot be used (number_defect, or an exponent
+// beyond a double's range).
+struct TypedNumber {
+    bool is_number = false;
+    double value = 0;
+    std::optional<std::string> defect;
+};
+
+inline TypedNumber read_typed_number(const std::string& text) {
+    TypedNumber n;
+    if (text.empty() || std::isspace(static_cast<unsigned char>(text.front()))) return n;
+    char* end = nullptr;
+    errno = 0;
+    n.value = std::strtod(text.c_str(), &end);
+    n.is_number = end == text.c_str() + text.size();
+    if (!n.is_number) return n;
+    n.defect = errno == ERANGE && std::isinf(n.value) ? "is too large for a double" : number_defect(n.value);
+    return n;
 }
 
 }  // namespace demcal::analytics

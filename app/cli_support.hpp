@@ -12,10 +12,16 @@ namespace demcal {
 nlohmann::json read_json_file(const std::string& path, const std::string& field);
 
 // Checks of number options. CLI11's own Range and PositiveNumber let NaN through and print their bounds with 300
-// digits; these refuse NaN and infinities and state the bounds as a user would type them.
+// digits; these refuse an empty value and what analytics::number_defect refuses (NaN, infinities, subnormals,
+// implausibly large numbers), naming it, and state the bounds as a user would type them.
 CLI::Validator number_in(double lo, double hi);  // lo <= x <= hi
 CLI::Validator positive_number();                // x > 0
 CLI::Validator non_negative_number();            // x >= 0
+CLI::Validator integer_in(long long lo, long long hi);  // a whole integer, lo <= x <= hi (never clamped)
+
+// Adds to every option of `app` and its subcommands that takes a value a check refusing an empty one (CLI11 read
+// `--replicates ""` as 0). Call once every command is registered.
+void refuse_empty_values(CLI::App& app);
 
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);

@@ -1,5 +1,6 @@
 // demcal sensitivity / calibrate / enlarge: the failure-line sensitivity study (seed Table 3.1), the calibration loop
 // and the particle-enlargement laws (seed eqs. 3.1-3.2). Every simulation is a stored, cached, resumable campaign run.
+#include "analytics/number_text.hpp"
 #include "analytics/scaling_law.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
@@ -39,9 +40,11 @@ struct CampaignCli {
 void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
     cmd->add_option("--normal-stress,-s", c.normal_stresses, "normal stresses of every failure line [Pa]")
         ->delimiter(',')
+        ->check(positive_number())
         ->capture_default_str();
     cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(positive_number());
-    cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)");
+    cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)")
+        ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
     cmd->add_option("--campaign,-c", c.campaign_dir, "campaign directory (store, runs, results)")->capture_default_str();
     cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
     cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
@@ -262,16 +265,18 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
         const auto colon = item.find(':');
         try {
             if (colon == std::string::npos) throw std::invalid_argument(item);
-            const auto whole_number = [](const std::string& text) {  // "5e3x" is not 5e3
-                std::size_t used = 0;
-                const double v = std::stod(text, &used);
-                if (used != text.size()) throw std::invalid_argument(text);
-                return v;
+            const auto whole_number = [&item](const std::string& text) {  // "5e3x" is not 5e3
+                const auto n = analytics::read_typed_number(text);
+                if (!n.is_number) throw std::invalid_argument(text);
+                if (n.defect)
+                    throw UserError("measured point '" + analytics::shortened_text(item) + "': " +
+                                    analytics::shortened_text(text) + " " + *n.defect);
+                return n.value;
             };
             sigma.push_back(whole_number(item.substr(0, colon)));
             tau.push_back(whole_number(item.substr(colon + 1)));
-        } catch (const std::exception&) {
-            throw UserError("measured point '" + item + "' is not of the form SIGMA:TAU (Pa)");
+        } catch (const std::invalid_argument&) {
+            throw UserError("measured point '" + analytics::shortened_text(item) + "' is not of the form SIGMA:TAU (Pa)");
         }
     }
     return targets_from_measured_line(sigma, tau);
@@ -283,7 +288,7 @@ void add_calibrate(CLI::App& app) {
     cmd->add_option("--target", o->target, "targets, e.g. mu_b=0.55,tau_c=800 (tau_c in Pa)");
     cmd->add_option("--measured", o->measured, "measured failure line SIGMA:TAU,... [Pa] (targets with its intervals)");
     cmd->add_option("--start", o->start_file, "starting material JSON")->required();
-    cmd->add_option("--tol", o->tol, "relative tolerance on each target")->capture_default_str();
+    cmd->add_option("--tol", o->tol, "relative tolerance on each target")->check(positive_number())->capture_default_str();
     cmd->add_option("--sensitivity", o->sensitivity_file, "stored sensitivity.json to reuse (default: run the study "
                                                           "around the start, reusing stored runs)");
     cmd->add_option("--controls", o->controls, "controlling parameters, one per target in order (default: chosen "

@@ -192,9 +192,11 @@ void add_shear_commands(CLI::App& app) {
     shear->add_option("material", opt->material_file, "material JSON (micromechanical parameters)")->required();
     shear->add_option("--normal-stress,-s", opt->normal_stresses, "normal stresses [Pa], e.g. 5e3,10e3,15e3")
         ->required()
-        ->delimiter(',');
+        ->delimiter(',')
+        ->check(positive_number());
     shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress (seeds seed, seed+1, ...)");
-    shear->add_option("--seed", opt->seed, "first packing seed");
+    shear->add_option("--seed", opt->seed, "first packing seed")
+        ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));
     shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<material name>)");
     shear->add_option("--template", opt->template_path, "YADE template (default: yade_scripts/shear_box.py)");
     shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));

@@ -29,8 +29,19 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"shear", tiny, "-s", "2e10"}, "'normal_stress' = 20000000000.0"},
         {{"shear", tiny, "-s", "5e3", "--seed", "2147483647", "-r", "2"}, "'seed' = 2147483648"},
         // NaN passed CLI11's own range checks
-        {{"shear", tiny, "-s", "5e3", "--timeout", "nan"}, "--timeout: nan is not a positive number"},
-        {{"sensitivity", tiny, "-s", "5e3,inf", "--params", "friction_coefficient"}, "normal_stress = inf"},
+        {{"shear", tiny, "-s", "5e3", "--timeout", "nan"}, "--timeout: 'nan' is not a number"},
+        {{"sensitivity", tiny, "-s", "5e3,inf", "--params", "friction_coefficient"}, "--normal-stress: 'inf' is not finite"},
+        // an empty value was read as 0, a subnormal called "not a number", a seed above 2^63 clamped to 2^63 - 1
+        {{"shear", tiny, "-s", "5e3", "--replicates", ""}, "--replicates: an empty value"},
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", ""}, "--levels: an empty value"},
+        {{"shear", tiny, "-s", "5e3", "--timeout", "1e-320"}, "--timeout: '1e-320' is subnormal"},
+        {{"shear", tiny, "-s", "5e3,1e-320"}, "--normal-stress: '1e-320' is subnormal"},
+        {{"shear", tiny, "-s", "5e3", "--seed", "9223372036854775808"},
+         "--seed: '9223372036854775808' is not an integer between 0 and 2147483647"},
+        // a negative cohesion target or negative measured stresses were calibrated against
+        {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800 must be >= 0"},
+        {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
+         "measured point 1 (5000:-7000): stresses must be >= 0 Pa"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "friction_coefficient", "--alpha", "2"}, "alpha = 2"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "particle_form", "--range", "particle_form=1:3"},
          "sensitivity level particle_form = 1.5"},
