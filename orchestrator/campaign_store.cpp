@@ -29,7 +29,7 @@ RunState run_state_from_string(const std::string& s) {
     if (s == "running") return RunState::running;
     if (s == "done") return RunState::done;
     if (s == "failed") return RunState::failed;
-    throw std::runtime_error("store: unknown run state '" + s + "'");
+    throw std::invalid_argument("store: unknown run state '" + analytics::shortened_text(s) + "' (a damaged store)");
 }
 
 namespace {
@@ -60,6 +60,8 @@ public:
         const int rc = sqlite3_step(st_);
         if (rc == SQLITE_ROW) return true;
         if (rc == SQLITE_DONE) return false;
+        if (rc == SQLITE_CORRUPT || rc == SQLITE_NOTADB)  // the file's fault, not the machine's: bad input
+            throw std::invalid_argument(std::string("store: damaged: ") + sqlite3_errmsg(db_));
         throw std::runtime_error(std::string("store: ") + sqlite3_errmsg(db_));
     }
     std::string text(int c) const {
@@ -97,9 +99,11 @@ void in_transaction(sqlite3* db, F&& f) {
     }
 }
 
-const char* kRunColumns =
-    "r.hash, r.params, r.state, r.attempts, r.result, r.cause, r.message, r.exit_code, r.wall_s, r.cpu_s, r.run_dir, "
-    "r.pgid, r.owner_pid";
+#define DEMCAL_RUN_COLUMNS                                                                                          \
+    "r.hash, r.params, r.state, r.attempts, r.result, r.cause, r.message, r.exit_code, r.wall_s, r.cpu_s, r.run_dir, " \
+    "r.pgid, r.owner_pid"
+const char* kRunColumns = DEMCAL_RUN_COLUMNS;
+const char* kRunColumnsQuery = "SELECT " DEMCAL_RUN_COLUMNS " FROM runs r";
 
 // A JSON column as the store holds it, read under the same rules as every JSON input (a damaged store is bad input).
 nlohmann::json stored_json(const Statement& st, int column, const char* name) {
@@ -169,6 +173,18 @@ void check_existing_store(sqlite3* db, const std::string& name) {
         throw std::invalid_argument(store + " is a SQLite database but not a demcal campaign store (application_id " +
                                     std::to_string(application_id) + ", " + (has_demcal_tables ? "" : "no ") +
                                     "demcal tables); nothing was written to it");
+    // every column demcal reads is there (quick_check passes a schema whose text was damaged)
+    for (const char* columns : {"SELECT key, value FROM meta", "SELECT id, name, kind, spec, status, created_at FROM campaigns",
+                                kRunColumnsQuery, "SELECT campaign_id, hash, label, position FROM campaign_runs",
+                                "SELECT id, hash, attempt, executor, started_at, finished_at, exit_code, cause, message, "
+                                "wall_s, cpu_s FROM attempts"}) {
+        try {
+            Statement(db, std::string(columns) + " LIMIT 0");
+        } catch (const std::runtime_error& e) {
+            throw std::invalid_argument(store + " does not have the tables of a demcal store (" + e.what() +
+                                        "); nothing was written to it");
+        }
+    }
     std::string verdict;
     try {
         Statement check(db, "PRAGMA quick_check(1)");
