@@ -164,7 +164,7 @@ void check_existing_store(sqlite3* db, const std::string& name) {
                          "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name IN "
                          "('meta', 'campaigns', 'runs', 'campaign_runs', 'attempts')");
         has_demcal_tables = tables.step() && tables.integer(0) == 5;
-    } catch (const std::runtime_error& e) {  // not a database at all, or its first page is damaged
+    } catch (const std::exception& e) {  // not a database at all, or its first page is damaged
         throw std::invalid_argument(store + " is not a readable SQLite database (" + e.what() +
                                     "); nothing was written to it");
     }
@@ -180,7 +180,7 @@ void check_existing_store(sqlite3* db, const std::string& name) {
                                 "wall_s, cpu_s FROM attempts"}) {
         try {
             Statement(db, std::string(columns) + " LIMIT 0");
-        } catch (const std::runtime_error& e) {
+        } catch (const std::exception& e) {
             throw std::invalid_argument(store + " does not have the tables of a demcal store (" + e.what() +
                                         "); nothing was written to it");
         }
@@ -189,7 +189,7 @@ void check_existing_store(sqlite3* db, const std::string& name) {
     try {
         Statement check(db, "PRAGMA quick_check(1)");
         verdict = check.step() ? check.text(0) : "no answer";
-    } catch (const std::runtime_error& e) {
+    } catch (const std::exception& e) {
         verdict = e.what();
     }
     if (verdict != "ok")
