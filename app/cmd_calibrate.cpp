@@ -421,6 +421,7 @@ struct EnlargeCli {
     std::string output = "enlargement.json";
     std::string plot_format = "png";
     bool no_plot = false;
+    bool allow_unconverged = false;
 };
 
 // The points and both fitted laws, side by side: OUTPUT with the plot's extension, its data in OUTPUT.dat.
@@ -454,6 +455,8 @@ void add_enlarge(CLI::App& app) {
     cmd->add_option("--output,-o", o->output, "result JSON (a plot beside it)")->capture_default_str();
     cmd->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     cmd->add_flag("--no-plot", o->no_plot, "write no plot (no gnuplot needed)");
+    cmd->add_flag("--allow-unconverged", o->allow_unconverged,
+                  "write the laws even when the power-law fit did not converge (exit 0)");
     cmd->callback([o] {
         if (fs::path(o->output).extension() != ".json")  // the plot and its data take the same name
             throw UserError("output = '" + o->output + "': must end in .json");
@@ -470,6 +473,10 @@ void add_enlarge(CLI::App& app) {
         if (r.size() < 3) throw UserError("materials: " + std::to_string(r.size()) + " given, need at least 3 radii");
         const auto e_law = analytics::fit_linear_law(r, e);
         const auto nu_law = analytics::fit_power_law(r, nu);
+        if (!nu_law.converged && !o->allow_unconverged)  // e.g. nu equal at every radius: D is not identifiable
+            throw std::runtime_error("enlarge: the power law nu(r) = C r^-D did not converge (" + nu_law.formula() +
+                                     "): D is not identifiable from these " + std::to_string(r.size()) +
+                                     " points; nothing written (--allow-unconverged writes it anyway)");
         nlohmann::json j = {{"young_modulus", e_law.to_json()},
                             {"poisson_ratio", nu_law.to_json()},
                             {"note", "r in m; poisson_ratio is YADE's ks/kn stiffness ratio, so nu(r) is a law for it"},

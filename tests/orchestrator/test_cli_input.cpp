@@ -211,3 +211,24 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
     for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::done);
     fs::remove_all(dir);
 }
+
+TEST_CASE("demcal enlarge says when the power law did not converge and writes nothing unless asked", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-enlarge-unconverged");
+    auto material = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand.json")));
+    std::vector<std::string> args{"enlarge", "--no-plot", "-o", (dir / "e.json").string()};
+    for (double r : {0.0025, 0.003, 0.0035}) {  // nu the same at every radius: the fit reported D = -0 with exit 0
+        material["particle_radius"] = r;
+        material["young_modulus"] = 1e10 * r + 5e6;
+        material["poisson_ratio"] = 0.2;
+        args.push_back((dir / ("r" + std::to_string(args.size()) + ".json")).string());
+        std::ofstream(args.back()) << material.dump();
+    }
+    CHECK(test::run_demcal(args, dir / "out.log") == 1);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("did not converge") && Contains("not identifiable"));
+    CHECK_FALSE(fs::exists(dir / "e.json"));
+    args.push_back("--allow-unconverged");
+    CHECK(test::run_demcal(args, dir / "out.log") == 0);
+    CHECK_THAT(test::read_file(dir / "out.log"), !Contains("-0 "));
+    CHECK(fs::exists(dir / "e.json"));
+    fs::remove_all(dir);
+}
