@@ -22,6 +22,7 @@ namespace demcal {
 
 namespace fs = std::filesystem;
 using namespace calibration;
+using orchestrator::check_run_count;
 
 namespace {
 
@@ -198,6 +199,13 @@ void write_study(const fs::path& dir, const SensitivityStudy& study, const std::
 
 // Checks every level's material before anything is written or run: a bad range must not cost simulations.
 void check_study(const nlohmann::json& base, const SensitivityCli& o) {
+    // the count first: planning a billion levels would itself take the memory
+    const std::size_t params = o.params.empty() ? orchestrator::micromechanical_param_names().size() : o.params.size();
+    const auto& c = o.campaign;
+    check_run_count(static_cast<double>(params) * o.levels * c.normal_stresses.size() * c.replicates, c.exec.max_runs,
+                    "sensitivity study: " + std::to_string(params) + " parameters x " + std::to_string(o.levels) +
+                        " levels x " + std::to_string(c.normal_stresses.size()) + " normal stresses x " +
+                        std::to_string(c.replicates) + " replicates");
     sensitivity_plan(base, sensitivity_options(o));
     check_campaign(o.campaign, base);
 }
@@ -329,6 +337,11 @@ void add_calibrate(CLI::App& app) {
             if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
             check_study(start, o->study);
         }
+        check_run_count(static_cast<double>(o->max_evaluations) * camp.normal_stresses.size() * camp.replicates,
+                        camp.exec.max_runs,
+                        "calibration: " + std::to_string(o->max_evaluations) + " evaluations x " +
+                            std::to_string(camp.normal_stresses.size()) + " normal stresses x " +
+                            std::to_string(camp.replicates) + " replicates");
         check_campaign(camp, start);
         SensitivityStudy study;
         if (!o->sensitivity_file.empty()) {

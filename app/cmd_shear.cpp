@@ -210,6 +210,9 @@ void add_shear_commands(CLI::App& app) {
         } catch (const std::invalid_argument& e) {
             throw UserError(e.what());
         }
+        check_run_count(static_cast<double>(opt->normal_stresses.size()) * opt->replicates, opt->exec.max_runs,
+                        "shear: " + std::to_string(opt->normal_stresses.size()) + " normal stresses x " +
+                            std::to_string(opt->replicates) + " replicates");
         spec.normal_stresses = opt->normal_stresses;
         spec.replicates = opt->replicates;
         spec.base_seed = opt->seed;

@@ -1,5 +1,6 @@
 #include "orchestrator/shear_campaign.hpp"
 
+#include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
 
 #include "orchestrator/run_identity.hpp"
@@ -158,6 +159,13 @@ std::unique_ptr<Executor> make_executor(const ExecutionOptions& o, const fs::pat
 }
 
 }  // namespace
+
+void check_run_count(double runs, long max_runs, const std::string& breakdown) {
+    if (runs > static_cast<double>(max_runs))
+        throw std::invalid_argument(breakdown + " = " + analytics::number_text(runs, 10) + " simulations, more than " +
+                                    "the limit --max-runs = " + std::to_string(max_runs) +
+                                    " (raise it with --max-runs if that many are meant)");
+}
 
 void validate_shear_spec(const ShearCampaignSpec& spec) {
     if (spec.normal_stresses.empty()) throw std::invalid_argument("normal_stress: at least one normal stress is needed");
