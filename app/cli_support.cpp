@@ -11,7 +11,10 @@
 #include <cstdlib>
 #include <cstdio>
 #include <fstream>
+#include <filesystem>
 #include <functional>
+
+#include <unistd.h>
 
 namespace demcal {
 
@@ -84,6 +87,19 @@ CLI::Validator positive_number() {
 
 CLI::Validator non_negative_number() {
     return number_check("a number >= 0", [](double v) { return v >= 0; });
+}
+
+void check_output_file(const std::string& path, const std::string& option) {
+    namespace fs = std::filesystem;
+    const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
+    if (path.empty()) throw UserError(option + ": an empty path");
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
+    const fs::path folder = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+    if (!fs::is_directory(folder, ec)) throw UserError(named + ": the folder " + folder.string() + " does not exist");
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+        throw UserError(named + ": the folder " + folder.string() + " is not writable");
+    if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) throw UserError(named + " is not writable");
 }
 
 std::string duration_text(double seconds) {

@@ -23,6 +23,10 @@ CLI::Validator integer_in(long long lo, long long hi);  // a whole integer, lo <
 // `--replicates ""` as 0). Call once every command is registered.
 void refuse_empty_values(CLI::App& app);
 
+// Checks, before any work starts, that `path` can be written as an output file: not a folder, its folder exists and
+// is writable (and the file itself, when it exists). Throws UserError naming `option`, the path and the rule.
+void check_output_file(const std::string& path, const std::string& option);
+
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);
 

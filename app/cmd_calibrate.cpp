@@ -316,6 +316,7 @@ void add_calibrate(CLI::App& app) {
     add_campaign_options(cmd, o->study.campaign);
     cmd->callback([o] {
         const auto& camp = o->study.campaign;
+        if (!o->output.empty()) check_output_file(o->output, "output");  // before hours of calibration, not after
         const auto start = orchestrator::validate_material(read_json_file(o->start_file, "start"), o->start_file);
         const auto targets = targets_of(*o);
         const auto bounds = parse_ranges(o->bounds, "bounds");
@@ -473,9 +474,7 @@ void add_enlarge(CLI::App& app) {
     cmd->callback([o] {
         if (fs::path(o->output).extension() != ".json")  // the plot and its data take the same name
             throw UserError("output = '" + o->output + "': must end in .json");
-        const fs::path folder = fs::path(o->output).parent_path();
-        if (!folder.empty() && !fs::is_directory(folder))
-            throw UserError("output = '" + o->output + "': the directory " + folder.string() + " does not exist");
+        check_output_file(o->output, "output");
         std::vector<double> r, e, nu;
         for (const auto& file : o->materials) {
             const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);

@@ -38,6 +38,10 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"shear", tiny, "-s", "5e3,1e-320"}, "--normal-stress: '1e-320' is subnormal"},
         {{"shear", tiny, "-s", "5e3", "--seed", "9223372036854775808"},
          "--seed: '9223372036854775808' is not an integer between 0 and 2147483647"},
+        // an output path that cannot be written was found only after the whole calibration
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "-o", "/"}, "output = '/' is a folder"},
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "-o", "/no/such/folder/m.json"},
+         "the folder /no/such/folder does not exist"},
         // limits, named with the flag that lifts them (an absurd level count started millions of runs)
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", "2000000000"},
          "levels x 2 normal stresses x 1 replicates = 3.2e+10 simulations, more than the limit --max-runs = 10000"},
