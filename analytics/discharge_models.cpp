@@ -1,6 +1,7 @@
 #include "analytics/discharge_models.hpp"
 
 #include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -264,12 +265,12 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
 }
 
 SiloGeometry geometry_from_json(const nlohmann::json& j) {
-    if (!j.is_object()) throw std::invalid_argument("geometry: expected a JSON object, got " + j.dump());
+    if (!j.is_object()) throw std::invalid_argument("geometry: expected a JSON object, got " + json_value_text(j));
     SiloGeometry g;
     auto number = [&](const std::string& key) -> std::optional<double> {
         if (!j.contains(key)) return std::nullopt;
         const auto& v = j.at(key);
-        if (!v.is_number()) throw std::invalid_argument("geometry: " + key + "=" + v.dump() + " is not a number");
+        if (!v.is_number()) throw std::invalid_argument("geometry: " + key + "=" + json_value_text(v) + " is not a number");
         return v.get<double>();
     };
     auto required = [&](const std::string& key) {
@@ -282,10 +283,10 @@ SiloGeometry geometry_from_json(const nlohmann::json& j) {
                                                 "slot_C",    "delta",     "phi_d_deg",   "delta_e_deg", "phi_w_deg"};
     for (const auto& [key, value] : j.items())
         if (std::find(known.begin(), known.end(), key) == known.end())
-            throw std::invalid_argument("geometry: unknown key " + key + "=" + value.dump());
+            throw std::invalid_argument("geometry: unknown key " + shortened_text(key) + "=" + json_value_text(value));
     if (!j.contains("geometry") || !j.at("geometry").is_string())
         throw std::invalid_argument("geometry: key geometry must be \"conical\" or \"rectangular\"" +
-                                    (j.contains("geometry") ? ", got " + j.at("geometry").dump() : std::string()));
+                                    (j.contains("geometry") ? ", got " + json_value_text(j.at("geometry")) : std::string()));
     const auto shape = j.at("geometry").get<std::string>();
     if (shape == "conical") {
         g.shape = SiloShape::conical;
@@ -298,7 +299,7 @@ SiloGeometry geometry_from_json(const nlohmann::json& j) {
         g.width = required("c_m");
         if (j.contains("D_m")) throw std::invalid_argument("geometry: D_m is for conical silos");
     } else {
-        throw std::invalid_argument("geometry: geometry=\"" + shape + "\", expected conical or rectangular");
+        throw std::invalid_argument("geometry: geometry=\"" + shortened_text(shape) + "\", expected conical or rectangular");
     }
     g.outlet = required("outlet_m");
     g.half_angle_deg = required("theta_deg");

@@ -1,9 +1,11 @@
 #include "analytics/measured_data.hpp"
 
+#include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <istream>
 #include <limits>
 #include <optional>
@@ -69,7 +71,12 @@ std::vector<std::string> split_csv_line(const std::string& line, const std::stri
 // Cells that may be empty: the geometry-specific sizes (they apply to one geometry only).
 bool may_be_empty(const std::string& column) { return column == "D_m" || column == "b_m" || column == "c_m"; }
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+std::string quote(const std::string& s) {
+    std::string quoted = "'";  // appended, not "'" + ... + "'": GCC 12 warns falsely (-Wrestrict) on the latter
+    quoted += shortened_text(s);
+    quoted += '\'';
+    return quoted;
+}
 
 std::string num(double v) {
     std::ostringstream s;
@@ -92,7 +99,7 @@ const DataColumn& MeasuredData::at(std::string_view name) const {
 }
 
 std::string MeasuredData::where(std::size_t row, std::string_view column) const {
-    return source + ": line " + std::to_string(lines.at(row)) + ", column " + std::string(column);
+    return source + ": line " + std::to_string(lines.at(row)) + ", column " + shortened_text(column);
 }
 
 const std::vector<std::string>& reserved_columns(MeasuredKind kind) {
@@ -120,7 +127,7 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
                 for (const auto& c : data.columns)
                     if (c.name == name)
                         throw std::invalid_argument(source + ": line " + std::to_string(line_no) +
-                                                    ": duplicate column " + name);
+                                                    ": duplicate column " + shortened_text(name));
                 data.columns.push_back(DataColumn{name, true, {}, {}});
             }
             have_header = true;
@@ -144,6 +151,9 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
                 if (!may_be_empty(col.name)) throw std::invalid_argument(data.where(r, col.name) + ": missing value");
                 continue;
             }
+            // a cell that reads as a number must be a usable one ("nan", "inf", "1e-320" are not categories)
+            if (const auto n = read_typed_number(cell); n.is_number && n.defect)
+                throw std::invalid_argument(data.where(r, col.name) + ": " + quote(cell) + " " + *n.defect);
             if (parse_number(cell)) {
                 ++numbers;
             } else if (texts++ == 0) {
@@ -234,8 +244,7 @@ void validate_measured(const MeasuredData& data, MeasuredKind kind) {
 }
 
 MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind) {
-    std::ifstream in(path);
-    if (!in) throw std::invalid_argument("cannot open data file " + path);
+    std::istringstream in(read_input_file(path, "data file " + shortened_text(path, 200), kMaxMeasuredDataBytes));
     auto data = parse_csv(in, path);
     validate_measured(data, kind);
     return data;

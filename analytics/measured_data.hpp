@@ -36,7 +36,8 @@ const std::vector<std::string>& reserved_columns(MeasuredKind kind);
 
 // Parses CSV text (comma-separated, optional double quotes, '#' comment lines and blank lines skipped). Checks the
 // shape (unique header names, the same number of fields on every line, no empty cells outside the geometry columns)
-// and decides which columns are numeric; throws std::invalid_argument naming line and column.
+// and decides which columns are numeric; a cell that reads as a number must pass analytics::number_defect (no
+// subnormal, non-finite or implausibly large values); throws std::invalid_argument naming line and column.
 MeasuredData parse_csv(std::istream& in, const std::string& source);
 
 // Checks the columns a kind needs and the physical sense of every value (positive sizes, outlet larger than the
@@ -44,7 +45,11 @@ MeasuredData parse_csv(std::istream& in, const std::string& source);
 // line, column and value.
 void validate_measured(const MeasuredData& data, MeasuredKind kind);
 
-// parse_csv + validate_measured on a file.
+// Measured data sets are a few hundred rows; a larger file is a wrong file.
+inline constexpr std::size_t kMaxMeasuredDataBytes = std::size_t{64} << 20;
+
+// parse_csv + validate_measured on a file (read by analytics::read_input_file: a folder, a device or a file over
+// kMaxMeasuredDataBytes is refused).
 MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind);
 
 // The data back as CSV (numbers with 10 significant digits), e.g. to write generated sets.

@@ -1,15 +1,65 @@
-// A number as a message shows it: the shortest stream form ("0.035", "1e+10"), so an error names a value as typed.
+// How a value given by a user shows in a message, and the rule every number read from a user follows (JSON inputs,
+// CSV data, command-line options): one place, so every reader refuses the same numbers with the same words.
 #pragma once
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 namespace demcal::analytics {
 
+// A number as a message shows it: the shortest stream form ("0.035", "1e+10"), so an error names a value as typed.
 inline std::string number_text(double value, int significant_digits = 6) {
     std::ostringstream s;
     s.precision(significant_digits);
     s << value;
     return s.str();
+}
+
+// A value as a message shows it: whole when short, else its start and how long it was (a 50 MB string in an input
+// must not end up on stderr in full).
+inline std::string shortened_text(std::string_view text, std::size_t max_chars = 60) {
+    if (text.size() <= max_chars) return std::string(text);
+    return std::string(text.substr(0, max_chars)) + "... (" + std::to_string(text.size()) + " characters)";
+}
+
+// Beyond this magnitude no input of demcal is a measurement or a setting, only a typo (1e308 for 1e3).
+inline constexpr double kLargestPlausibleNumber = 1e100;
+
+// Why a number read from a user cannot be used, or nothing when it can. Subnormals are refused because arithmetic on
+// them loses precision and can stall a time loop (a step of 1e-320 s never advances the clock).
+inline std::optional<std::string> number_defect(double value) {
+    if (std::isnan(value)) return "is not a number";
+    if (std::isinf(value)) return "is not finite";
+    if (std::fpclassify(value) == FP_SUBNORMAL) return "is subnormal (too close to 0 to compute with)";
+    if (std::fabs(value) > kLargestPlausibleNumber)
+        return "is implausibly large (|value| > " + number_text(kLargestPlausibleNumber) + ")";
+    return std::nullopt;
+}
+
+// A number typed by a user (an option, a CSV cell, a target), read whole by strtod: `is_number` is false when the
+// text is no number at all; otherwise `value`, and `defect` says why it cannot be used (number_defect, or an exponent
+// beyond a double's range).
+struct TypedNumber {
+    bool is_number = false;
+    double value = 0;
+    std::optional<std::string> defect;
+};
+
+inline TypedNumber read_typed_number(const std::string& text) {
+    TypedNumber n;
+    if (text.empty() || std::isspace(static_cast<unsigned char>(text.front()))) return n;
+    char* end = nullptr;
+    errno = 0;
+    n.value = std::strtod(text.c_str(), &end);
+    n.is_number = end == text.c_str() + text.size();
+    if (!n.is_number) return n;
+    n.defect = errno == ERANGE && std::isinf(n.value) ? "is too large for a double" : number_defect(n.value);
+    return n;
 }
 
 }  // namespace demcal::analytics

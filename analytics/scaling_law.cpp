@@ -56,6 +56,7 @@ double weighted_r_squared(std::span<const double> y, const std::vector<double>& 
 
 LawParameter parameter(const char* name, double value, double variance, double t) {
     const double se = std::sqrt(std::max(variance, 0.0));
+    if (value == 0) value = 0;  // -0 read "D = -0"
     return {name, value, se, value - t * se, value + t * se};
 }
 
@@ -71,6 +72,8 @@ std::string ScalingLawFit::formula() const {
     o.precision(4);
     if (law == "linear")
         o << "y(r) = " << params[0].value << " r " << (params[1].value < 0 ? "- " : "+ ") << std::fabs(params[1].value);
+    else if (params[1].value < 0)  // y grows with r: "r^-(-0.5)", not "r^--0.5"
+        o << "y(r) = " << params[0].value << " r^-(" << params[1].value << ")";
     else
         o << "y(r) = " << params[0].value << " r^-" << params[1].value;
     return o.str();

@@ -1,46 +1,80 @@
 #include "app/cli_support.hpp"
 
 #include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
 #include "app/commands.hpp"
 
+#include <cctype>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
+#include <filesystem>
 #include <functional>
+
+#include <unistd.h>
 
 namespace demcal {
 
 nlohmann::json read_json_file(const std::string& path, const std::string& field) {
-    std::ifstream f(path);
-    if (!f) throw UserError(field + " = '" + path + "' cannot be read");
     try {
-        return nlohmann::json::parse(f);
-    } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number too large for a double
-        throw UserError(field + " = '" + path + "' is not valid JSON: " + e.what());
+        return analytics::read_json_input(path, field);
+    } catch (const analytics::InputError& e) {
+        throw UserError(e.what());
     }
 }
 
 namespace {
 
-// A validator that accepts a finite number for which `ok` holds; `what` completes "VALUE is not ...".
+constexpr const char* kEmptyValue = "an empty value (omit the option to get its default)";
+
+// A validator that accepts a number for which `ok` holds; `what` completes "VALUE is not ...". The text is read by
+// strtod, so a subnormal or an overflowing exponent is named as such by analytics::number_defect, not as "not a
+// number".
 CLI::Validator number_check(const std::string& what, std::function<bool(double)> ok) {
     return CLI::Validator(
         [what, ok](std::string& text) -> std::string {
-            double v = 0;
-            size_t used = 0;
-            try {
-                v = std::stod(text, &used);
-            } catch (const std::exception&) {
-                used = 0;
-            }
-            if (used == 0 || used != text.size()) return "'" + text + "' is not a number";
-            if (!std::isfinite(v) || !ok(v)) return text + " is not " + what;
+            if (text.empty()) return kEmptyValue;
+            const std::string shown = "'" + analytics::shortened_text(text) + "'";
+            const auto n = analytics::read_typed_number(text);
+            if (!n.is_number) return shown + " is not a number";
+            if (n.defect) return shown + " " + *n.defect;
+            const double v = n.value;
+            if (!ok(v)) return text + " is not " + what;
             return {};
         },
         what);
 }
 
 }  // namespace
+
+CLI::Validator integer_in(long long lo, long long hi) {
+    const std::string what = "an integer between " + std::to_string(lo) + " and " + std::to_string(hi);
+    return CLI::Validator(
+        [what, lo, hi](std::string& text) -> std::string {
+            if (text.empty()) return kEmptyValue;
+            long long v = 0;
+            const char* begin = text.c_str() + (text.front() == '+' ? 1 : 0);
+            const auto [end, ec] = std::from_chars(begin, text.c_str() + text.size(), v);
+            const std::string shown = "'" + analytics::shortened_text(text) + "'";
+            if (end != text.c_str() + text.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+                return shown + " is not an integer";
+            // out of range of a long long (a seed above 2^63 was silently clamped to 2^63 - 1)
+            if (ec == std::errc::result_out_of_range || v < lo || v > hi) return shown + " is not " + what;
+            return {};
+        },
+        what);
+}
+
+void refuse_empty_values(CLI::App& app) {
+    for (CLI::Option* opt : app.get_options())
+        if (opt->get_type_size_max() > 0)  // takes values (a flag takes none)
+            opt->check(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); },
+                                      ""));
+    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
+}
 
 CLI::Validator number_in(double lo, double hi) {
     return number_check("between " + analytics::number_text(lo) + " and " + analytics::number_text(hi),
@@ -53,6 +87,19 @@ CLI::Validator positive_number() {
 
 CLI::Validator non_negative_number() {
     return number_check("a number >= 0", [](double v) { return v >= 0; });
+}
+
+void check_output_file(const std::string& path, const std::string& option) {
+    namespace fs = std::filesystem;
+    const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
+    if (path.empty()) throw UserError(option + ": an empty path");
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
+    const fs::path folder = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+    if (!fs::is_directory(folder, ec)) throw UserError(named + ": the folder " + folder.string() + " does not exist");
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+        throw UserError(named + ": the folder " + folder.string() + " is not writable");
+    if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) throw UserError(named + " is not writable");
 }
 
 std::string duration_text(double seconds) {

@@ -7,14 +7,25 @@
 
 namespace demcal {
 
-// Parses the JSON file at `path`; a missing file or bad JSON is a UserError naming `field` and the path.
+// Reads the JSON file at `path` through analytics::read_json_input; any refusal is a UserError naming `field`, the
+// path and the rule.
 nlohmann::json read_json_file(const std::string& path, const std::string& field);
 
 // Checks of number options. CLI11's own Range and PositiveNumber let NaN through and print their bounds with 300
-// digits; these refuse NaN and infinities and state the bounds as a user would type them.
+// digits; these refuse an empty value and what analytics::number_defect refuses (NaN, infinities, subnormals,
+// implausibly large numbers), naming it, and state the bounds as a user would type them.
 CLI::Validator number_in(double lo, double hi);  // lo <= x <= hi
 CLI::Validator positive_number();                // x > 0
 CLI::Validator non_negative_number();            // x >= 0
+CLI::Validator integer_in(long long lo, long long hi);  // a whole integer, lo <= x <= hi (never clamped)
+
+// Adds to every option of `app` and its subcommands that takes a value a check refusing an empty one (CLI11 read
+// `--replicates ""` as 0). Call once every command is registered.
+void refuse_empty_values(CLI::App& app);
+
+// Checks, before any work starts, that `path` can be written as an output file: not a folder, its folder exists and
+// is writable (and the file itself, when it exists). Throws UserError naming `option`, the path and the rule.
+void check_output_file(const std::string& path, const std::string& option);
 
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);

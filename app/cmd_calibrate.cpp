@@ -1,5 +1,6 @@
 // demcal sensitivity / calibrate / enlarge: the failure-line sensitivity study (seed Table 3.1), the calibration loop
 // and the particle-enlargement laws (seed eqs. 3.1-3.2). Every simulation is a stored, cached, resumable campaign run.
+#include "analytics/number_text.hpp"
 #include "analytics/scaling_law.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
@@ -21,6 +22,7 @@ namespace demcal {
 
 namespace fs = std::filesystem;
 using namespace calibration;
+using orchestrator::check_run_count;
 
 namespace {
 
@@ -39,9 +41,11 @@ struct CampaignCli {
 void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
     cmd->add_option("--normal-stress,-s", c.normal_stresses, "normal stresses of every failure line [Pa]")
         ->delimiter(',')
+        ->check(positive_number())
         ->capture_default_str();
     cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(positive_number());
-    cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)");
+    cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)")
+        ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
     cmd->add_option("--campaign,-c", c.campaign_dir, "campaign directory (store, runs, results)")->capture_default_str();
     cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
     cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
@@ -195,6 +199,13 @@ void write_study(const fs::path& dir, const SensitivityStudy& study, const std::
 
 // Checks every level's material before anything is written or run: a bad range must not cost simulations.
 void check_study(const nlohmann::json& base, const SensitivityCli& o) {
+    // the count first: planning a billion levels would itself take the memory
+    const std::size_t params = o.params.empty() ? orchestrator::micromechanical_param_names().size() : o.params.size();
+    const auto& c = o.campaign;
+    check_run_count(static_cast<double>(params) * o.levels * c.normal_stresses.size() * c.replicates, c.exec.max_runs,
+                    "sensitivity study: " + std::to_string(params) + " parameters x " + std::to_string(o.levels) +
+                        " levels x " + std::to_string(c.normal_stresses.size()) + " normal stresses x " +
+                        std::to_string(c.replicates) + " replicates");
     sensitivity_plan(base, sensitivity_options(o));
     check_campaign(o.campaign, base);
 }
@@ -262,16 +273,18 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
         const auto colon = item.find(':');
         try {
             if (colon == std::string::npos) throw std::invalid_argument(item);
-            const auto whole_number = [](const std::string& text) {  // "5e3x" is not 5e3
-                std::size_t used = 0;
-                const double v = std::stod(text, &used);
-                if (used != text.size()) throw std::invalid_argument(text);
-                return v;
+            const auto whole_number = [&item](const std::string& text) {  // "5e3x" is not 5e3
+                const auto n = analytics::read_typed_number(text);
+                if (!n.is_number) throw std::invalid_argument(text);
+                if (n.defect)
+                    throw UserError("measured point '" + analytics::shortened_text(item) + "': " +
+                                    analytics::shortened_text(text) + " " + *n.defect);
+                return n.value;
             };
             sigma.push_back(whole_number(item.substr(0, colon)));
             tau.push_back(whole_number(item.substr(colon + 1)));
-        } catch (const std::exception&) {
-            throw UserError("measured point '" + item + "' is not of the form SIGMA:TAU (Pa)");
+        } catch (const std::invalid_argument&) {
+            throw UserError("measured point '" + analytics::shortened_text(item) + "' is not of the form SIGMA:TAU (Pa)");
         }
     }
     return targets_from_measured_line(sigma, tau);
@@ -283,7 +296,7 @@ void add_calibrate(CLI::App& app) {
     cmd->add_option("--target", o->target, "targets, e.g. mu_b=0.55,tau_c=800 (tau_c in Pa)");
     cmd->add_option("--measured", o->measured, "measured failure line SIGMA:TAU,... [Pa] (targets with its intervals)");
     cmd->add_option("--start", o->start_file, "starting material JSON")->required();
-    cmd->add_option("--tol", o->tol, "relative tolerance on each target")->capture_default_str();
+    cmd->add_option("--tol", o->tol, "relative tolerance on each target")->check(positive_number())->capture_default_str();
     cmd->add_option("--sensitivity", o->sensitivity_file, "stored sensitivity.json to reuse (default: run the study "
                                                           "around the start, reusing stored runs)");
     cmd->add_option("--controls", o->controls, "controlling parameters, one per target in order (default: chosen "
@@ -303,6 +316,7 @@ void add_calibrate(CLI::App& app) {
     add_campaign_options(cmd, o->study.campaign);
     cmd->callback([o] {
         const auto& camp = o->study.campaign;
+        if (!o->output.empty()) check_output_file(o->output, "output");  // before hours of calibration, not after
         const auto start = orchestrator::validate_material(read_json_file(o->start_file, "start"), o->start_file);
         const auto targets = targets_of(*o);
         const auto bounds = parse_ranges(o->bounds, "bounds");
@@ -324,6 +338,11 @@ void add_calibrate(CLI::App& app) {
             if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
             check_study(start, o->study);
         }
+        check_run_count(static_cast<double>(o->max_evaluations) * camp.normal_stresses.size() * camp.replicates,
+                        camp.exec.max_runs,
+                        "calibration: " + std::to_string(o->max_evaluations) + " evaluations x " +
+                            std::to_string(camp.normal_stresses.size()) + " normal stresses x " +
+                            std::to_string(camp.replicates) + " replicates");
         check_campaign(camp, start);
         SensitivityStudy study;
         if (!o->sensitivity_file.empty()) {
@@ -416,6 +435,7 @@ struct EnlargeCli {
     std::string output = "enlargement.json";
     std::string plot_format = "png";
     bool no_plot = false;
+    bool allow_unconverged = false;
 };
 
 // The points and both fitted laws, side by side: OUTPUT with the plot's extension, its data in OUTPUT.dat.
@@ -449,12 +469,12 @@ void add_enlarge(CLI::App& app) {
     cmd->add_option("--output,-o", o->output, "result JSON (a plot beside it)")->capture_default_str();
     cmd->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     cmd->add_flag("--no-plot", o->no_plot, "write no plot (no gnuplot needed)");
+    cmd->add_flag("--allow-unconverged", o->allow_unconverged,
+                  "write the laws even when the power-law fit did not converge (exit 0)");
     cmd->callback([o] {
         if (fs::path(o->output).extension() != ".json")  // the plot and its data take the same name
             throw UserError("output = '" + o->output + "': must end in .json");
-        const fs::path folder = fs::path(o->output).parent_path();
-        if (!folder.empty() && !fs::is_directory(folder))
-            throw UserError("output = '" + o->output + "': the directory " + folder.string() + " does not exist");
+        check_output_file(o->output, "output");
         std::vector<double> r, e, nu;
         for (const auto& file : o->materials) {
             const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
@@ -465,6 +485,10 @@ void add_enlarge(CLI::App& app) {
         if (r.size() < 3) throw UserError("materials: " + std::to_string(r.size()) + " given, need at least 3 radii");
         const auto e_law = analytics::fit_linear_law(r, e);
         const auto nu_law = analytics::fit_power_law(r, nu);
+        if (!nu_law.converged && !o->allow_unconverged)  // e.g. nu equal at every radius: D is not identifiable
+            throw std::runtime_error("enlarge: the power law nu(r) = C r^-D did not converge (" + nu_law.formula() +
+                                     "): D is not identifiable from these " + std::to_string(r.size()) +
+                                     " points; nothing written (--allow-unconverged writes it anyway)");
         nlohmann::json j = {{"young_modulus", e_law.to_json()},
                             {"poisson_ratio", nu_law.to_json()},
                             {"note", "r in m; poisson_ratio is YADE's ks/kn stiffness ratio, so nu(r) is a law for it"},

@@ -176,6 +176,11 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
         std::cout << "no failure line: fewer than 3 finished runs on 2 normal stresses\n";
     }
     if (outcome.interrupted) return 130;
+    if (!outcome.infrastructure_failure.empty()) {
+        std::cout << "the simulator could not be started (" << outcome.infrastructure_failure
+                  << "); the runs it hit stay pending: fix --yade, then `demcal resume " << dir.string() << "`\n";
+        return kExitResumeLater;
+    }
     return outcome.failed > 0 ? 1 : 0;
 }
 
@@ -187,9 +192,11 @@ void add_shear_commands(CLI::App& app) {
     shear->add_option("material", opt->material_file, "material JSON (micromechanical parameters)")->required();
     shear->add_option("--normal-stress,-s", opt->normal_stresses, "normal stresses [Pa], e.g. 5e3,10e3,15e3")
         ->required()
-        ->delimiter(',');
+        ->delimiter(',')
+        ->check(positive_number());
     shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress (seeds seed, seed+1, ...)");
-    shear->add_option("--seed", opt->seed, "first packing seed");
+    shear->add_option("--seed", opt->seed, "first packing seed")
+        ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));
     shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<material name>)");
     shear->add_option("--template", opt->template_path, "YADE template (default: yade_scripts/shear_box.py)");
     shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
@@ -203,6 +210,9 @@ void add_shear_commands(CLI::App& app) {
         } catch (const std::invalid_argument& e) {
             throw UserError(e.what());
         }
+        check_run_count(static_cast<double>(opt->normal_stresses.size()) * opt->replicates, opt->exec.max_runs,
+                        "shear: " + std::to_string(opt->normal_stresses.size()) + " normal stresses x " +
+                            std::to_string(opt->replicates) + " replicates");
         spec.normal_stresses = opt->normal_stresses;
         spec.replicates = opt->replicates;
         spec.base_seed = opt->seed;
@@ -265,6 +275,7 @@ void add_shear_commands(CLI::App& app) {
     resume->callback([resume_opt] {
         if (!fs::exists(fs::path(resume_opt->campaign_dir) / "campaign.sqlite"))
             throw UserError("campaign = '" + resume_opt->campaign_dir + "' holds no campaign.sqlite");
+        find_yade(resume_opt->exec.yade);  // before the store is opened: a bad --yade costs nothing
         ShearCampaignRunner runner(resume_opt->campaign_dir, resume_opt->exec);
         const auto outs = runner.resume(print_progress);
         if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";

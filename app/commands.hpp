@@ -12,6 +12,10 @@ struct UserError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// Exit status of a command that stopped for a reason outside the input (the simulator could not be started): run
+// `demcal resume` once it is fixed (EX_TEMPFAIL of sysexits.h).
+inline constexpr int kExitResumeLater = 75;
+
 void add_shear_commands(CLI::App& app);        // shear, status, resume            (cmd_shear.cpp)
 void add_silo_command(CLI::App& app);          // silo                              (cmd_silo.cpp)
 void add_discharge_commands(CLI::App& app);    // predict, diagnose                 (cmd_diagnose.cpp)

@@ -12,6 +12,9 @@ void add_execution_options(CLI::App* cmd, orchestrator::ExecutionOptions& e) {
         ->check(CLI::IsMember({"local", "slurm"}));
     cmd->add_option("--partition", e.slurm_partition, "SLURM partition (slurm executor)");
     cmd->add_option("--yade", e.yade, "YADE launcher to run");
+    cmd->add_option("--max-runs", e.max_runs, "most simulations this command may plan (a guard against typos)")
+        ->check(integer_in(1, 1000000000))
+        ->capture_default_str();
 }
 
 }  // namespace demcal

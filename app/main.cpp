@@ -1,3 +1,4 @@
+#include "app/cli_support.hpp"
 #include "app/commands.hpp"
 
 #include <iostream>
@@ -10,6 +11,7 @@ int main(int argc, char** argv) {
     demcal::add_silo_command(app);
     demcal::add_discharge_commands(app);
     demcal::add_calibration_commands(app);
+    demcal::refuse_empty_values(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::RuntimeError& e) {  // a command's own exit status (75: suspended, resume it)

@@ -21,6 +21,9 @@ FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runne
         auto ev = evaluate_failure_line(runner, settings.spec_for(material), progress);
         if (ev.outcome.interrupted)
             throw std::runtime_error("interrupted; every finished run is stored: run the same command again to resume");
+        if (!ev.outcome.infrastructure_failure.empty())
+            throw std::runtime_error("the simulator could not be started (" + ev.outcome.infrastructure_failure +
+                                     "); every finished run is stored: fix --yade and run the same command again");
         return ev;
     };
 }

@@ -1,5 +1,7 @@
 #include "calibration/macro_target.hpp"
 
+#include "analytics/number_text.hpp"
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -74,16 +76,18 @@ std::vector<MacroTarget> parse_targets(const std::string& text) {
         t.quantity = item.substr(0, eq);
         check_quantity(t.quantity);
         const std::string value = item.substr(eq + 1);
-        std::size_t used = 0;
-        try {
-            t.value = std::stod(value, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != value.size() || value.empty() || !std::isfinite(t.value))
-            throw std::invalid_argument("target " + t.quantity + " = '" + value + "' is not a number");
+        const auto number = analytics::read_typed_number(value);
+        if (!number.is_number)
+            throw std::invalid_argument("target " + t.quantity + " = '" + analytics::shortened_text(value) +
+                                        "' is not a number");
+        if (number.defect)
+            throw std::invalid_argument("target " + t.quantity + " = '" + analytics::shortened_text(value) + "' " +
+                                        *number.defect);
+        t.value = number.value;
         if (t.quantity == "mu_b" && !(t.value > 0))
             throw std::invalid_argument("target mu_b = " + value + " must be > 0 (a friction coefficient)");
+        if (t.quantity == "tau_c" && t.value < 0)
+            throw std::invalid_argument("target tau_c = " + value + " must be >= 0 (a cohesion [Pa])");
         for (const auto& other : targets)
             if (other.quantity == t.quantity) throw std::invalid_argument("target " + t.quantity + " is given twice");
         targets.push_back(t);
@@ -94,6 +98,11 @@ std::vector<MacroTarget> parse_targets(const std::string& text) {
 
 std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigma, std::span<const double> tau,
                                                     double confidence) {
+    for (std::size_t i = 0; i < sigma.size() && i < tau.size(); ++i)
+        if (!(sigma[i] >= 0) || !(tau[i] >= 0))
+            throw std::invalid_argument("measured point " + std::to_string(i + 1) + " (" +
+                                        analytics::number_text(sigma[i]) + ":" + analytics::number_text(tau[i]) +
+                                        "): stresses must be >= 0 Pa");
     const auto line = analytics::fit_failure_line(sigma, tau, confidence);
     std::vector<MacroTarget> targets;
     for (const auto& q : macro_quantities()) targets.push_back({q, macro_value(line, q), macro_half_width(line, q)});

@@ -1,5 +1,8 @@
 #include "orchestrator/campaign_store.hpp"
 
+#include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
+
 #include <sqlite3.h>
 
 #include <chrono>
@@ -26,7 +29,7 @@ RunState run_state_from_string(const std::string& s) {
     if (s == "running") return RunState::running;
     if (s == "done") return RunState::done;
     if (s == "failed") return RunState::failed;
-    throw std::runtime_error("store: unknown run state '" + s + "'");
+    throw std::invalid_argument("store: unknown run state '" + analytics::shortened_text(s) + "' (a damaged store)");
 }
 
 namespace {
@@ -57,6 +60,8 @@ public:
         const int rc = sqlite3_step(st_);
         if (rc == SQLITE_ROW) return true;
         if (rc == SQLITE_DONE) return false;
+        if (rc == SQLITE_CORRUPT || rc == SQLITE_NOTADB)  // the file's fault, not the machine's: bad input
+            throw std::invalid_argument(std::string("store: damaged: ") + sqlite3_errmsg(db_));
         throw std::runtime_error(std::string("store: ") + sqlite3_errmsg(db_));
     }
     std::string text(int c) const {
@@ -94,41 +99,135 @@ void in_transaction(sqlite3* db, F&& f) {
     }
 }
 
-const char* kRunColumns =
-    "r.hash, r.params, r.state, r.attempts, r.result, r.cause, r.message, r.exit_code, r.wall_s, r.cpu_s, r.run_dir, "
-    "r.pgid, r.owner_pid";
+#define DEMCAL_RUN_COLUMNS                                                                                          \
+    "r.hash, r.params, r.state, r.attempts, r.result, r.cause, r.message, r.exit_code, r.wall_s, r.cpu_s, r.run_dir, " \
+    "r.pgid, r.owner_pid"
+const char* kRunColumns = DEMCAL_RUN_COLUMNS;
+const char* kRunColumnsQuery = "SELECT " DEMCAL_RUN_COLUMNS " FROM runs r";
 
-RunRecord read_run(const Statement& st, bool with_label) {
+// A JSON column as the store holds it, read under the same rules as every JSON input (a damaged store is bad input).
+nlohmann::json stored_json(const Statement& st, int column, const char* name) {
+    return analytics::parse_json_text(st.text(column), std::string("campaign store column ") + name);
+}
+
+// Run folders are stored relative to the store's directory, so a campaign moved or copied (cluster to laptop) finds
+// its own runs. Rows of older stores hold absolute paths; every demcal run folder is CAMPAIGN/runs/<name>, so such a
+// row is read as that layout under the store's directory, never as a folder of the campaign it was copied from.
+std::filesystem::path resolved_run_dir(const std::filesystem::path& stored, const std::filesystem::path& base_dir) {
+    if (stored.is_relative()) return base_dir / stored;
+    if (stored.parent_path().filename() == "runs") return base_dir / "runs" / stored.filename();
+    return stored;
+}
+
+std::string stored_run_dir(const std::filesystem::path& run_dir, const std::filesystem::path& base_dir) {
+    const auto relative = std::filesystem::absolute(run_dir).lexically_normal().lexically_relative(base_dir);
+    const bool inside = !relative.empty() && *relative.begin() != "..";
+    return inside ? relative.string() : run_dir.string();
+}
+
+RunRecord read_run(const Statement& st, bool with_label, const std::filesystem::path& base_dir) {
     RunRecord r;
     r.hash = st.text(0);
-    r.params = nlohmann::json::parse(st.text(1));
+    r.params = stored_json(st, 1, "runs.params");
     r.state = run_state_from_string(st.text(2));
     r.attempts = static_cast<int>(st.integer(3));
-    if (!st.is_null(4)) r.result = nlohmann::json::parse(st.text(4));
+    if (!st.is_null(4)) r.result = stored_json(st, 4, "runs.result");
     r.cause = st.text(5);
     r.message = st.text(6);
     r.exit_code = static_cast<int>(st.integer(7));
     r.wall_s = st.real(8);
     r.cpu_s = st.real(9);
-    r.run_dir = st.text(10);
+    r.run_dir = resolved_run_dir(st.text(10), base_dir);
     r.pgid = static_cast<long>(st.integer(11));
     r.owner_pid = static_cast<long>(st.integer(12));
-    if (with_label) r.label = nlohmann::json::parse(st.text(13));
+    if (with_label) r.label = stored_json(st, 13, "campaign_runs.label");
     return r;
 }
 
 }  // namespace
 
-CampaignStore::CampaignStore(const std::filesystem::path& db_path) : path_(db_path) {
-    if (sqlite3_open_v2(db_path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
+namespace {
+
+constexpr int kDemcalApplicationId = 0x64656d63;  // "demc" in the SQLite header: marks a file as a demcal store
+
+// Refuses, reading only, a file that is not an intact demcal store: nothing may be written into a file that is not
+// ours (status and resume wrote demcal's tables into any SQLite file), and a damaged store must not be resumed as if
+// it were whole.
+void check_existing_store(sqlite3* db, const std::string& name) {
+    const std::string store = "campaign store '" + name + "'";
+    std::int64_t application_id = 0;
+    bool has_demcal_tables = false;
+    try {
+        Statement id(db, "PRAGMA application_id");
+        if (id.step()) application_id = id.integer(0);
+        Statement tables(db,
+                         "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name IN "
+                         "('meta', 'campaigns', 'runs', 'campaign_runs', 'attempts')");
+        has_demcal_tables = tables.step() && tables.integer(0) == 5;
+    } catch (const std::exception& e) {  // not a database at all, or its first page is damaged
+        throw std::invalid_argument(store + " is not a readable SQLite database (" + e.what() +
+                                    "); nothing was written to it");
+    }
+    // stores written before demcal set application_id (0) are recognised by their tables
+    if (application_id != kDemcalApplicationId && !(application_id == 0 && has_demcal_tables))
+        throw std::invalid_argument(store + " is a SQLite database but not a demcal campaign store (application_id " +
+                                    std::to_string(application_id) + ", " + (has_demcal_tables ? "" : "no ") +
+                                    "demcal tables); nothing was written to it");
+    // every column demcal reads is there (quick_check passes a schema whose text was damaged)
+    for (const char* columns : {"SELECT key, value FROM meta", "SELECT id, name, kind, spec, status, created_at FROM campaigns",
+                                kRunColumnsQuery, "SELECT campaign_id, hash, label, position FROM campaign_runs",
+                                "SELECT id, hash, attempt, executor, started_at, finished_at, exit_code, cause, message, "
+                                "wall_s, cpu_s FROM attempts"}) {
+        try {
+            Statement(db, std::string(columns) + " LIMIT 0");
+        } catch (const std::exception& e) {
+            throw std::invalid_argument(store + " does not have the tables of a demcal store (" + e.what() +
+                                        "); nothing was written to it");
+        }
+    }
+    std::string verdict;
+    try {
+        Statement check(db, "PRAGMA quick_check(1)");
+        verdict = check.step() ? check.text(0) : "no answer";
+    } catch (const std::exception& e) {
+        verdict = e.what();
+    }
+    if (verdict != "ok")
+        throw std::invalid_argument(store + " is damaged (SQLite quick_check: " + analytics::shortened_text(verdict, 200) +
+                                    "); restore it from a copy, or move it away to start the campaign afresh");
+}
+
+}  // namespace
+
+CampaignStore::CampaignStore(const std::filesystem::path& db_path)
+    : path_(db_path), base_dir_(std::filesystem::absolute(db_path).lexically_normal().parent_path()) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(db_path, ec);
+    const bool existed = std::filesystem::exists(status);
+    if (existed && !std::filesystem::is_regular_file(status))
+        throw std::invalid_argument("campaign store '" + db_path.string() + "' is not a regular file");
+    if (existed && std::filesystem::file_size(db_path, ec) == 0)
+        throw std::invalid_argument("campaign store '" + db_path.string() +
+                                    "' is empty (0 bytes), not a demcal campaign store; nothing was written to it");
+    const int flags = SQLITE_OPEN_READWRITE | (existed ? 0 : SQLITE_OPEN_CREATE);
+    if (sqlite3_open_v2(db_path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
         std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
         sqlite3_close(db_);
         throw std::runtime_error("store: cannot open " + db_path.string() + ": " + m);
     }
     sqlite3_busy_timeout(db_, 10000);
+    if (existed) {
+        try {
+            check_existing_store(db_, db_path.string());
+        } catch (...) {
+            sqlite3_close(db_);
+            throw;
+        }
+    }
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=FULL");
     exec("PRAGMA foreign_keys=ON");
+    exec("PRAGMA application_id=" + std::to_string(kDemcalApplicationId));
     exec(R"sql(
 CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);
 INSERT OR IGNORE INTO meta VALUES('schema_version', '1');
@@ -181,7 +280,7 @@ CampaignRecord read_campaign(const Statement& st) {
     c.id = st.integer(0);
     c.name = st.text(1);
     c.kind = st.text(2);
-    c.spec = nlohmann::json::parse(st.text(3));
+    c.spec = stored_json(st, 3, "campaigns.spec");
     c.status = st.text(4);
     c.created_at = st.real(5);
     return c;
@@ -215,7 +314,7 @@ RunRecord CampaignStore::ensure_run(std::int64_t campaign_id, const std::string&
         Statement ins(db_,
                       "INSERT OR IGNORE INTO runs(hash, params, state, run_dir, created_at, updated_at) "
                       "VALUES(?,?,'pending',?,?,?)");
-        ins.bind(1, hash).bind(2, params.dump()).bind(3, run_dir.string()).bind(4, t).bind(5, t).step();
+        ins.bind(1, hash).bind(2, params.dump()).bind(3, stored_run_dir(run_dir, base_dir_)).bind(4, t).bind(5, t).step();
         if (sqlite3_changes(db_) > 0) {
             for (const auto& [k, v] : params.items())
                 if (v.is_number())
@@ -233,7 +332,7 @@ RunRecord CampaignStore::ensure_run(std::int64_t campaign_id, const std::string&
 std::optional<RunRecord> CampaignStore::run(const std::string& hash) {
     Statement st(db_, std::string("SELECT ") + kRunColumns + " FROM runs r WHERE r.hash = ?");
     st.bind(1, hash);
-    if (st.step()) return read_run(st, false);
+    if (st.step()) return read_run(st, false, base_dir_);
     return std::nullopt;
 }
 
@@ -243,7 +342,7 @@ std::vector<RunRecord> CampaignStore::campaign_runs(std::int64_t campaign_id) {
                           "ORDER BY c.position");
     st.bind(1, campaign_id);
     std::vector<RunRecord> out;
-    while (st.step()) out.push_back(read_run(st, true));
+    while (st.step()) out.push_back(read_run(st, true, base_dir_));
     return out;
 }
 
@@ -251,7 +350,7 @@ std::vector<RunRecord> CampaignStore::runs_in_state(RunState s) {
     Statement st(db_, std::string("SELECT ") + kRunColumns + " FROM runs r WHERE r.state = ?");
     st.bind(1, to_string(s));
     std::vector<RunRecord> out;
-    while (st.step()) out.push_back(read_run(st, false));
+    while (st.step()) out.push_back(read_run(st, false, base_dir_));
     return out;
 }
 

@@ -28,7 +28,7 @@ struct RunRecord {
     std::string cause, message;      // of the last failure
     int exit_code = 0;
     double wall_s = 0, cpu_s = 0;    // of the successful (or last) attempt
-    std::filesystem::path run_dir;
+    std::filesystem::path run_dir;   // absolute; stored relative to the campaign directory
     long pgid = 0, owner_pid = 0;    // while running: the process group and the orchestrator that owns it
     nlohmann::json label;            // campaign-specific tags (normal stress, replicate), from campaign_runs
 };
@@ -42,6 +42,9 @@ struct CampaignRecord {
 
 class CampaignStore {
 public:
+    // Opens the store, creating it when the file does not exist. An existing file must be an intact demcal store
+    // (application_id, or the tables of a store written before it was set; PRAGMA quick_check): anything else is
+    // refused with std::invalid_argument naming the file, before anything is written to it.
     explicit CampaignStore(const std::filesystem::path& db_path);
     ~CampaignStore();
     CampaignStore(const CampaignStore&) = delete;
@@ -80,6 +83,7 @@ private:
     void exec(const std::string& sql);
     sqlite3* db_ = nullptr;
     std::filesystem::path path_;
+    std::filesystem::path base_dir_;  // the campaign directory: run folders are stored relative to it
 };
 
 double now_seconds();  // wall clock, seconds since the epoch

@@ -1,5 +1,8 @@
 #include "orchestrator/shear_campaign.hpp"
 
+#include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
+
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_params.hpp"
 #include "orchestrator/slurm_executor.hpp"
@@ -42,16 +45,32 @@ fs::path default_shear_template() {
     return fs::path(DEMCAL_YADE_SCRIPTS_DIR) / "shear_box.py";
 }
 
+namespace {
+// A program a process can start: a regular file (after symlinks) with execute permission. access(X_OK) alone also
+// accepts a folder, which then failed every run as if the simulation had.
+bool is_executable_file(const fs::path& p) {
+    std::error_code ec;
+    return fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0;
+}
+}  // namespace
+
 fs::path find_yade(const std::string& yade) {
+    if (yade.empty()) throw std::invalid_argument("yade = '': empty; give the YADE launcher's name or path");
     if (yade.find('/') != std::string::npos) {
-        if (::access(yade.c_str(), X_OK) == 0) return yade;
+        if (is_executable_file(yade)) return yade;
+        std::error_code ec;
+        const std::string why = !fs::exists(yade, ec)        ? "does not exist"
+                                : fs::is_directory(yade, ec) ? "is a folder, not a program"
+                                : !fs::is_regular_file(yade, ec) ? "is not a regular file"
+                                                                 : "is not executable";
+        throw std::invalid_argument("yade = '" + yade + "' " + why + " (pass --yade with the YADE launcher)");
     } else if (const char* path = std::getenv("PATH")) {
         std::string p = path;
         for (std::size_t a = 0; a <= p.size();) {
             std::size_t b = p.find(':', a);
             if (b == std::string::npos) b = p.size();
             const fs::path cand = fs::path(p.substr(a, b - a)) / yade;
-            if (::access(cand.c_str(), X_OK) == 0) return cand;
+            if (is_executable_file(cand)) return cand;
             a = b + 1;
         }
     }
@@ -110,10 +129,25 @@ void write_run_directory(const PlannedRun& r, const std::string& template_text, 
     if (!fs::exists(params) || read_text_file(params) != p) write_text_file_atomically(params, p);
 }
 
+// The executors append to DIR/stdout.log and DIR/stderr.log and read the failure cause from stderr.log: an earlier
+// attempt's "DEMCAL_FAILURE" line would be taken for this attempt's (a retry that succeeded was recorded with the
+// failure before it). Each attempt's logs are kept under their own names instead.
+void keep_previous_attempt_logs(const fs::path& run_dir, int attempts_so_far) {
+    for (const char* log : {"stdout", "stderr"}) {
+        const fs::path current = run_dir / (std::string(log) + ".log");
+        std::error_code ec;
+        if (fs::exists(current, ec))
+            fs::rename(current, run_dir / (std::string(log) + ".attempt" + std::to_string(attempts_so_far) + ".log"));
+    }
+}
+
+// The executor's cause when the simulator's process could not be started (local_executor.cpp: execvp failed).
+constexpr const char* kSimulatorNotStarted = "exec";
+
 // Physical failures and bad parameters are deterministic: a retry would fail the same way.
 bool retry_is_pointless(const std::string& cause) {
     static const std::set<std::string> final_causes = {"nan", "kinetic_energy", "escaped", "normal_stress", "params",
-                                                       "exec", "no_result"};
+                                                       "no_result"};
     return final_causes.count(cause) > 0;
 }
 
@@ -125,6 +159,13 @@ std::unique_ptr<Executor> make_executor(const ExecutionOptions& o, const fs::pat
 }
 
 }  // namespace
+
+void check_run_count(double runs, long max_runs, const std::string& breakdown) {
+    if (runs > static_cast<double>(max_runs))
+        throw std::invalid_argument(breakdown + " = " + analytics::number_text(runs, 10) + " simulations, more than " +
+                                    "the limit --max-runs = " + std::to_string(max_runs) +
+                                    " (raise it with --max-runs if that many are meant)");
+}
 
 void validate_shear_spec(const ShearCampaignSpec& spec) {
     if (spec.normal_stresses.empty()) throw std::invalid_argument("normal_stress: at least one normal stress is needed");
@@ -148,7 +189,7 @@ std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
     const fs::path file = run_dir / "result.json";
     if (!fs::exists(file)) return std::nullopt;
     try {
-        auto result = nlohmann::json::parse(read_text_file(file));
+        auto result = analytics::read_json_input(file, "result");
         if (result.contains("peak_shear_stress") && result["peak_shear_stress"].is_number()) return result;
     } catch (const std::exception&) {
     }
@@ -272,7 +313,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         nlohmann::json result;
         if (o.succeeded()) {
             try {
-                result = nlohmann::json::parse(read_text_file(job.dir / "result.json"));
+                result = analytics::read_json_input(job.dir / "result.json", "result");
                 if (!result.contains("peak_shear_stress") || !result["peak_shear_stress"].is_number())
                     throw std::runtime_error("no number 'peak_shear_stress'");
             } catch (const std::exception& e) {
@@ -290,6 +331,15 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
             report("done", job.id);
             return;
         }
+        if (cause == kSimulatorNotStarted) {
+            // the machine's fault, not the run's: the run stays pending for a resume with a working simulator, and
+            // no further run is started (each would fail the same way)
+            store_->mark_attempt_failed(job.id, cause, message, o.exit_code, o.wall_s, o.cpu_s, false);
+            ++prog.pending;
+            if (out.infrastructure_failure.empty()) out.infrastructure_failure = message;
+            report("not started", job.id);
+            return;
+        }
         const int attempts = store_->run(job.id)->attempts;
         const bool final = retry_is_pointless(cause) || attempts > options_.retries;
         store_->mark_attempt_failed(job.id, cause, message, o.exit_code, o.wall_s, o.cpu_s, final);
@@ -303,11 +353,12 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         }
     };
     JobSource next = [&]() -> std::optional<Job> {
-        if (queue.empty()) return std::nullopt;
+        if (queue.empty() || !out.infrastructure_failure.empty()) return std::nullopt;
         const std::string h = queue.front();
         queue.pop_front();
         const PlannedRun& r = *by_hash.at(h);
         fs::remove(r.dir / "result.json");  // a result must come from this attempt
+        keep_previous_attempt_logs(r.dir, store_->run(h)->attempts);
         return Job{h, r.dir,
                    {find_yade(options_.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py", "params.json",
                     "result.json"},
@@ -329,6 +380,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     const bool all_done = std::all_of(out.runs.begin(), out.runs.end(),
                                       [](const RunRecord& r) { return r.state == RunState::done; });
     store_->set_campaign_status(out.campaign.id, all_done ? "complete" : out.interrupted ? "interrupted"
+                                                         : !out.infrastructure_failure.empty() ? "open"
                                                          : out.failed ? "failed" : "open");
     out.campaign = *store_->find_campaign(out.campaign.name);
     return out;

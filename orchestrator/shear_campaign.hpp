@@ -38,7 +38,12 @@ struct ExecutionOptions {
     std::string executor = "local";  // "local" or "slurm"
     std::string yade = "yade";    // the YADE launcher (path or name on PATH)
     std::string slurm_partition;  // SLURM only; empty = the default partition
+    long max_runs = 10000;        // most simulations one command may plan (a typo in --levels started millions)
 };
+
+// Refuses a plan of more than `max_runs` simulations before anything is planned or written; `breakdown` says how
+// the count came about ("3 normal stresses x 1000 replicates"). Counts as double: the product may overflow an int.
+void check_run_count(double runs, long max_runs, const std::string& breakdown);
 
 struct CampaignProgress {
     int total = 0, done = 0, failed = 0, running = 0, pending = 0, reused = 0;
@@ -57,7 +62,10 @@ struct ShearCampaignOutcome {
     int failed = 0;
     double cpu_s = 0;             // CPU seconds of all the campaign's successful runs (also the reused ones)
     bool interrupted = false;
-    bool complete() const { return !interrupted && failed == 0; }
+    // Why the simulator could not be started (empty when it could): an infrastructure failure, not a run's. The
+    // runs it hit stay pending, so a resume with a working simulator runs them.
+    std::string infrastructure_failure;
+    bool complete() const { return !interrupted && failed == 0 && infrastructure_failure.empty(); }
 };
 
 std::filesystem::path default_shear_template();

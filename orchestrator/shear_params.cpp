@@ -1,5 +1,8 @@
 #include "orchestrator/shear_params.hpp"
 
+#include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
+
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -10,7 +13,7 @@ namespace demcal::orchestrator {
 namespace {
 constexpr double inf = std::numeric_limits<double>::infinity();
 
-std::string format_value(const nlohmann::json& v) { return v.dump(); }
+std::string format_value(const nlohmann::json& v) { return analytics::json_value_text(v); }
 
 std::string range_text(const ParamSpec& s) {
     std::ostringstream o;
@@ -118,7 +121,7 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
             continue;
         }
         const ParamSpec* s = find_shear_param(key);
-        if (!s) throw std::invalid_argument(where + ": unknown field '" + key + "' = " + format_value(value));
+        if (!s) throw std::invalid_argument(where + ": unknown field '" + analytics::shortened_text(key) + "' = " + format_value(value));
         if (s->per_run)
             throw std::invalid_argument(where + ": field '" + key + "' = " + format_value(value) +
                                         " is set per run by the campaign (use --normal-stress / --seed)");

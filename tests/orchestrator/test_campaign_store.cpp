@@ -4,8 +4,12 @@
 
 #include <catch2/catch.hpp>
 
-#include <filesystem>
+#include <sqlite3.h>
 #include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 
 using namespace demcal::orchestrator;
 namespace fs = std::filesystem;
@@ -79,5 +83,82 @@ TEST_CASE("a run that wrote its result just before the orchestrator died is kept
     CHECK(finished->wall_s == 17.5);
     CHECK(s.run("unfinished")->state == RunState::pending);
     CHECK(s.run("garbled")->state == RunState::pending);  // a partial file is not a result
+    fs::remove_all(d);
+}
+
+namespace {
+std::string bytes_of(const fs::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+void sql(const fs::path& db_file, const std::string& statements) {
+    sqlite3* db = nullptr;
+    REQUIRE(sqlite3_open(db_file.c_str(), &db) == SQLITE_OK);
+    CHECK(sqlite3_exec(db, statements.c_str(), nullptr, nullptr, nullptr) == SQLITE_OK);
+    sqlite3_close(db);
+}
+}  // namespace
+
+TEST_CASE("a file that is not a demcal store is refused without a byte written to it", "[store]") {
+    const fs::path d = fresh_dir("foreign-store");
+    auto refused_untouched = [&](const fs::path& file, const std::string& expected) {
+        const std::string before = bytes_of(file);
+        CHECK_THROWS_AS(CampaignStore(file), std::invalid_argument);
+        CHECK_THROWS_WITH(CampaignStore(file), Catch::Contains(file.string()) && Catch::Contains(expected));
+        CHECK(bytes_of(file) == before);
+        CHECK_FALSE(fs::exists(file.string() + "-wal"));
+    };
+    std::ofstream(d / "empty.sqlite").close();
+    refused_untouched(d / "empty.sqlite", "is empty (0 bytes)");
+    std::ofstream(d / "text.sqlite") << "just some notes, not a database at all\n" << std::string(5000, 'x');
+    refused_untouched(d / "text.sqlite", "is not a readable SQLite database");
+    sql(d / "other.sqlite", "CREATE TABLE notes(t TEXT); INSERT INTO notes VALUES('mine');");
+    refused_untouched(d / "other.sqlite", "not a demcal campaign store");
+    sql(d / "app.sqlite", "PRAGMA application_id = 42; CREATE TABLE meta(key TEXT);");
+    refused_untouched(d / "app.sqlite", "application_id 42");
+    fs::remove_all(d);
+}
+
+TEST_CASE("a damaged store is refused before a resume, a store without application_id is still accepted", "[store]") {
+    const fs::path d = fresh_dir("damaged-store");
+    {
+        CampaignStore s(d / "c.sqlite");
+        const auto cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
+        for (int i = 0; i < 200; ++i)  // several pages of runs
+            s.ensure_run(cid, "h" + std::to_string(i), {{"normal_stress", 1e4 + i}, {"note", std::string(200, 'n')}},
+                         d / "runs" / ("h" + std::to_string(i)), {{"replicate", i}});
+    }
+    REQUIRE_FALSE(fs::exists(d / "c.sqlite-wal"));  // the last connection checkpointed it into the file
+    fs::copy_file(d / "c.sqlite", d / "legacy.sqlite");
+    sql(d / "legacy.sqlite", "PRAGMA application_id = 0;");  // as written before demcal set it
+    CHECK(CampaignStore(d / "legacy.sqlite").campaigns().size() == 1);
+
+    {  // overwrite the middle of the file: b-tree pages of the runs table
+        std::fstream f(d / "c.sqlite", std::ios::in | std::ios::out | std::ios::binary);
+        const auto size = fs::file_size(d / "c.sqlite");
+        f.seekp(static_cast<std::streamoff>(size / 2));
+        const std::string junk(3000, '\x7f');
+        f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
+    }
+    CHECK_THROWS_WITH(CampaignStore(d / "c.sqlite"), Catch::Contains("is damaged (SQLite quick_check"));
+    fs::remove_all(d);
+}
+
+TEST_CASE("run folders are stored relative to the campaign, so a copied campaign uses its own", "[store]") {
+    const fs::path d = fresh_dir("moved-store");
+    fs::create_directories(d / "a");
+    {
+        CampaignStore s(d / "a" / "campaign.sqlite");
+        const auto cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
+        s.ensure_run(cid, "h1", {{"normal_stress", 1e4}}, d / "a" / "runs" / "h1", {{"replicate", 0}});
+        s.ensure_run(cid, "h2", {{"normal_stress", 2e4}}, d / "a" / "runs" / "h2", {{"replicate", 0}});
+    }
+    // h2 as an older store recorded it: absolute, in the original campaign's folder
+    sql(d / "a" / "campaign.sqlite", "UPDATE runs SET run_dir = '" + (d / "a" / "runs" / "h2").string() +
+                                         "' WHERE hash = 'h2';");
+    fs::copy(d / "a", d / "b", fs::copy_options::recursive);
+    CampaignStore copy(d / "b" / "campaign.sqlite");
+    CHECK(copy.run("h1")->run_dir == d / "b" / "runs" / "h1");
+    CHECK(copy.run("h2")->run_dir == d / "b" / "runs" / "h2");
     fs::remove_all(d);
 }

@@ -29,8 +29,28 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"shear", tiny, "-s", "2e10"}, "'normal_stress' = 20000000000.0"},
         {{"shear", tiny, "-s", "5e3", "--seed", "2147483647", "-r", "2"}, "'seed' = 2147483648"},
         // NaN passed CLI11's own range checks
-        {{"shear", tiny, "-s", "5e3", "--timeout", "nan"}, "--timeout: nan is not a positive number"},
-        {{"sensitivity", tiny, "-s", "5e3,inf", "--params", "friction_coefficient"}, "normal_stress = inf"},
+        {{"shear", tiny, "-s", "5e3", "--timeout", "nan"}, "--timeout: 'nan' is not a number"},
+        {{"sensitivity", tiny, "-s", "5e3,inf", "--params", "friction_coefficient"}, "--normal-stress: 'inf' is not finite"},
+        // an empty value was read as 0, a subnormal called "not a number", a seed above 2^63 clamped to 2^63 - 1
+        {{"shear", tiny, "-s", "5e3", "--replicates", ""}, "--replicates: an empty value"},
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", ""}, "--levels: an empty value"},
+        {{"shear", tiny, "-s", "5e3", "--timeout", "1e-320"}, "--timeout: '1e-320' is subnormal"},
+        {{"shear", tiny, "-s", "5e3,1e-320"}, "--normal-stress: '1e-320' is subnormal"},
+        {{"shear", tiny, "-s", "5e3", "--seed", "9223372036854775808"},
+         "--seed: '9223372036854775808' is not an integer between 0 and 2147483647"},
+        // an output path that cannot be written was found only after the whole calibration
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "-o", "/"}, "output = '/' is a folder"},
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "-o", "/no/such/folder/m.json"},
+         "the folder /no/such/folder does not exist"},
+        // limits, named with the flag that lifts them (an absurd level count started millions of runs)
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", "2000000000"},
+         "levels x 2 normal stresses x 1 replicates = 3.2e+10 simulations, more than the limit --max-runs = 10000"},
+        {{"shear", tiny, "-s", "5e3,1e4", "-r", "6000"}, "shear: 2 normal stresses x 6000 replicates = 12000"},
+        {{"shear", tiny, "-s", "5e3,1e4", "-r", "6000", "--max-runs", "1e9"}, "--max-runs: '1e9' is not an integer"},
+        // a negative cohesion target or negative measured stresses were calibrated against
+        {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800 must be >= 0"},
+        {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
+         "measured point 1 (5000:-7000): stresses must be >= 0 Pa"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "friction_coefficient", "--alpha", "2"}, "alpha = 2"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "particle_form", "--range", "particle_form=1:3"},
          "sensitivity level particle_form = 1.5"},
@@ -101,5 +121,123 @@ TEST_CASE("demcal enlarge fits both laws and draws them, and refuses an output i
     CHECK(result["poisson_ratio"]["params"]["D"]["value"].get<double>() == Approx(0.5).epsilon(1e-6));
     CHECK(fs::file_size(dir / "e.png") > 1000);
     CHECK(fs::exists(dir / "e.dat"));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("every JSON input goes through one reader: deep nesting, duplicates and subnormals end in exit 2",
+          "[cli][input]") {
+    const fs::path dir = test::fresh_test_dir("cli-json-input");
+    const fs::path campaign = dir / "never";
+    const std::string deep = "{\"density\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+    struct Case {
+        std::string text;
+        std::string expect;
+    };
+    const std::vector<Case> cases{
+        {deep, "nests deeper than 64 levels"},  // was a segmentation fault
+        {R"({"density": 2600, "density": 1})", "field 'density' appears twice"},
+        {R"({"timestep_fraction": 1e-320})", "field 'timestep_fraction' = 1e-320 is subnormal"},
+    };
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    for (const auto& c : cases) {
+        std::ofstream(dir / "bad.json") << c.text;
+        for (const std::vector<std::string>& args :
+             {std::vector<std::string>{"shear", (dir / "bad.json").string(), "-s", "5e3"},
+              std::vector<std::string>{"sensitivity", (dir / "bad.json").string(), "-s", "5e3,1e4"},
+              std::vector<std::string>{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--sensitivity",
+                                       (dir / "bad.json").string()},
+              std::vector<std::string>{"predict", (dir / "bad.json").string()}}) {
+            auto full = args;
+            full.insert(full.end(), {"--campaign", campaign.string()});
+            if (args[0] == "predict") full.resize(2);
+            INFO(args[0] + ": " + c.expect);
+            const int rc = test::run_demcal(full, dir / "out.log");
+            const std::string log = test::read_file(dir / "out.log");
+            INFO(log.substr(0, 500));
+            CHECK(rc == 2);
+            CHECK_THAT(log, Contains(c.expect));
+            CHECK(log.size() < 1000);
+            CHECK_FALSE(fs::exists(campaign));
+        }
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("status and resume refuse a file that is not a demcal store without writing to it", "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("cli-foreign-store");
+    std::ofstream(dir / "campaign.sqlite").close();  // zero bytes: status said "nothing to do" and wrote tables
+    for (const std::string command : {"status", "resume"}) {
+        INFO(command);
+        CHECK(test::run_demcal({command, dir.string()}, dir / "out.log") == 2);
+        const std::string log = test::read_file(dir / "out.log");
+        CHECK_THAT(log, Contains((dir / "campaign.sqlite").string()) && Contains("is empty (0 bytes)"));
+        CHECK(fs::file_size(dir / "campaign.sqlite") == 0);
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a YADE path that is a folder, empty or not executable is refused before anything is written", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-bad-yade");
+    const fs::path campaign = dir / "never";
+    std::ofstream(dir / "not-executable") << "#!/bin/sh\n";
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::vector<std::pair<std::string, std::string>> cases{
+        {dir.string(), "is a folder, not a program"}, {"", "yade = '': empty"},
+        {(dir / "not-executable").string(), "is not executable"}, {(dir / "none").string(), "does not exist"}};
+    for (const auto& [yade, expect] : cases) {
+        INFO(yade);
+        CHECK(test::run_demcal({"shear", tiny, "-s", "5e3", "--yade", yade, "--campaign", campaign.string()},
+                               dir / "out.log") == 2);
+        CHECK_THAT(test::read_file(dir / "out.log"), Contains(expect));
+        CHECK_FALSE(fs::exists(campaign));
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume with a working one runs them",
+          "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("cli-yade-not-started");
+    const fs::path campaign = dir / "campaign";
+    // executable, but its interpreter does not exist: execvp fails, as for a launcher of a broken installation
+    std::ofstream(dir / "broken-yade") << "#!/nonexistent/interpreter\n";
+    // a stand-in simulator: writes the result file named by its last argument
+    std::ofstream(dir / "stand-in-yade") << "#!/bin/sh\nfor last; do :; done\n"
+                                            "echo '{\"peak_shear_stress\": 1000, \"residual_shear_stress\": 800}' > "
+                                            "\"$last\"\n";
+    fs::permissions(dir / "broken-yade", fs::perms::owner_all);
+    fs::permissions(dir / "stand-in-yade", fs::perms::owner_all);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4", "--yade", (dir / "broken-yade").string(),
+                                     "--campaign", campaign.string(), "--retries", "0"},
+                                    dir / "out.log");
+    INFO(test::read_file(dir / "out.log"));
+    CHECK(rc == 75);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("could not be started"));
+    for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::pending);
+    CHECK(test::run_demcal({"resume", campaign.string(), "--yade", (dir / "stand-in-yade").string()},
+                           dir / "resume.log") == 0);
+    INFO(test::read_file(dir / "resume.log"));
+    for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::done);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal enlarge says when the power law did not converge and writes nothing unless asked", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-enlarge-unconverged");
+    auto material = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand.json")));
+    std::vector<std::string> args{"enlarge", "--no-plot", "-o", (dir / "e.json").string()};
+    for (double r : {0.0025, 0.003, 0.0035}) {  // nu the same at every radius: the fit reported D = -0 with exit 0
+        material["particle_radius"] = r;
+        material["young_modulus"] = 1e10 * r + 5e6;
+        material["poisson_ratio"] = 0.2;
+        args.push_back((dir / ("r" + std::to_string(args.size()) + ".json")).string());
+        std::ofstream(args.back()) << material.dump();
+    }
+    CHECK(test::run_demcal(args, dir / "out.log") == 1);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("did not converge") && Contains("not identifiable"));
+    CHECK_FALSE(fs::exists(dir / "e.json"));
+    args.push_back("--allow-unconverged");
+    CHECK(test::run_demcal(args, dir / "out.log") == 0);
+    CHECK_THAT(test::read_file(dir / "out.log"), !Contains("-0 "));
+    CHECK(fs::exists(dir / "e.json"));
     fs::remove_all(dir);
 }
