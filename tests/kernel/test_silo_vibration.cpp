@@ -143,7 +143,9 @@ TEST_CASE("silo case: the vibration starts its set delay after the opening; a ze
 // a law (even one not started) rebuilds its neighbour list on the first step where the uninterrupted run does not,
 // and the sums then differ in the last bits (reproduced with the kernel alone: 5 plane walls on a law that never
 // starts, 300 falling spheres, 1 extra build, positions 1.7e-15 m apart 3000 steps later; still walls: 0 and 0).
-// The fix belongs in kernel/simulation_impl.hpp (store wall_disp_built_ with the state).
+// The fix belongs in kernel/simulation_impl.hpp: save_state writes wall_disp_built_ after the wall motion, load_state
+// reads it back (and the state format's version goes up). With those two lines, checked outside this branch, this
+// case resumes to the same steps, fill energy, rate and flow ratio to the bit.
 TEST_CASE("silo case: a vibrating run killed at checkpoints resumes to the uninterrupted result bit for bit",
           "[silo][vibration][checkpoint][!shouldfail]") {
     SiloCaseSettings s = tiny_vibrating_case();
