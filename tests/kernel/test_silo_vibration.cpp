@@ -107,7 +107,7 @@ std::vector<std::pair<double, double>> discharge_energies(SiloCaseSettings s) {
 }
 }  // namespace
 
-TEST_CASE("silo case: the vibration starts its set delay after the opening; a zero frequency is a still bin",
+TEST_CASE("silo case: the vibration starts its set delay after the opening, a zero frequency is a still bin",
           "[silo][vibration]") {
     SiloCaseSettings still = tiny_case();
     still.max_time = 0.05;
