@@ -57,6 +57,10 @@ struct SiloCli {
     double stiffness_scale = 1;
     double stop_fraction = 1;
     double skin = 0;
+    double vibration_frequency = 0;
+    double vibration_amplitude = 0;
+    std::string vibration_direction = "x";
+    double vibration_start = 0;
     bool no_plots = false;
     double checkpoint_every = 900;
     bool no_checkpoint = false;
@@ -249,6 +253,46 @@ void check_session_options(const SiloCli& o, CLI::App& sub) {
                         ": must be a number of seconds >= 0 (0: none)");
 }
 
+// --vibration-frequency and --vibration-amplitude go together; --vibration-direction and --vibration-start only with
+// them. The ranges are checked with the other settings (ks::validate).
+ks::BinVibration vibration_from(const SiloCli& o, CLI::App& sub) {
+    const bool frequency = sub.count("--vibration-frequency") > 0, amplitude = sub.count("--vibration-amplitude") > 0;
+    if (frequency != amplitude)
+        throw UserError(frequency ? "--vibration-frequency " + ks::setting_text(o.vibration_frequency) +
+                                        " needs --vibration-amplitude M (the bin's displacement amplitude)"
+                                  : "--vibration-amplitude " + ks::setting_text(o.vibration_amplitude) +
+                                        " needs --vibration-frequency HZ");
+    if (!frequency) {
+        for (const char* option : {"--vibration-direction", "--vibration-start"})
+            if (sub.count(option))
+                throw UserError(std::string(option) +
+                                " applies to a vibrating bin: add --vibration-frequency and --vibration-amplitude");
+        return {};
+    }
+    ks::BinVibration v;
+    v.frequency = o.vibration_frequency;
+    v.amplitude = o.vibration_amplitude;
+    v.start_after_opening = o.vibration_start;
+    if (o.vibration_direction == "x") v.direction = ks::VibrationDirection::x;
+    else if (o.vibration_direction == "z") v.direction = ks::VibrationDirection::z;
+    else
+        throw UserError("vibration-direction = '" + o.vibration_direction +
+                        "': must be x (perpendicular to the silo axis) or z (along it)");
+    return v;
+}
+
+// "100 Hz, 0.11 mm along x (perpendicular to the axis), ...: peak acceleration 4.4 g"; empty when still.
+std::string vibration_text(const ks::SiloCaseSettings& s) {
+    const ks::BinVibration& v = s.vibration;
+    if (!v.vibrates()) return {};
+    return ks::setting_text(v.frequency) + " Hz, " + ks::setting_text(v.amplitude * 1e3) + " mm along " +
+           ks::to_string(v.direction) +
+           (v.direction == ks::VibrationDirection::x ? " (perpendicular to the axis)" : " (along the axis)") +
+           ", the whole bin from " + ks::setting_text(v.start_after_opening) +
+           " s after the opening (still while filling): peak acceleration " +
+           ks::setting_text(v.peak_acceleration() / s.gravity) + " g";
+}
+
 ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     check_session_options(o, sub);
     ks::SiloCaseSettings s;
@@ -270,6 +314,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.materials.stiffness_scale = o.stiffness_scale;
     s.stop_fraction = o.stop_fraction;
     s.skin = o.skin;
+    s.vibration = vibration_from(o, sub);
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
     try {
@@ -290,6 +335,22 @@ nlohmann::json geometry_json(const ks::SiloGeometry& g) {
     j["body_height_m"] = g.body_height;
     j["hopper_height_m"] = g.hopper_height();
     return j;
+}
+
+// The settings as given (a still bin too: a sweep reads every run the same way) and the peak acceleration.
+nlohmann::json vibration_json(const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
+    const ks::BinVibration& v = s.vibration;
+    return {{"vibrates", v.vibrates()},
+            {"frequency_hz", v.frequency},
+            {"amplitude_m", v.amplitude},
+            {"direction", ks::to_string(v.direction)},
+            {"start_after_opening_s", v.start_after_opening},
+            {"start_time_s", r.fill_time + v.start_after_opening},
+            {"peak_acceleration_m_s2", v.peak_acceleration()},
+            {"peak_acceleration_g", v.peak_acceleration() / s.gravity},
+            {"note", "displacement A sin(2 pi f (t - start_time_s)) of every wall of the bin (hopper, body, outlet "
+                     "plate), still while filling; x: horizontal, perpendicular to the silo axis (the seed's "
+                     "vibrator), z: along the axis; peak acceleration A (2 pi f)^2, in g of the run's gravity"}};
 }
 
 // Beverloo (with the Rose-Tanaka hopper factor) for the measured bulk density: the sanity check of the rate.
@@ -413,6 +474,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     s.wall_limit = o.wall_limit;
     std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
               << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string();
+    if (s.vibration.vibrates()) std::cout << "\n  vibration: " << vibration_text(s);
     if (!s.checkpoint_file.empty())
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
                   << " (continue an interrupted run with `demcal silo --resume " << dir.string() << "`)";
@@ -457,8 +519,9 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     s.checkpoint_file = file.string();  // removed once the outputs are written
     s.wall_limit = o.wall_limit;
     std::cout << "demcal silo --resume: " << s.geometry.describe() << "\n  " << threads << " thread(s), seed "
-              << s.seed << ", stiffness scale " << s.materials.stiffness_scale << ", checkpoint " << file.string()
-              << std::endl;
+              << s.seed << ", stiffness scale " << s.materials.stiffness_scale << ", checkpoint " << file.string();
+    if (s.vibration.vibrates()) std::cout << "\n  vibration: " << vibration_text(s);
+    std::cout << std::endl;
     const StopOnSignal stop_on_signal;
     write_outputs(dir, s,
                   ks::resume_silo_case(file.string(), {threads, o.checkpoint_every, o.wall_limit, StopOnSignal::reason},
@@ -531,6 +594,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                          {"frames", r.flow.frames},
                          {"measure", r.flow.measure}};
     if (!r.flow.message.empty()) j["flow_pattern"]["message"] = r.flow.message;
+    j["vibration"] = vibration_json(s, r);
     if (r.bulk_density > 0) j["beverloo_check"] = beverloo_check(s, r);
     j["steps"] = r.steps;
     j["time_step_s"] = r.time_step;
@@ -594,6 +658,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                   << " s), R^2 = " << fixed(r.fit.r_squared, 5) << "\n";
     else
         std::cout << "rate: not determined (" << r.fit.message << ")\n";
+    if (s.vibration.vibrates()) std::cout << "vibration: " << vibration_text(s) << "\n";
     std::cout << "flow pattern: " << ks::to_string(r.flow.pattern) << " (wall/axis velocity ratio "
               << fixed(r.flow.ratio, 3) << ")\n";
     std::cout << r.steps << " steps of " << std::setprecision(3) << r.time_step << " s, wall time "
@@ -645,6 +710,19 @@ void add_silo_command(CLI::App& app) {
                     "stop once this fraction of the filled mass has left (1: until empty)")
         ->capture_default_str();
     sub->add_option("--skin", o->skin, "Verlet skin of the neighbour list [m] (0: 40 dt x 1 m/s within 0.2-1 mm)")
+        ->capture_default_str();
+    sub->add_option("--vibration-frequency", o->vibration_frequency,
+                    "the whole bin (hopper, body, outlet plate) vibrates at this frequency [Hz], 0-1000, from the "
+                    "opening (the seed's eccentric vibrator; needs --vibration-amplitude)");
+    sub->add_option("--vibration-amplitude", o->vibration_amplitude,
+                    "displacement amplitude A of the bin's vibration [m], 0-0.01 (the seed: up to 1.1e-4); "
+                    "d(t) = A sin(2 pi f t)");
+    sub->add_option("--vibration-direction", o->vibration_direction,
+                    "x: horizontal, perpendicular to the silo axis (as the seed's vibrator); z: along the axis")
+        ->capture_default_str();
+    sub->add_option("--vibration-start", o->vibration_start,
+                    "the vibration starts this many simulated seconds after the outlet opens; the bin is still "
+                    "while it fills")
         ->capture_default_str();
     sub->add_flag("--no-plots", o->no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o->checkpoint_every,

@@ -143,28 +143,30 @@ Simulation::PairParams to_kernel(const PairCoefficients& p) {
     return k;
 }
 
-// The silo's walls; returns the outlet plate's wall id. The body wall reaches up to `wall_top`.
-int add_silo_walls(Simulation& sim, const SiloGeometry& g, int steel, double wall_top) {
+// The silo's walls, all moving on `bin_motion` (null: still); returns the outlet plate's wall id. The body wall
+// reaches up to `wall_top`.
+int add_silo_walls(Simulation& sim, const SiloGeometry& g, int steel, double wall_top,
+                   const std::shared_ptr<const WallMotion>& bin_motion) {
+    const auto add = [&](const Wall& w) { return sim.add_wall(bin_motion ? w.moving(bin_motion) : w); };
     const double hh = g.hopper_height(), th = g.half_angle_deg * pi / 180;
     if (g.shape == SiloShape::conical) {
         const double r0 = g.outlet_half(), R = g.top_half();
-        sim.add_wall(Wall::cone(0, 0, r0, 0, th, R, steel));
-        sim.add_wall(Wall::cylinder(0, 0, R, hh, wall_top, steel));
-        return sim.add_wall(Wall::disk(0, 0, r0 * 1.001, 0, steel));
+        add(Wall::cone(0, 0, r0, 0, th, R, steel));
+        add(Wall::cylinder(0, 0, R, hh, wall_top, steel));
+        return add(Wall::disk(0, 0, r0 * 1.001, 0, steel));
     }
     const double a2 = 0.5 * g.outlet, b2 = 0.5 * g.depth, c2 = 0.5 * g.width;
     for (double s : {-1.0, 1.0}) {
         // slanted hopper wall from the outlet edge (x = s a/2, z = 0) to the body (x = s c/2, z = hh), full depth
-        sim.add_wall(Wall::rectangle_from_corners(Vec3(s * a2, -b2, 0), Vec3(s * a2, b2, 0), Vec3(s * c2, -b2, hh),
-                                                  steel));
+        add(Wall::rectangle_from_corners(Vec3(s * a2, -b2, 0), Vec3(s * a2, b2, 0), Vec3(s * c2, -b2, hh), steel));
         // vertical body wall x = s c/2
-        sim.add_wall(Wall::rectangle_from_corners(Vec3(s * c2, -b2, hh), Vec3(s * c2, b2, hh),
-                                                  Vec3(s * c2, -b2, wall_top), steel));
+        add(Wall::rectangle_from_corners(Vec3(s * c2, -b2, hh), Vec3(s * c2, b2, hh), Vec3(s * c2, -b2, wall_top),
+                                         steel));
         // front/back wall y = s b/2 over the whole height (the part outside the hopper is never reached)
-        sim.add_wall(Wall::rectangle_from_corners(Vec3(-c2, s * b2, 0), Vec3(c2, s * b2, 0), Vec3(-c2, s * b2, wall_top),
-                                                  steel));
+        add(Wall::rectangle_from_corners(Vec3(-c2, s * b2, 0), Vec3(c2, s * b2, 0), Vec3(-c2, s * b2, wall_top),
+                                         steel));
     }
-    return sim.add_wall(Wall::rectangle(Vec3(0, 0, 0), Vec3::UnitZ(), Vec3::UnitX(), a2 * 1.001, b2, steel));
+    return add(Wall::rectangle(Vec3(0, 0, 0), Vec3::UnitZ(), Vec3::UnitX(), a2 * 1.001, b2, steel));
 }
 
 }  // namespace
@@ -191,6 +193,29 @@ void validate(const SiloCaseSettings& s) {
                            " s at this stiffness); use a fraction of it, or --dt-fraction");
     if (!(s.time_step_fraction > 0 && s.time_step_fraction <= 1))
         reject_setting("dt_fraction", s.time_step_fraction, "must lie in (0, 1] (of the Rayleigh time step)");
+    validate(s.vibration);
+    if (s.vibration.vibrates()) {
+        // a period resolved by fewer steps would alias: the walls jump rather than oscillate
+        constexpr double kStepsPerPeriod = 20;
+        const double dt = s.time_step > 0 ? s.time_step
+                                          : s.time_step_fraction *
+                                                rayleigh_time_step(s.materials.wheat_scaled(), smallest_radius);
+        if (s.vibration.frequency * dt * kStepsPerPeriod > 1)
+            reject_setting("vibration_frequency", s.vibration.frequency,
+                           "a period is only " + setting_text(1 / (s.vibration.frequency * dt)) + " time steps of " +
+                               setting_text(dt) + " s; at most " + setting_text(1 / (kStepsPerPeriod * dt)) +
+                               " Hz at this time step (20 steps per period), or a smaller --dt-fraction");
+        if (s.vibration.start_after_opening >= s.max_time)
+            reject_setting("vibration_start", s.vibration.start_after_opening,
+                           "not before the discharge's time limit (max_time = " + setting_text(s.max_time) +
+                               " s after the opening): the bin would never vibrate");
+        // grains count as discharged below a fixed plane: the vibrating outlet must stay above it
+        if (s.vibration.direction == VibrationDirection::z && s.vibration.amplitude >= 0.5 * s.removal_depth)
+            reject_setting("vibration_amplitude", s.vibration.amplitude,
+                           "along z the outlet would come within half the removal depth (" +
+                               setting_text(s.removal_depth) + " m) of the plane below which grains count as "
+                               "discharged: at most " + setting_text(0.5 * s.removal_depth) + " m along z");
+    }
     if (!(s.fill_time_max > 0) || !std::isfinite(s.fill_time_max)) reject_setting("fill_time", s.fill_time_max, "must be > 0 s");
     if (!(s.max_time > 0) || !std::isfinite(s.max_time)) reject_setting("max_time", s.max_time, "must be > 0 s");
     if (!(s.stop_fraction > 0 && s.stop_fraction <= 1))
@@ -211,11 +236,11 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
-// Version 3: each section (tag and settings; the case's state; the kernel's state) closed by a checksum, the kernel's
-// state in its format 3 (contact histories of any size, moving walls). Versions 1 and 2 (no checksums, the kernel's
-// format 2) are refused with a message that says so.
+// Version 4: each section (tag and settings; the case's state; the kernel's state) closed by a checksum, the kernel's
+// state in its format 3 (contact histories of any size, moving walls); the settings include the bin's vibration
+// (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 3;
+constexpr int kCheckpointVersion = 4;
 
 // Every setting that shapes the run, named once: the checkpoint stores the settings through this list.
 template <class S, class F>
@@ -263,6 +288,10 @@ void for_each_setting(S& s, F&& f) {
     f("min_axis_speed", s.flow.min_axis_speed);
     f("mass_threshold", s.flow.mass_threshold);
     f("funnel_threshold", s.flow.funnel_threshold);
+    f("vibration_frequency", s.vibration.frequency);
+    f("vibration_amplitude", s.vibration.amplitude);
+    f("vibration_direction", s.vibration.direction);
+    f("vibration_start", s.vibration.start_after_opening);
     f("skin", s.skin);
     f("seed", s.seed);
     f("vtk_dir", s.vtk_dir);
@@ -302,6 +331,7 @@ public:
         sim_.set_pair(wheat_, wheat_, to_kernel(s_.materials.wheat_wheat));
         sim_.set_pair(wheat_, steel_, to_kernel(s_.materials.wheat_steel));
         grain_ = sim_.add_clump_template(tmpl_);
+        if (s_.vibration.vibrates()) bin_motion_ = std::make_shared<BinVibrationMotion>(s_.vibration);
         r_.grain_mass = tmpl_.mass;
         r_.cpu_sessions = 1;  // a resumed run reads the count from its checkpoint
     }
@@ -312,7 +342,7 @@ public:
         Generator gen(s_.geometry, tmpl_, s_.seed);
         const auto placed = gen.generate(n, 0.003, 30.0);
         wall_top_ = std::max(s_.geometry.top(), gen.top() + 0.01);
-        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_);
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_);
         for (const auto& p : placed) sim_.add_clump(grain_, wheat_, p.com, p.q);
         r_.grains = long(placed.size());
         const double dt = s_.time_step > 0 ? s_.time_step : s_.time_step_fraction * sim_.rayleigh_timestep();
@@ -399,7 +429,8 @@ public:
         r.value(r_.cpu_sessions, "cpu sessions");
         r.array(r_.discharge, "discharge record");
         if (phase_ != Phase::filling && phase_ != Phase::discharge) r.fail("phase", "unknown value");
-        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_);
+        if (bin_motion_ && phase_ == Phase::discharge) bin_motion_->open_at(t_open_);  // the law the run was on
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_);
         if (phase_ == Phase::discharge) {
             make_discharge_recorders();
             classifier_->load(r);
@@ -571,6 +602,7 @@ private:
     void open() {
         sim_.set_wall_enabled(plate_, false);
         t_open_ = sim_.time();
+        if (bin_motion_) bin_motion_->open_at(t_open_);
         make_discharge_recorders();
         next_frame_ = sim_.steps_done();
         r_.discharge.push_back({0.0, 0.0, 0});
@@ -678,6 +710,7 @@ private:
     ClumpTemplate tmpl_;
     Simulation sim_;
     int wheat_ = 0, steel_ = 0, grain_ = 0, plate_ = -1;
+    std::shared_ptr<BinVibrationMotion> bin_motion_;  // every wall's law; null: the bin is still
     SiloCaseResult r_;
     SiloProgress pr_;
     std::unique_ptr<FlowPatternClassifier> classifier_;
@@ -716,7 +749,7 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string current = prefix + std::to_string(kCheckpointVersion);
     if (tag == current) {
         version = kCheckpointVersion;
-    } else if (tag == prefix + "1" || tag == prefix + "2") {
+    } else if (tag == prefix + "1" || tag == prefix + "2" || tag == prefix + "3") {
         r.fail("format tag", "written by an older demcal (" + tag + "; this one reads " + current +
                                  "): finish that run with the demcal that started it, or start it again");
     } else {

@@ -2,6 +2,7 @@
 // under gravity against a closed outlet plate until the grains are at rest, opening, discharge until empty; the
 // discharged mass against time, the rate from its steady part, the flow pattern and the mid-plane velocity section.
 #pragma once
+#include "kernel/silo/bin_vibration.hpp"
 #include "kernel/silo/discharge_fit.hpp"
 #include "kernel/silo/flow_pattern.hpp"
 #include "kernel/silo/section_field.hpp"
@@ -39,6 +40,9 @@ struct SiloCaseSettings {
     double section_cell = 0.0025;    // [m]
     double section_half_thickness = 0.011;  // slab |y| < 2 d_p [m]
     FlowPatternSettings flow;
+    // The whole bin (every wall: hopper, body, outlet plate) vibrates from vibration.start_after_opening after the
+    // opening; still while it fills. Default: still.
+    BinVibration vibration;
     // Verlet skin [m]; 0: automatic, 40 dt x 1 m/s within [0.2 mm, 1 mm] (grains leave the outlet at ~1 m/s: the list
     // then lasts tens of steps; measured on the reduced 70 deg case, dt = 66 us: 1 mm ran 1.7 times faster than the
     // kernel's default 0.1 r; at the seed's dt = 2.1 us a 0.2 mm skin keeps fewer pairs in the list).
@@ -67,7 +71,7 @@ struct SiloCaseSettings {
 // the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit and stop_request are not
 // stored: a resumed run takes them from its caller.
 
-// Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions).
+// Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions, the vibration).
 void validate(const SiloCaseSettings& s);
 
 struct SiloProgress {

@@ -95,6 +95,33 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --vtk-every 0.1", "--vtk-every applies to the VTK snapshots"},
                           Case{"--theta 30 --fill-mass 1e9", "fill_mass = 1e+09"},
                           Case{"--theta 30 --dt 1e-4", "dt = 0.0001: larger than the Rayleigh time step"},
+                          // the bin's vibration: both numbers or none, ranges, no subnormals
+                          Case{"--theta 30 --vibration-frequency 100",
+                               "--vibration-frequency 100 needs --vibration-amplitude"},
+                          Case{"--theta 30 --vibration-amplitude 1e-4",
+                               "--vibration-amplitude 0.0001 needs --vibration-frequency"},
+                          Case{"--theta 30 --vibration-start 0.1", "--vibration-start applies to a vibrating bin"},
+                          Case{"--theta 30 --vibration-direction z",
+                               "--vibration-direction applies to a vibrating bin"},
+                          Case{"--theta 30 --vibration-frequency 1500 --vibration-amplitude 1e-4",
+                               "vibration_frequency = 1500"},
+                          Case{"--theta 30 --vibration-frequency -5 --vibration-amplitude 1e-4",
+                               "vibration_frequency = -5"},
+                          Case{"--theta 30 --vibration-frequency inf --vibration-amplitude 1e-4",
+                               "vibration_frequency = inf"},
+                          Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 0.05",
+                               "vibration_amplitude = 0.05"},
+                          Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude nan",
+                               "vibration_amplitude = nan"},
+                          Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-310",
+                               "vibration_amplitude = 1e-310: a subnormal"},
+                          Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-4 --vibration-direction y",
+                               "vibration-direction = 'y'"},
+                          Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-4 --vibration-start -1",
+                               "vibration_start = -1"},
+                          Case{"--theta 30 --vibration-frequency 1000 --vibration-amplitude 1e-4 "
+                               "--stiffness-scale 0.001",
+                               "vibration_frequency = 1000: a period is only"},
                           // the command-line parser's own refusals exit 2 as well
                           Case{"--theta abc", "--theta = abc"},
                           Case{"--theta 30 --thetaa 3", "not expected"}}) {
@@ -145,6 +172,31 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     const std::string summary = read_file(dir / "out" / "summary.json");
     CHECK_THAT(summary, Catch::Matchers::Contains("\"wall_to_axis_velocity_ratio\""));
     CHECK_THAT(summary, Catch::Matchers::Contains("\"grains\": 300"));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal silo: a tiny vibrating run records the vibration and its peak acceleration", "[silo][cli]") {
+    require_demcal();
+    const fs::path dir = fs::temp_directory_path() / "demcal_test_silo_cli_vibration";
+    fs::remove_all(dir);
+    const Run r = run_silo("--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
+                               "/examples/silo/reduced_conical_70deg.json' --theta 45 --particles 300 "
+                               "--stiffness-scale 0.001 --fill-time 0.3 --max-time 0.1 --threads 1 --no-plots "
+                               "--vibration-frequency 100 --vibration-amplitude 1.1e-4 --vibration-start 0.01 --out '" +
+                               (dir / "out").string() + "'",
+                           dir);
+    INFO(r.err);
+    REQUIRE(r.rc == 0);
+    const std::string summary = read_file(dir / "out" / "summary.json");
+    INFO(summary);
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"vibrates\": true"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"frequency_hz\": 100.0"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"amplitude_m\": 0.00011"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"direction\": \"x\""));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"start_after_opening_s\": 0.01"));
+    // A (2 pi f)^2 / g = 1.1e-4 (628.3)^2 / 9.81 = 4.427
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"peak_acceleration_g\": 4.42"));
+    CHECK_THAT(read_file(dir / "out.log"), Catch::Matchers::Contains("vibration: 100 Hz, 0.11 mm along x"));
     fs::remove_all(dir);
 }
 
