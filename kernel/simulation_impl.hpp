@@ -999,6 +999,7 @@ void BasicSimulation<Law>::save_state(std::ostream& os) const {
   }
   w.array(enabled);
   w.array(wall_motion);
+  w.array(wall_disp_built_);  // (when a moving wall next forces a neighbour build)
   // the for_each lists only hand out references; nothing is modified
   auto* self = const_cast<BasicSimulation*>(this);
   self->for_each_sphere_array([&](auto& a, int) { w.array(a); });
@@ -1042,6 +1043,8 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   std::vector<Vec3> wall_motion;
   r.array(enabled, "wall switches");
   r.array(wall_motion, "wall motion");
+  r.array(wall_disp_built_, "wall displacements at the last neighbour build");
+  if (wall_disp_built_.size() > walls_.size()) r.fail("walls", "wrong count");
   if (enabled.size() != walls_.size() || wall_motion.size() != 2 * walls_.size()) r.fail("walls", "wrong count");
   for_each_sphere_array([&](auto& a, int) { r.array(a, "sphere arrays"); });
   for_each_clump_array([&](auto& a) { r.array(a, "clump arrays"); });

@@ -137,17 +137,10 @@ TEST_CASE("silo case: the vibration starts its set delay after the opening, a ze
     CHECK(after_differ == after);
 }
 
-// KNOWN TO FAIL, hence [!shouldfail] (Catch reports it as passing while it fails, and as failing once it passes: then
-// remove the tag). The cause is in the kernel, not in the silo case: BasicSimulation::save_state does not store the
-// walls' displacement at the last neighbour build (wall_disp_built_), so after load_state a simulation with any wall on
-// a law (even one not started) rebuilds its neighbour list on the first step where the uninterrupted run does not,
-// and the sums then differ in the last bits (reproduced with the kernel alone: 5 plane walls on a law that never
-// starts, 300 falling spheres, 1 extra build, positions 1.7e-15 m apart 3000 steps later; still walls: 0 and 0).
-// The fix belongs in kernel/simulation_impl.hpp: save_state writes wall_disp_built_ after the wall motion, load_state
-// reads it back (and the state format's version goes up). With those two lines, checked outside this branch, this
-// case resumes to the same steps, fill energy, rate and flow ratio to the bit.
+// The kernel's state holds the walls' displacement at the last neighbour build: without it a resumed run with a wall on
+// a law rebuilt its list one step early and drifted in the last bits (found by this test).
 TEST_CASE("silo case: a vibrating run killed at checkpoints resumes to the uninterrupted result bit for bit",
-          "[silo][vibration][checkpoint][!shouldfail]") {
+          "[silo][vibration][checkpoint]") {
     SiloCaseSettings s = tiny_vibrating_case();
     s.vibration.start_after_opening = 0.02;
     const SiloCaseResult whole = run_silo_case(s);
