@@ -983,9 +983,9 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
     // The reported fits: on every row, or without the flagged rows when asked. The effects' tests and CV come from
     // the search (always without them).
     s.rows = o.dropped ? kept : all_rows(n);
-    const Scored before = score(s, base, search.base_fit.params);
-    const bool same_as_before = search.model.terms.empty();
-    const Scored after = same_as_before ? before : o.dropped ? score(s, search.model, search.fit.params) : with_all;
+    const bool no_effect = search.model.terms.empty();  // then before and after are one fit
+    const Scored before = no_effect && !o.dropped ? with_all : score(s, base, search.base_fit.params);
+    const Scored after = no_effect ? before : o.dropped ? score(s, search.model, search.fit.params) : with_all;
     for (double se : before.fit.std_errors)
         if (!std::isfinite(se)) {
             result.warnings.push_back("some parameters of " + model_name +
