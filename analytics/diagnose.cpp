@@ -344,19 +344,49 @@ std::function<void(const std::vector<std::size_t>&, double*)> unseen_levels_clea
     };
 }
 
-// x's effect per level of a regime, measured from x's lowest value: eta = beta[level] * (x - x_min).
+// Where a regime slope of x is measured from, row by row. A covariate with an off state (0 in the data, e.g. vibration
+// off) acts from 0: the regimes agree when it is off. Any other covariate is centred within each level (`level`, or
+// one level when null), so that its slopes cannot stand in for a difference in level between the regimes (an angle
+// effect), which is the business of the base model and of other candidates.
+struct SlopeOrigin {
+    std::shared_ptr<const std::vector<double>> of_row;
+    std::string text;  // for the form
+};
+
+SlopeOrigin slope_origin(const std::vector<double>& x, const std::shared_ptr<const std::vector<int>>& level) {
+    const std::size_t n = x.size();
+    if (*std::min_element(x.begin(), x.end()) == 0.0)
+        return {std::make_shared<const std::vector<double>>(n, 0.0), "x_ref = 0 (off)"};
+    const int levels = level ? *std::max_element(level->begin(), level->end()) + 1 : 1;
+    std::vector<double> sum(levels, 0.0), count(levels, 0.0);
+    for (std::size_t r = 0; r < n; ++r) {
+        const int l = level ? (*level)[r] : 0;
+        sum[l] += x[r];
+        count[l] += 1;
+    }
+    std::vector<double> origin(n);
+    for (std::size_t r = 0; r < n; ++r) {
+        const int l = level ? (*level)[r] : 0;
+        origin[r] = sum[l] / count[l];
+    }
+    std::string text = level ? "x_ref = mean of x in each level" : "x_ref = mean of x = " + short_number(origin[0]);
+    return {std::make_shared<const std::vector<double>>(std::move(origin)), std::move(text)};
+}
+
+// x's effect per level of a regime: eta = beta[level] * (x - x_ref).
 Term regime_term(const Setting& s, const Model& m, const DataColumn& col, const Regime& g) {
     const auto& x = col.values;
-    const double x_min = *std::min_element(x.begin(), x.end()), sd = sd_of(x);
+    const double sd = sd_of(x);
+    const auto origin = slope_origin(x, g.level);
     const std::string levels = [&] {
         std::string out;
         for (const auto& l : g.level_names) out += (out.empty() ? "" : "|") + l;
         return out;
     }();
-    const std::string eta = "beta[" + g.name + "]*(x - x_min)";
+    const std::string eta = "beta[" + g.name + "]*(x - x_ref)";
     Term t{col.name,
-           (m.relative ? "W *= exp(" + eta + ")" : "tau += " + eta) + ", x_min = " + short_number(x_min) + ", " +
-               g.name + " in " + levels,
+           (m.relative ? "W *= exp(" + eta + ")" : "tau += " + eta) + ", " + origin.text + ", " + g.name + " in " +
+               levels,
            "regime", {}, {}, {std::vector<double>(g.level_names.size(), 0.0)}, nullptr, nullptr, g.name};
     for (const auto& l : g.level_names) {
         t.param_names.push_back("beta[" + l + "]");
@@ -364,30 +394,33 @@ Term regime_term(const Setting& s, const Model& m, const DataColumn& col, const 
     }
     const bool rel = m.relative;
     const double scale = s.scale;
-    t.apply = [&x, x_min, sd, level = g.level, rel, scale](double w, std::size_t r, const double* tp, const double*) {
-        return apply_effect(w, tp[(*level)[r]] * (x[r] - x_min) / sd, rel, scale);
+    t.apply = [&x, x_ref = origin.of_row, sd, level = g.level, rel, scale](double w, std::size_t r, const double* tp,
+                                                                           const double*) {
+        return apply_effect(w, tp[(*level)[r]] * (x[r] - (*x_ref)[r]) / sd, rel, scale);
     };
     t.clear_unseen = unseen_levels_cleared(g.level, static_cast<int>(g.level_names.size()), 0);
     return t;
 }
 
-// x's effect changing continuously with a condition variable z: eta = (beta + gamma*(z - z0)) * (x - x_min).
+// x's effect changing continuously with a condition variable z: eta = (beta + gamma*(z - z0)) * (x - x_ref).
 Term interaction_term(const Setting& s, const Model& m, const DataColumn& x_col, const DataColumn& z_col) {
     const auto& x = x_col.values;
     const auto& z = z_col.values;
-    const double x_min = *std::min_element(x.begin(), x.end()), sd_x = sd_of(x);
+    const double sd_x = sd_of(x);
+    const auto origin = slope_origin(x, nullptr);
     const double z0 = mean_of(z), sd_z = sd_of(z);
-    const std::string eta = "(beta + gamma*(z - z0))*(x - x_min)";
+    const std::string eta = "(beta + gamma*(z - z0))*(x - x_ref)";
     const double unit = m.relative ? 1.0 : s.scale;
     Term t{x_col.name,
            (m.relative ? "W *= exp(" + eta + ")" : "tau += " + eta) + ", z = " + z_col.name +
-               ", z0 = " + short_number(z0) + ", x_min = " + short_number(x_min),
+               ", z0 = " + short_number(z0) + ", " + origin.text,
            "interaction", {"beta", "gamma"}, {unit / sd_x, unit / (sd_x * sd_z)}, {{0.0, 0.0}}, nullptr, nullptr,
            z_col.name};
     const bool rel = m.relative;
     const double scale = s.scale;
-    t.apply = [&x, &z, x_min, sd_x, z0, sd_z, rel, scale](double w, std::size_t r, const double* tp, const double*) {
-        return apply_effect(w, (tp[0] + tp[1] * (z[r] - z0) / sd_z) * (x[r] - x_min) / sd_x, rel, scale);
+    t.apply = [&x, &z, x_ref = origin.of_row, sd_x, z0, sd_z, rel, scale](double w, std::size_t r, const double* tp,
+                                                                          const double*) {
+        return apply_effect(w, (tp[0] + tp[1] * (z[r] - z0) / sd_z) * (x[r] - (*x_ref)[r]) / sd_x, rel, scale);
     };
     return t;
 }

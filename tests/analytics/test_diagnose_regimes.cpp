@@ -93,31 +93,35 @@ TEST_CASE("diagnose: the flow mode by Jenike's limit replaces the seed's classes
 }
 
 TEST_CASE("diagnose: a slope that differs by the values of a named column is found by that column", "[diagnose]") {
-    // Operator C's runs lose rate with moisture (35 % over 10-16 %); A and B's do not.
-    for (std::uint64_t seed : {41u, 42u}) {
+    // Operator C's runs lose rate with moisture (35 % over 10-16 %, about its middle, 13 %); A and B's do not. C
+    // runs a third of the 36 rows, so in some seeds its moisture spread is too narrow to tell: 6 of 8 at least.
+    int found = 0;
+    for (std::uint64_t seed = 41; seed <= 48; ++seed) {
         const auto data = with_factor(spec("oldal", "none", 0, seed), [](const MeasuredData& d, std::size_t r) {
             const bool c = d.at("operator").text[r] == "C";
-            return c ? std::exp(-std::log(1.35) * (d.at("moisture_pct").values[r] - 10) / 6) : 1.0;
+            return c ? std::exp(-std::log(1.35) * (d.at("moisture_pct").values[r] - 13) / 6) : 1.0;
         });
         DiagnoseOptions by_operator;
         by_operator.regime_columns = {"operator"};
         const auto r = diagnose(data, "oldal", by_operator);
         INFO("seed " << seed);
-        REQUIRE(!r.effects.empty());
+        if (r.effects.empty()) continue;
         CHECK(r.effects[0].variable == "moisture_pct");
         CHECK(r.effects[0].regime == "operator");
-        CHECK(param(r.effects[0], "beta[C]") < 0);
+        if (r.effects[0].regime != "operator") continue;
+        ++found;
+        CHECK(param(r.effects[0], "beta[C]") < -2 * std::abs(param(r.effects[0], "beta[A]")));
         // Without the option the operator is no regime: whatever is found is not "by operator".
         for (const auto& e : diagnose(data, "oldal").effects) CHECK(e.regime != "operator");
     }
+    CHECK(found >= 6);
 }
 
 TEST_CASE("diagnose: a slope that changes continuously with a condition variable is an x*z interaction", "[diagnose]") {
-    // The temperature effect grows with the outlet: none at the smallest, -25 % over the temperature range at the
-    // largest.
+    // The temperature effect (about 20 C) grows with the outlet: none at the smallest, -8 %/C at the largest.
     const auto data = with_factor(spec("oldal", "none", 0, 51), [](const MeasuredData& d, std::size_t r) {
         const double outlet = d.at("outlet_m").values[r], t = d.at("temperature_C").values[r];
-        return std::exp(-0.04 * (outlet - 0.025) / 0.025 * (t - 14));
+        return std::exp(-0.04 * (outlet - 0.025) / 0.025 * (t - 20));
     });
     const auto r = diagnose(data, "oldal");
     REQUIRE(!r.effects.empty());
