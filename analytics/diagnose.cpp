@@ -606,9 +606,12 @@ std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const D
     const std::size_t n = d.rows();
     std::vector<Regime> out;
     if (options.effective_friction_deg.has_value() != options.wall_friction_deg.has_value())
-        throw std::invalid_argument(std::string("flow mode by Jenike's limit needs both friction angles; only ") +
-                                    (options.wall_friction_deg ? "the wall friction" : "the effective friction") +
-                                    " was given");
+        throw std::invalid_argument(
+            "flow mode by Jenike's limit needs both friction angles: " +
+            (options.wall_friction_deg ? "wall_friction_deg=" + short_number(*options.wall_friction_deg) +
+                                             " given, effective_friction_deg missing"
+                                       : "effective_friction_deg=" + short_number(*options.effective_friction_deg) +
+                                             " given, wall_friction_deg missing"));
     double limit = seed_mass_flow_limit_deg;
     flow_mode_rule = "seed classes: mass below 30 deg, mixed 30-40 deg, funnel above 40 deg";
     if (options.wall_friction_deg) {

@@ -45,7 +45,7 @@ const std::vector<std::pair<std::string, std::string>>& synthetic_effects() {
     static const std::vector<std::pair<std::string, std::string>> effects{
         {"moisture", "moisture_pct"}, {"hopper_angle", "theta_deg"}, {"annulus", "d_p_m"},
         {"drift", "run_order"},       {"operator", "operator"},      {"curved_locus", "sigma_Pa"},
-        {"vibration_by_mode", "vibration_Hz"}, {"outlier", ""}};
+        {"vibration_by_mode", "vibration_Hz"}, {"hopper_angle+vibration_by_mode", "vibration_Hz"}, {"outlier", ""}};
     return effects;
 }
 
@@ -62,7 +62,8 @@ SyntheticSet make_synthetic(const SyntheticSpec& spec) {
     if ((spec.effect == "curved_locus") != shear && (spec.effect == "curved_locus" || spec.effect == "hopper_angle" ||
                                                      spec.effect == "annulus"))
         throw std::invalid_argument("synthetic set: effect " + spec.effect + " does not apply to " + spec.model);
-    const bool by_mode = spec.effect == "vibration_by_mode";
+    const bool by_mode = spec.effect == "vibration_by_mode" || spec.effect == "hopper_angle+vibration_by_mode";
+    const bool hopper_angle = spec.effect == "hopper_angle" || spec.effect == "hopper_angle+vibration_by_mode";
     if (by_mode && spec.model != "beverloo" && spec.model != "oldal")
         throw std::invalid_argument("synthetic set: effect " + spec.effect + " needs a conical model that ignores "
                                     "the angle (beverloo, oldal), not " + spec.model);
@@ -141,7 +142,7 @@ SyntheticSet make_synthetic(const SyntheticSpec& spec) {
         if (spec.effect == "moisture") y *= 1 - spec.effect_size * (moisture - 13) / 6;
         if (spec.effect == "drift") y *= 1 - spec.effect_size * i / (n - 1.0);
         if (spec.effect == "operator" && op == "C") y *= 1 + spec.effect_size;
-        if (spec.effect == "hopper_angle") y *= rose_tanaka_factor(c.theta, phi_d);
+        if (hopper_angle) y *= rose_tanaka_factor(c.theta, phi_d);
         if (by_mode) {
             // +effect_size/2 in mass flow at the strongest vibration, -effect_size/2 in funnel flow: effect_size apart.
             const auto mode = flow_mode_by_seed_classes(c.theta);

@@ -165,4 +165,5 @@ TEST_CASE("write the example data sets", "[.][write-examples]") {
     write(spec("failure-line", "curved_locus", 0.3, 42, 0.01, 3), "shear_curved.csv");
     write(spec("oldal", "vibration_by_mode", 0.25, 42), "oldal_vibration_by_mode.csv");
     write(spec("oldal", "outlier", 0.3, 42), "oldal_outlier.csv");
+    write(spec("beverloo", "hopper_angle+vibration_by_mode", 0.25, 42), "beverloo_angle_vibration.csv");
 }
