@@ -645,7 +645,6 @@ std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const D
         g.level = std::make_shared<const std::vector<int>>(std::move(mode));
         if (g.level_names.size() > 1) out.push_back(std::move(g));
     }
-    if (!conical) flow_mode_rule.clear();
     for (const auto& name : options.regime_columns) {
         const auto* col = d.find(name);
         if (!col) {
@@ -756,7 +755,7 @@ LeastSquaresFit fit_base(const Setting& s, const Model& m, std::vector<std::stri
 struct Search {
     Model model;  // the base model with the effects added
     LeastSquaresFit base_fit, fit;
-    double cv_before = 0, cv_after = 0;
+    double cv_after = 0;  // CV RMSE of the model found, on the rows searched
     std::vector<AddedEffect> effects;
     std::vector<std::vector<CandidateTest>> rounds;
 };
@@ -764,12 +763,12 @@ struct Search {
 // The rounds of candidate tests on s.rows (F test, Holm, cross-validation), from the base model.
 Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions& options,
                       std::vector<std::string>& warnings) {
-    Search out{base, fit_base(s, base, warnings), {}, 0, 0, {}, {}};
+    Search out{base, fit_base(s, base, warnings), {}, 0, {}, {}};
     Model& m = out.model;
     LeastSquaresFit& fit = out.fit;
     fit = out.base_fit;
     const std::size_t n = s.rows.size();
-    out.cv_before = out.cv_after = cross_validated_rmse(s, m, fit.params);
+    out.cv_after = cross_validated_rmse(s, m, fit.params);
     double& cv_now = out.cv_after;
     std::set<std::string> done;
     for (int round = 0; round < options.max_effects; ++round) {
@@ -945,8 +944,12 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
 
     const Model base = base_model(model_name, data, s);
     s.regimes = regimes_of(data, kind, options, result.flow_mode_rule);
-    if (std::none_of(s.regimes.begin(), s.regimes.end(), [](const Regime& g) { return g.name == "flow_mode"; }))
+    if (std::none_of(s.regimes.begin(), s.regimes.end(), [](const Regime& g) { return g.name == "flow_mode"; })) {
         result.flow_mode_rule.clear();
+        if (options.wall_friction_deg)
+            result.warnings.push_back("friction angles given, but the flow mode is no regime here: it needs conical "
+                                      "rows whose angles span more than one mode");
+    }
     result.residual_scale = base.relative ? "relative" : "absolute";
     if (n < base.size() + 2)
         throw std::invalid_argument(data.source + ": " + std::to_string(n) + " rows are too few to fit model " +
