@@ -801,14 +801,25 @@ Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions
                 (best < 0 || tests[i].cv_rmse < tests[best].cv_rmse))
                 best = static_cast<int>(i);
         }
-        // A physical effect from the library is preferred to a generic term that predicts about as well (within
-        // min_cv_improvement): it names the mechanism, and the generic one is often its approximation.
-        if (best >= 0 && tests[best].kind != "physical")
+        // A simpler or more telling candidate that predicts about as well as the best (within min_cv_improvement)
+        // replaces it: x's own plain term replaces x by regime or x*z (extra slopes fitted to a plain effect's noise
+        // would call it regime-dependent), and a physical effect from the library replaces a generic term (it names
+        // the mechanism; the generic one is often its approximation).
+        auto prefer = [&](auto&& qualifies) {
             for (std::size_t i = 0; i < tests.size(); ++i)
-                if (tests[i].kind == "physical" && tests[i].p_holm < options.family_alpha &&
+                if (qualifies(tests[i]) && tests[i].p_holm < options.family_alpha &&
                     tests[i].cv_rmse < (1.0 - options.min_cv_improvement) * cv_now &&
-                    tests[i].cv_rmse <= (1.0 + options.min_cv_improvement) * tests[best].cv_rmse)
+                    tests[i].cv_rmse <= (1.0 + options.min_cv_improvement) * tests[best].cv_rmse) {
                     best = static_cast<int>(i);
+                    return;
+                }
+        };
+        if (best >= 0 && !tests[best].regime.empty()) {
+            const std::string x = tests[best].variable;
+            prefer([&x](const CandidateTest& c) { return c.variable == x && c.regime.empty() && c.kind != "physical"; });
+        }
+        if (best >= 0 && tests[best].kind != "physical")
+            prefer([](const CandidateTest& c) { return c.kind == "physical"; });
         if (best >= 0) tests[best].accepted = true;
         out.rounds.push_back(tests);
         if (best < 0) break;

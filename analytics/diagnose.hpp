@@ -35,7 +35,7 @@ struct DiagnoseOptions {
     // Both given: the flow mode comes from Jenike's mass-flow limit for these friction angles, else from the seed's
     // classes.
     std::optional<double> effective_friction_deg, wall_friction_deg;
-    double outlier_alpha = 0.05;  // probability of flagging any row of a set without outliers (Bonferroni)
+    double outlier_alpha = 0.01;  // probability of flagging any row of a set without outliers (Bonferroni); as family_alpha
     bool drop_outliers = false;   // report the fits without the flagged rows (else: with all rows)
 };
 
@@ -95,7 +95,7 @@ struct Outlier {
 };
 
 struct OutlierReport {
-    double alpha = 0.05, threshold = 0;  // |studentized residual| above threshold is flagged
+    double alpha = 0.01, threshold = 0;  // |studentized residual| above threshold is flagged
     std::vector<Outlier> rows;
     // The final model fitted with every row / without the flagged rows (errors over the rows fitted).
     ErrorSummary with_outliers, without_outliers;

@@ -111,7 +111,7 @@ TEST_CASE("the JSON result has the documented shape", "[diagnose]") {
     CHECK(e.at("form").is_string());
     CHECK(e.at("params").at("beta").is_number());
     CHECK(e.at("p_value").is_number());
-    // The search's CV runs without the flagged rows (none, or a clean row by chance: alpha = 0.05).
+    // The search's CV runs without the flagged rows (none, or a clean row by chance: outlier_alpha).
     CHECK(e.at("cv_rmse_after") ==
           Approx(j.at("outliers").at("without_outliers").at("cv_rmse").get<double>()).epsilon(1e-6));
     CHECK(j.at("outliers").at("rows").is_array());
