@@ -118,7 +118,7 @@ TEST_CASE("the JSON result has the documented shape", "[diagnose]") {
 }
 
 // On demand: the false-positive rate on clean controls and the recovery rate of effects, over many seeds.
-//   build-diagnose/tests/test_analytics "[rates]"
+//   build/tests/test_analytics "[rates]"
 TEST_CASE("rates of false positives and of effect recovery", "[.][rates]") {
     const int seeds = 200;
     std::ostringstream table;
@@ -150,7 +150,7 @@ TEST_CASE("rates of false positives and of effect recovery", "[.][rates]") {
 }
 
 // On demand: writes the example data sets of examples/diagnose/.
-//   build-diagnose/tests/test_analytics "[write-examples]"
+//   build/tests/test_analytics "[write-examples]"
 TEST_CASE("write the example data sets", "[.][write-examples]") {
     auto write = [](const SyntheticSpec& s, const std::string& name) {
         std::ofstream out(std::string(DEMCAL_SOURCE_DIR) + "/examples/diagnose/" + name);
