@@ -955,7 +955,10 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
 
     const Model base = base_model(model_name, data, s);
     s.regimes = regimes_of(data, kind, options, result.flow_mode_rule);
-    if (std::none_of(s.regimes.begin(), s.regimes.end(), [](const Regime& g) { return g.name == "flow_mode"; })) {
+    for (const auto& g : s.regimes)
+        if (g.name == "flow_mode")
+            for (int l : *g.level) result.flow_mode_of_row.push_back(g.level_names[l]);
+    if (result.flow_mode_of_row.empty()) {
         result.flow_mode_rule.clear();
         if (options.wall_friction_deg)
             result.warnings.push_back("friction angles given, but the flow mode is no regime here: it needs conical "

@@ -115,6 +115,7 @@ struct DiagnoseResult {
     std::vector<int> lines;                          // file line of each row
     std::vector<double> observed, fitted_before, fitted_after;
     std::string flow_mode_rule;  // how the flow mode was told, when it was a regime candidate
+    std::vector<std::string> flow_mode_of_row;  // "mass" | "mixed" | "funnel" per row, when it was
     OutlierReport outliers;
     std::vector<std::string> warnings;
     // {"model", "n", "before": {...}, "effects": [...], "after": {...}} plus details (parameters, tests, rounds).

@@ -111,27 +111,48 @@ double residual_of(const analytics::DiagnoseResult& r, double fitted, std::size_
     return r.residual_scale == "relative" ? 100.0 * (r.observed[i] - fitted) / fitted : r.observed[i] - fitted;
 }
 
+// The regime of each row for the first regime effect added (flow mode or a column's value); empty when none.
+std::vector<std::string> regime_labels(const analytics::DiagnoseResult& r, const analytics::MeasuredData& data) {
+    for (const auto& e : r.effects) {
+        if (e.kind != "regime") continue;
+        if (e.regime == "flow_mode") return r.flow_mode_of_row;
+        if (const auto* c = data.find(e.regime)) return c->text;
+    }
+    return {};
+}
+
 // Residuals against the fitted value and against the first added effect's column (or the file order): before/after.
+// Rows are coloured by the regime of a regime effect, so that its slopes show; outliers are drawn apart.
 void plot_residuals(const analytics::DiagnoseResult& r, const analytics::MeasuredData& data,
                     const std::filesystem::path& dat, const std::filesystem::path& before,
                     const std::filesystem::path& after) {
+    // x: the covariate of a regime effect (its slopes by regime are the finding), else the first effect's column.
     std::string x_name = "row in file";
     const analytics::DataColumn* x_col = nullptr;
-    for (const auto& e : r.effects)
-        if (const auto* c = data.find(e.variable); c && c->numeric) {
-            x_col = c;
-            x_name = e.variable;
-            break;
-        }
+    for (const bool regime_only : {true, false}) {
+        for (const auto& e : r.effects)
+            if (const auto* c = data.find(e.variable); c && c->numeric && (!regime_only || e.kind == "regime")) {
+                x_col = c;
+                x_name = e.variable;
+                break;
+            }
+        if (x_col) break;
+    }
+    const auto labels = regime_labels(r, data);
+    std::vector<std::string> levels;  // in order of appearance
+    for (const auto& l : labels)
+        if (std::find(levels.begin(), levels.end(), l) == levels.end()) levels.push_back(l);
+    if (levels.empty()) levels.push_back("rows");
     {
         std::ofstream out(dat);
-        out << "# line observed fitted_before fitted_after residual_before residual_after x outlier\n";
+        out << "# line observed fitted_before fitted_after residual_before residual_after x outlier regime_index\n";
         for (std::size_t i = 0; i < r.observed.size(); ++i) {
             const bool outlier = std::any_of(r.outliers.rows.begin(), r.outliers.rows.end(),
                                              [&](const analytics::Outlier& o) { return o.line == r.lines[i]; });
             out << r.lines[i] << " " << r.observed[i] << " " << r.fitted_before[i] << " " << r.fitted_after[i] << " "
                 << residual_of(r, r.fitted_before[i], i) << " " << residual_of(r, r.fitted_after[i], i) << " "
-                << (x_col ? x_col->values[i] : static_cast<double>(i + 1)) << " " << (outlier ? 1 : 0) << "\n";
+                << (x_col ? x_col->values[i] : static_cast<double>(i + 1)) << " " << (outlier ? 1 : 0) << " "
+                << (labels.empty() ? 0 : std::find(levels.begin(), levels.end(), labels[i]) - levels.begin()) << "\n";
         }
         if (!out) throw UserError("cannot write " + dat.string());
     }
@@ -146,10 +167,15 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
           << "set xlabel 'fitted " << r.response << "' noenhanced\n";
         // Outliers (column 8 = 1) drawn apart, so that the eye does not read them as a trend.
         auto points = [&](const std::string& x) {
-            const std::string q = gnuplot_quote(dat);
-            return q + " using " + x + ":($8 == 0 ? $" + std::to_string(col) +
-                   " : 1/0) with points pt 7 ps 0.8 lc rgb '#1f77b4' title 'rows', " + q + " using " + x + ":($8 == 1 ? $" +
-                   std::to_string(col) + " : 1/0) with points pt 6 ps 2 lc rgb '#d62728' title 'outliers', 0 lt -1 notitle\n";
+            const std::string q = gnuplot_quote(dat), y = "$" + std::to_string(col);
+            std::string series;
+            for (std::size_t k = 0; k < levels.size(); ++k)
+                series += q + " using " + x + ":($8 == 0 && $9 == " + std::to_string(k) + " ? " + y +
+                          " : 1/0) with points pt 7 ps 0.8 lc " + std::to_string(k + 1) + " title '" + levels[k] + "', ";
+            if (!r.outliers.rows.empty())
+                series += q + " using " + x + ":($8 == 1 ? " + y +
+                          " : 1/0) with points pt 6 ps 2 lc rgb '#d62728' title 'outliers', ";
+            return series + "0 lt -1 notitle\n";
         };
         g << "plot " << points(std::to_string(fitted)) << "set xlabel '" << x_name << "' noenhanced\n"
           << "plot " << points("7") << "unset multiplot\n";
