@@ -13,6 +13,14 @@
 //    model); a candidate is added only when it is significant after Holm AND cuts the cross-validated RMSE by at
 //    least `min_cv_improvement`; the best such candidate (lowest CV RMSE) is added, except that a physical effect
 //    within `min_cv_improvement` of the best generic one is preferred (it names the mechanism); the search repeats.
+//  * effects that depend on a regime: a covariate x whose effect differs by the flow mode (from the hopper angle),
+//    by the levels of a column the user names, or continuously with a condition variable z (x*z term). x acts from 0
+//    when it has an off state (vibration 0 Hz), else from its mean within each regime, so that the slopes cannot
+//    stand in for a level difference between regimes. They are candidates like the others (same F test, Holm family,
+//    CV rule); x's plain term replaces them when it predicts within min_cv_improvement.
+//  * outliers: externally studentized residuals (leverage from the fit's Jacobian) against a Bonferroni threshold
+//    over the rows; the effect search runs without the flagged rows, and the flags are taken again under the model
+//    it found until they settle, so a single bad row can neither create an effect nor hide behind one.
 #pragma once
 #include "analytics/measured_data.hpp"
 
@@ -41,8 +49,8 @@ struct DiagnoseOptions {
 
 enum class FlowMode { mass, mixed, funnel };
 std::string to_string(FlowMode mode);
-// The seed's simulations and experiments (Jenike's chart for its wheat and steel): mass flow below a 30 deg half
-// angle, mixed flow from 30 to 40 deg, funnel flow above. With a known wall friction the limit is Jenike's, and the
+// The seed's simulations and experiments (as Jenike's design chart predicted for its wheat): mass flow below 30 deg
+// half angle, mixed flow from 30 to 40 deg, funnel flow above. With a known wall friction the limit is Jenike's, and the
 // mixed band keeps the seed's width of 10 deg above it. 90 deg (flat bottom) is funnel flow.
 constexpr double seed_mass_flow_limit_deg = 30, mixed_flow_band_deg = 10;
 FlowMode flow_mode_of_angle(double half_angle_deg, double mass_flow_limit_deg = seed_mass_flow_limit_deg);

@@ -17,9 +17,9 @@ struct SyntheticSpec {
     // annulus (d_p_m, empty annulus k d_p with k above the model's) | drift (run_order) | operator (operator C reads
     // high) | curved_locus (sigma_Pa, failure-line only) | vibration_by_mode (vibration_Hz raises W in mass flow, leaves
     // it in mixed flow, lowers it in funnel flow, as the seed measured; the seed's seven angles 10-70 deg; beverloo
-    // and oldal only) | hopper_angle+vibration_by_mode (both: the set on which issue 26 found diagnose naming the
-    // angle alone; both at effect_size) | outlier (one row, chosen by the seed, off by effect_size with a random sign: a gross error,
-    // not an effect).
+    // and oldal only) | hopper_angle+vibration_by_mode (both at effect_size: the kind of set on which issue 26 found
+    // diagnose naming the angle alone) | outlier (one row, chosen by the seed, off by effect_size with a random sign:
+    // a gross error, not an effect).
     std::string effect = "none";
     double effect_size = 0.2;  // relative change of the response between the extremes of the effect (0.2 = 20 %)
     double noise = 0.03;       // sd of the relative noise of W (or of tau, relative to the mean tau)
