@@ -701,7 +701,8 @@ std::vector<double> studentized_residuals(const Setting& s, const Model& m, cons
         std::vector<double> up(n);
         for (std::size_t i = 0; i < n; ++i) up[i] = residual(s, m, s.rows[i], q.data());
         q[j] = p[j] - h;
-        for (std::size_t i = 0; i < n; ++i) gsl_matrix_set(u, i, j, (up[i] - residual(s, m, s.rows[i], q.data())) / (2 * h));
+        for (std::size_t i = 0; i < n; ++i)
+            gsl_matrix_set(u, i, j, (up[i] - residual(s, m, s.rows[i], q.data())) / (2 * h));
         q[j] = p[j];
     }
     gsl_linalg_SV_decomp(u, v, sv, work);
@@ -816,7 +817,9 @@ Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions
         };
         if (best >= 0 && !tests[best].regime.empty()) {
             const std::string x = tests[best].variable;
-            prefer([&x](const CandidateTest& c) { return c.variable == x && c.regime.empty() && c.kind != "physical"; });
+            prefer([&x](const CandidateTest& c) {
+                return c.variable == x && c.regime.empty() && c.kind != "physical";
+            });
         }
         if (best >= 0 && tests[best].kind != "physical")
             prefer([](const CandidateTest& c) { return c.kind == "physical"; });
@@ -1001,12 +1004,10 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
         auto again = flagged_rows(s, search.model, all_rows_fit, options.outlier_alpha);
         if (again == flagged) break;
         if (pass == 2) {
+            std::string excluded;
+            for (auto r : flagged) excluded += (excluded.empty() ? "" : ", ") + std::to_string(data.lines[r]);
             result.warnings.push_back("the outlier flags did not settle in 3 passes; the last search excluded lines " +
-                                      [&] {
-                                          std::string l;
-                                          for (auto r : flagged) l += (l.empty() ? "" : ", ") + std::to_string(data.lines[r]);
-                                          return l.empty() ? std::string("none") : l;
-                                      }());
+                                      (excluded.empty() ? std::string("none") : excluded));
             break;
         }
         flagged = std::move(again);

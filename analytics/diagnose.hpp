@@ -43,15 +43,15 @@ struct DiagnoseOptions {
     // Both given: the flow mode comes from Jenike's mass-flow limit for these friction angles, else from the seed's
     // classes.
     std::optional<double> effective_friction_deg, wall_friction_deg;
-    double outlier_alpha = 0.01;  // probability of flagging any row of a set without outliers (Bonferroni); as family_alpha
+    double outlier_alpha = 0.01;  // chance of flagging any row of a set without outliers (Bonferroni), as family_alpha
     bool drop_outliers = false;   // report the fits without the flagged rows (else: with all rows)
 };
 
 enum class FlowMode { mass, mixed, funnel };
 std::string to_string(FlowMode mode);
 // The seed's simulations and experiments (as Jenike's design chart predicted for its wheat): mass flow below 30 deg
-// half angle, mixed flow from 30 to 40 deg, funnel flow above. With a known wall friction the limit is Jenike's, and the
-// mixed band keeps the seed's width of 10 deg above it. 90 deg (flat bottom) is funnel flow.
+// half angle, mixed flow from 30 to 40 deg, funnel flow above. With a known wall friction the limit is Jenike's, and
+// the mixed band keeps the seed's width of 10 deg above it. 90 deg (flat bottom) is funnel flow.
 constexpr double seed_mass_flow_limit_deg = 30, mixed_flow_band_deg = 10;
 FlowMode flow_mode_of_angle(double half_angle_deg, double mass_flow_limit_deg = seed_mass_flow_limit_deg);
 inline FlowMode flow_mode_by_seed_classes(double half_angle_deg) { return flow_mode_of_angle(half_angle_deg); }

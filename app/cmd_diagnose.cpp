@@ -171,7 +171,8 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
             std::string series;
             for (std::size_t k = 0; k < levels.size(); ++k)
                 series += q + " using " + x + ":($8 == 0 && $9 == " + std::to_string(k) + " ? " + y +
-                          " : 1/0) with points pt 7 ps 0.8 lc " + std::to_string(k + 1) + " title '" + levels[k] + "', ";
+                          " : 1/0) with points pt 7 ps 0.8 lc " + std::to_string(k + 1) + " title '" + levels[k] +
+                          "', ";
             if (!r.outliers.rows.empty())
                 series += q + " using " + x + ":($8 == 1 ? " + y +
                           " : 1/0) with points pt 6 ps 2 lc rgb '#d62728' title 'outliers', ";
@@ -243,7 +244,8 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
         md << "Round " << k + 1 << "\n\n| effect | kind | form | F | p | Holm p | CV RMSE | added |\n"
            << "|---|---|---|---|---|---|---|---|\n";
         for (const auto& c : r.rounds[k])
-            md << "| " << effect_name(c.variable, c.kind, c.regime) << " | " << c.kind << " | `" << c.form << "` | " << sci(c.f_statistic) << " | "
+            md << "| " << effect_name(c.variable, c.kind, c.regime) << " | " << c.kind << " | `" << c.form << "` | "
+               << sci(c.f_statistic) << " | "
                << sci(c.p_value) << " | " << sci(c.p_holm) << " | " << sci(c.cv_rmse) << " | "
                << (c.accepted ? "yes" : "") << " |\n";
         md << "\n";
@@ -283,7 +285,8 @@ void run_diagnose(const DiagnoseArgs& a) {
               << "before: RMSE " << sci(r.before.rmse) << "  CV RMSE " << sci(r.before.cv_rmse) << "  MAPE "
               << sci(r.before.mape) << " %\n";
     for (const auto& e : r.effects) {
-        std::cout << "  + " << effect_name(e.variable, e.kind, e.regime) << " (" << e.kind << "): " << e.form << "\n    ";
+        std::cout << "  + " << effect_name(e.variable, e.kind, e.regime) << " (" << e.kind << "): " << e.form
+                  << "\n    ";
         for (const auto& p : e.params) std::cout << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << "  ";
         std::cout << "p = " << sci(e.p_value) << " (Holm " << sci(e.p_holm) << ", " << e.candidates_tried
                   << " candidates), CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after) << "\n";
