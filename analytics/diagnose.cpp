@@ -5,6 +5,7 @@
 
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_fit.h>
+#include <gsl/gsl_linalg.h>
 
 #include <algorithm>
 #include <cmath>
@@ -35,6 +36,7 @@ struct Term {
     std::function<double(double prediction, std::size_t row, const double* tp, const double* bp)> apply;
     // Zeroes the parameters that the rows cannot inform (levels of a category absent from a CV training set).
     std::function<void(const std::vector<std::size_t>& rows, double* tp)> clear_unseen;
+    std::string regime = {};  // see CandidateTest::regime
 };
 
 struct Model {
@@ -61,6 +63,14 @@ struct Model {
     }
 };
 
+// A partition of the rows under which a covariate's effect may differ.
+struct Regime {
+    std::string name;    // "flow_mode" or the categorical column
+    std::string source;  // the column the levels come from (not tried as the covariate of its own regime)
+    std::vector<std::string> level_names;
+    std::shared_ptr<const std::vector<int>> level;  // level of each row
+};
+
 struct Setting {
     const MeasuredData& data;
     std::vector<double> y;
@@ -70,7 +80,15 @@ struct Setting {
     std::vector<int> fold;           // CV fold of each row
     int folds = 0;
     std::set<std::string> used;      // columns the model's formula uses
+    std::vector<std::size_t> rows;   // the rows fitted and scored: all, or all but the flagged outliers
+    std::vector<Regime> regimes;
 };
+
+// A term's effect eta on the prediction: a factor exp(eta) on a rate (relative residuals), an offset scale*eta on a
+// stress (absolute residuals, fitted in units of scale).
+double apply_effect(double w, double eta, bool relative, double scale) {
+    return relative ? w * std::exp(eta) : w + scale * eta;
+}
 
 double residual(const Setting& s, const Model& m, std::size_t row, const double* p) {
     const double w = m.predict(row, p);
@@ -86,15 +104,15 @@ LeastSquaresFit fit_rows(const Setting& s, const Model& m, const std::vector<std
     return fit_least_squares(rows.size(), f, start);
 }
 
-std::vector<std::size_t> all_rows(const Setting& s) {
-    std::vector<std::size_t> rows(s.y.size());
+std::vector<std::size_t> all_rows(std::size_t n) {
+    std::vector<std::size_t> rows(n);
     std::iota(rows.begin(), rows.end(), 0);
     return rows;
 }
 
 // Fits a model whose last term is new, from the previous parameters and each of the new term's starting points.
 LeastSquaresFit fit_extended(const Setting& s, const Model& m, const std::vector<double>& previous) {
-    const auto rows = all_rows(s);
+    const auto& rows = s.rows;
     if (m.terms.empty() || previous.size() == m.size()) return fit_rows(s, m, rows, previous);
     LeastSquaresFit best;
     best.sse = std::numeric_limits<double>::infinity();
@@ -111,10 +129,11 @@ struct Errors {
     double rmse = 0, mape = 0;
 };
 
+// Errors over the rows fitted (s.rows).
 Errors errors_of(const Setting& s, const std::vector<double>& predicted) {
     double sq = 0, ape = 0;
     int counted = 0;
-    for (std::size_t i = 0; i < s.y.size(); ++i) {
+    for (std::size_t i : s.rows) {
         const double w = std::isfinite(predicted[i]) ? predicted[i] : 0.0;
         sq += (s.y[i] - w) * (s.y[i] - w);
         if (s.y[i] != 0) {
@@ -122,7 +141,7 @@ Errors errors_of(const Setting& s, const std::vector<double>& predicted) {
             ++counted;
         }
     }
-    return {std::sqrt(sq / s.y.size()), counted ? 100.0 * ape / counted : nan};
+    return {std::sqrt(sq / s.rows.size()), counted ? 100.0 * ape / counted : nan};
 }
 
 std::vector<double> predictions(const Setting& s, const Model& m, const std::vector<double>& p) {
@@ -136,7 +155,7 @@ double cross_validated_rmse(const Setting& s, const Model& m, const std::vector<
     std::vector<double> predicted(s.y.size(), nan);
     for (int f = 0; f < s.folds; ++f) {
         std::vector<std::size_t> train, test;
-        for (std::size_t i = 0; i < s.y.size(); ++i) (s.fold[i] == f ? test : train).push_back(i);
+        for (std::size_t i : s.rows) (s.fold[i] == f ? test : train).push_back(i);
         if (test.empty()) continue;
         auto start = full_fit;
         double* tp = start.data() + m.param_names.size();
@@ -155,7 +174,7 @@ std::optional<LackOfFitTest> lack_of_fit(const Setting& s, const Model& m, const
     std::vector<double> sum(s.n_conditions, 0.0), sum_sq(s.n_conditions, 0.0);
     std::vector<int> count(s.n_conditions, 0);
     double sse = 0;
-    for (std::size_t i = 0; i < s.y.size(); ++i) {
+    for (std::size_t i : s.rows) {
         const double r = residual(s, m, i, p.data());
         sse += r * r;
         sum[s.condition[i]] += r;
@@ -163,10 +182,15 @@ std::optional<LackOfFitTest> lack_of_fit(const Setting& s, const Model& m, const
         ++count[s.condition[i]];
     }
     double pure = 0;
-    for (int c = 0; c < s.n_conditions; ++c) pure += sum_sq[c] - sum[c] * sum[c] / count[c];
+    int conditions = 0;
+    for (int c = 0; c < s.n_conditions; ++c)
+        if (count[c] > 0) {
+            pure += sum_sq[c] - sum[c] * sum[c] / count[c];
+            ++conditions;
+        }
     LackOfFitTest t;
-    t.df_pure_error = static_cast<int>(s.y.size()) - s.n_conditions;
-    t.df_lack_of_fit = s.n_conditions - static_cast<int>(p.size());
+    t.df_pure_error = static_cast<int>(s.rows.size()) - conditions;
+    t.df_lack_of_fit = conditions - static_cast<int>(p.size());
     if (t.df_pure_error <= 0 || t.df_lack_of_fit <= 0 || pure <= 0) return std::nullopt;
     t.f_statistic = ((sse - pure) / t.df_lack_of_fit) / (pure / t.df_pure_error);
     t.p_value = gsl_cdf_fdist_Q(std::max(t.f_statistic, 0.0), t.df_lack_of_fit, t.df_pure_error);
@@ -308,6 +332,122 @@ Model base_model(const std::string& name, const MeasuredData& d, Setting& s) {
 
 // --- candidate effects ------------------------------------------------------------------------------------------
 
+// For Term::clear_unseen: zeroes the parameter of every level (from first_level on, at tp[level - first_level]) that
+// the training rows do not contain.
+std::function<void(const std::vector<std::size_t>&, double*)> unseen_levels_cleared(
+    std::shared_ptr<const std::vector<int>> level, int levels, int first_level) {
+    return [level, levels, first_level](const std::vector<std::size_t>& rows, double* tp) {
+        std::vector<bool> seen(levels, false);
+        for (auto r : rows) seen[(*level)[r]] = true;
+        for (int l = first_level; l < levels; ++l)
+            if (!seen[l]) tp[l - first_level] = 0.0;
+    };
+}
+
+// Where a regime slope of x is measured from, row by row. A covariate with an off state (0 in the data, e.g. vibration
+// off) acts from 0: the regimes agree when it is off. Any other covariate is centred within each level (`level`, or
+// one level when null), so that its slopes cannot stand in for a difference in level between the regimes (an angle
+// effect), which is the business of the base model and of other candidates.
+struct SlopeOrigin {
+    std::shared_ptr<const std::vector<double>> of_row;
+    std::string text;  // for the form
+};
+
+SlopeOrigin slope_origin(const std::vector<double>& x, const std::shared_ptr<const std::vector<int>>& level) {
+    const std::size_t n = x.size();
+    if (*std::min_element(x.begin(), x.end()) == 0.0)
+        return {std::make_shared<const std::vector<double>>(n, 0.0), "x_ref = 0 (off)"};
+    const int levels = level ? *std::max_element(level->begin(), level->end()) + 1 : 1;
+    std::vector<double> sum(levels, 0.0), count(levels, 0.0);
+    for (std::size_t r = 0; r < n; ++r) {
+        const int l = level ? (*level)[r] : 0;
+        sum[l] += x[r];
+        count[l] += 1;
+    }
+    std::vector<double> origin(n);
+    for (std::size_t r = 0; r < n; ++r) {
+        const int l = level ? (*level)[r] : 0;
+        origin[r] = sum[l] / count[l];
+    }
+    std::string text = level ? "x_ref = mean of x in each level" : "x_ref = mean of x = " + short_number(origin[0]);
+    return {std::make_shared<const std::vector<double>>(std::move(origin)), std::move(text)};
+}
+
+// x's effect per level of a regime: eta = beta[level] * (x - x_ref).
+Term regime_term(const Setting& s, const Model& m, const DataColumn& col, const Regime& g) {
+    const auto& x = col.values;
+    const double sd = sd_of(x);
+    const auto origin = slope_origin(x, g.level);
+    const std::string levels = [&] {
+        std::string out;
+        for (const auto& l : g.level_names) out += (out.empty() ? "" : "|") + l;
+        return out;
+    }();
+    const std::string eta = "beta[" + g.name + "]*(x - x_ref)";
+    Term t{col.name,
+           (m.relative ? "W *= exp(" + eta + ")" : "tau += " + eta) + ", " + origin.text + ", " + g.name + " in " +
+               levels,
+           "regime", {}, {}, {std::vector<double>(g.level_names.size(), 0.0)}, nullptr, nullptr, g.name};
+    for (const auto& l : g.level_names) {
+        t.param_names.push_back("beta[" + l + "]");
+        t.param_scale.push_back((m.relative ? 1.0 : s.scale) / sd);
+    }
+    const bool rel = m.relative;
+    const double scale = s.scale;
+    t.apply = [&x, x_ref = origin.of_row, sd, level = g.level, rel, scale](double w, std::size_t r, const double* tp,
+                                                                           const double*) {
+        return apply_effect(w, tp[(*level)[r]] * (x[r] - (*x_ref)[r]) / sd, rel, scale);
+    };
+    t.clear_unseen = unseen_levels_cleared(g.level, static_cast<int>(g.level_names.size()), 0);
+    return t;
+}
+
+// x's effect changing continuously with a condition variable z: eta = (beta + gamma*(z - z0)) * (x - x_ref).
+Term interaction_term(const Setting& s, const Model& m, const DataColumn& x_col, const DataColumn& z_col) {
+    const auto& x = x_col.values;
+    const auto& z = z_col.values;
+    const double sd_x = sd_of(x);
+    const auto origin = slope_origin(x, nullptr);
+    const double z0 = mean_of(z), sd_z = sd_of(z);
+    const std::string eta = "(beta + gamma*(z - z0))*(x - x_ref)";
+    const double unit = m.relative ? 1.0 : s.scale;
+    Term t{x_col.name,
+           (m.relative ? "W *= exp(" + eta + ")" : "tau += " + eta) + ", z = " + z_col.name +
+               ", z0 = " + short_number(z0) + ", " + origin.text,
+           "interaction", {"beta", "gamma"}, {unit / sd_x, unit / (sd_x * sd_z)}, {{0.0, 0.0}}, nullptr, nullptr,
+           z_col.name};
+    const bool rel = m.relative;
+    const double scale = s.scale;
+    t.apply = [&x, &z, x_ref = origin.of_row, sd_x, z0, sd_z, rel, scale](double w, std::size_t r, const double* tp,
+                                                                          const double*) {
+        return apply_effect(w, (tp[0] + tp[1] * (z[r] - z0) / sd_z) * (x[r] - (*x_ref)[r]) / sd_x, rel, scale);
+    };
+    return t;
+}
+
+// Candidates whose covariate x acts differently by regime or along a condition variable. x: a numeric covariate that
+// describes the run, not the set-up (condition columns are the model's business), not yet an effect.
+std::vector<Term> regime_candidates(const Setting& s, const Model& m, const std::set<std::string>& done) {
+    const auto& d = s.data;
+    const MeasuredKind kind = m.relative ? MeasuredKind::discharge : MeasuredKind::shear;
+    const auto& conditions = condition_columns(kind);
+    auto is_condition = [&](const std::string& name) {
+        return std::find(conditions.begin(), conditions.end(), name) != conditions.end();
+    };
+    auto varies = [](const DataColumn& c) { return all_finite(c) && !is_constant(c); };
+    std::vector<Term> out;
+    for (const auto& x : d.columns) {
+        if (!x.numeric || x.name == (m.relative ? "W_kg_s" : "tau_Pa") || is_condition(x.name) ||
+            s.used.count(x.name) || done.count(x.name) || !varies(x))
+            continue;
+        for (const auto& g : s.regimes)
+            if (g.source != x.name) out.push_back(regime_term(s, m, x, g));
+        for (const auto& z : conditions)
+            if (const auto* zc = d.find(z); zc && varies(*zc)) out.push_back(interaction_term(s, m, x, *zc));
+    }
+    return out;
+}
+
 std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<std::string>& done,
                              std::vector<std::string>& warnings, bool first_round) {
     const auto& d = s.data;
@@ -348,8 +488,7 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
                 const bool rel = m.relative;
                 const double scale = s.scale;
                 t.apply = [&x, x0, sd, rel, scale](double w, std::size_t r, const double* tp, const double*) {
-                    const double z = (x[r] - x0) / sd;
-                    return rel ? w * std::exp(tp[0] * z) : w + scale * tp[0] * z;
+                    return apply_effect(w, tp[0] * (x[r] - x0) / sd, rel, scale);
                 };
                 out.push_back(t);
             }
@@ -380,15 +519,9 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
             auto shared_level = std::make_shared<std::vector<int>>(level);
             t.apply = [shared_level, rel, scale](double w, std::size_t r, const double* tp, const double*) {
                 const int l = (*shared_level)[r];
-                const double b = l == 0 ? 0.0 : tp[l - 1];
-                return rel ? w * std::exp(b) : w + scale * b;
+                return apply_effect(w, l == 0 ? 0.0 : tp[l - 1], rel, scale);
             };
-            t.clear_unseen = [shared_level, levels](const std::vector<std::size_t>& rows, double* tp) {
-                std::vector<bool> seen(levels, false);
-                for (auto r : rows) seen[(*shared_level)[r]] = true;
-                for (int l = 1; l < levels; ++l)
-                    if (!seen[l]) tp[l - 1] = 0.0;
-            };
+            t.clear_unseen = unseen_levels_cleared(shared_level, levels, 1);
             out.push_back(t);
         }
     }
@@ -434,6 +567,7 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
         };
         out.push_back(t);
     }
+    for (auto& t : regime_candidates(s, m, done)) out.push_back(std::move(t));
     // Drift in the order of the file, unless a column (a run number, a time) already orders the rows.
     if (!some_column_orders_rows && !done.count("row_order") && n > 2) {
         auto order = std::make_shared<std::vector<double>>(n);
@@ -444,8 +578,7 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
         Term t{"row_order", rel ? "W *= exp(beta*(row - row0)) (drift in file order)" : "tau += beta*(row - row0) (drift in file order)",
                "drift", {"beta_per_row"}, {rel ? 1.0 / sd : scale / sd}, {{0.0}}, nullptr, nullptr};
         t.apply = [order, x0, sd, rel, scale](double w, std::size_t r, const double* tp, const double*) {
-            const double z = ((*order)[r] - x0) / sd;
-            return rel ? w * std::exp(tp[0] * z) : w + scale * tp[0] * z;
+            return apply_effect(w, tp[0] * ((*order)[r] - x0) / sd, rel, scale);
         };
         out.push_back(t);
     }
@@ -462,6 +595,274 @@ void holm(std::vector<CandidateTest>& tests) {
         running = std::max(running, std::min(1.0, (m - j) * tests[idx[j]].p_value));
         tests[idx[j]].p_holm = running;
     }
+}
+
+// --- regimes ----------------------------------------------------------------------------------------------------
+
+// The regimes the data and options define: the flow mode (conical hoppers whose angles span more than one mode) and
+// each categorical column the user names.
+std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const DiagnoseOptions& options,
+                               std::string& flow_mode_rule) {
+    const std::size_t n = d.rows();
+    std::vector<Regime> out;
+    if (options.effective_friction_deg.has_value() != options.wall_friction_deg.has_value())
+        throw std::invalid_argument(
+            "flow mode by Jenike's limit needs both friction angles: " +
+            (options.wall_friction_deg ? "wall_friction_deg=" + short_number(*options.wall_friction_deg) +
+                                             " given, effective_friction_deg missing"
+                                       : "effective_friction_deg=" + short_number(*options.effective_friction_deg) +
+                                             " given, wall_friction_deg missing"));
+    double limit = seed_mass_flow_limit_deg;
+    flow_mode_rule = "seed classes: mass below 30 deg, mixed 30-40 deg, funnel above 40 deg";
+    if (options.wall_friction_deg) {
+        try {
+            limit = jenike_mass_flow_limit_deg(*options.effective_friction_deg, *options.wall_friction_deg);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(std::string("flow mode by Jenike's limit: ") + e.what());
+        }
+        flow_mode_rule = "Jenike's limit " + short_number(limit) + " deg (delta_e " +
+                         short_number(*options.effective_friction_deg) + ", phi_w " +
+                         short_number(*options.wall_friction_deg) + "): mass below it, mixed up to " +
+                         short_number(limit + mixed_flow_band_deg) + " deg, funnel above";
+    }
+    const auto* theta = d.find("theta_deg");
+    const auto* geometry = d.find("geometry");
+    const bool conical = kind == MeasuredKind::discharge && theta && geometry &&
+                         std::all_of(geometry->text.begin(), geometry->text.end(),
+                                     [](const std::string& g) { return g == "conical"; });
+    if (conical) {
+        Regime g{"flow_mode", "theta_deg", {}, nullptr};
+        std::vector<int> mode(n);
+        for (std::size_t r = 0; r < n; ++r) mode[r] = static_cast<int>(flow_mode_of_angle(theta->values[r], limit));
+        // Levels in the order mass, mixed, funnel; only the modes present.
+        std::vector<int> index(3, -1);
+        for (int k = 0; k < 3; ++k)
+            if (std::find(mode.begin(), mode.end(), k) != mode.end()) {
+                index[k] = static_cast<int>(g.level_names.size());
+                g.level_names.push_back(to_string(static_cast<FlowMode>(k)));
+            }
+        for (auto& v : mode) v = index[v];
+        g.level = std::make_shared<const std::vector<int>>(std::move(mode));
+        if (g.level_names.size() > 1) out.push_back(std::move(g));
+    }
+    for (const auto& name : options.regime_columns) {
+        const auto* col = d.find(name);
+        if (!col) {
+            std::string known;
+            for (const auto& c : d.columns) known += (known.empty() ? "" : ", ") + c.name;
+            throw std::invalid_argument("regime column '" + name + "' is not in " + d.source + " (columns: " + known +
+                                        ")");
+        }
+        Regime g{name, name, {}, nullptr};
+        std::map<std::string, int> level_of;
+        std::vector<int> level(n);
+        for (std::size_t r = 0; r < n; ++r) {
+            auto [it, added] = level_of.emplace(col->text[r], static_cast<int>(level_of.size()));
+            if (added) g.level_names.push_back(col->text[r]);
+            level[r] = it->second;
+        }
+        if (g.level_names.size() < 2)
+            throw std::invalid_argument("regime column '" + name + "' has a single value '" + g.level_names[0] +
+                                        "': no regimes to compare");
+        if (g.level_names.size() > n / 3)
+            throw std::invalid_argument("regime column '" + name + "' has " + std::to_string(g.level_names.size()) +
+                                        " values for " + std::to_string(n) +
+                                        " rows: too many for a slope per value (at most a third of the rows)");
+        g.level = std::make_shared<const std::vector<int>>(std::move(level));
+        out.push_back(std::move(g));
+    }
+    return out;
+}
+
+// --- outliers ---------------------------------------------------------------------------------------------------
+
+// Externally studentized residuals of s.rows under the fit p to s.rows (the deletion formulas of least squares, with
+// the leverages of the Jacobian at p); NaN where a row's leverage is 1 (it alone fixes a parameter).
+std::vector<double> studentized_residuals(const Setting& s, const Model& m, const std::vector<double>& p) {
+    const std::size_t n = s.rows.size(), k = p.size();
+    std::vector<double> t(n, nan);
+    if (n < k + 2) return t;
+    std::vector<double> e(n);
+    double sse = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        e[i] = residual(s, m, s.rows[i], p.data());
+        sse += e[i] * e[i];
+    }
+    // Jacobian by central differences, then its SVD: the leverage of row i is the squared norm of row i of U over the
+    // singular values that are not zero.
+    gsl_matrix* u = gsl_matrix_alloc(n, k);
+    gsl_matrix* v = gsl_matrix_alloc(k, k);
+    gsl_vector* sv = gsl_vector_alloc(k);
+    gsl_vector* work = gsl_vector_alloc(k);
+    std::vector<double> q = p;
+    for (std::size_t j = 0; j < k; ++j) {
+        const double h = 1e-6 * std::max(1.0, std::abs(p[j]));
+        q[j] = p[j] + h;
+        std::vector<double> up(n);
+        for (std::size_t i = 0; i < n; ++i) up[i] = residual(s, m, s.rows[i], q.data());
+        q[j] = p[j] - h;
+        for (std::size_t i = 0; i < n; ++i)
+            gsl_matrix_set(u, i, j, (up[i] - residual(s, m, s.rows[i], q.data())) / (2 * h));
+        q[j] = p[j];
+    }
+    gsl_linalg_SV_decomp(u, v, sv, work);
+    const double tolerance = gsl_vector_get(sv, 0) * 1e-10 * static_cast<double>(n);
+    const double dof = static_cast<double>(n - k);
+    for (std::size_t i = 0; i < n; ++i) {
+        double h = 0;
+        for (std::size_t j = 0; j < k; ++j)
+            if (gsl_vector_get(sv, j) > tolerance) h += gsl_matrix_get(u, i, j) * gsl_matrix_get(u, i, j);
+        if (h > 1 - 1e-9) continue;
+        const double s2 = (sse - e[i] * e[i] / (1 - h)) / (dof - 1);  // residual variance without row i
+        if (s2 > 0) t[i] = e[i] / std::sqrt(s2 * (1 - h));
+    }
+    gsl_vector_free(work);
+    gsl_vector_free(sv);
+    gsl_matrix_free(v);
+    gsl_matrix_free(u);
+    return t;
+}
+
+// The Bonferroni threshold for |t| over the n rows of a fit with k parameters.
+double outlier_threshold(std::size_t n, std::size_t k, double alpha) {
+    return n >= k + 2 ? gsl_cdf_tdist_Qinv(alpha / (2.0 * n), static_cast<double>(n - k - 1)) : nan;
+}
+
+// Rows (indices into the data) of s.rows whose studentized residual under the fit p is beyond the threshold.
+std::vector<std::size_t> flagged_rows(const Setting& s, const Model& m, const std::vector<double>& p, double alpha) {
+    const auto t = studentized_residuals(s, m, p);
+    const double limit = outlier_threshold(s.rows.size(), p.size(), alpha);
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < t.size(); ++i)
+        if (std::abs(t[i]) > limit) out.push_back(s.rows[i]);
+    return out;
+}
+
+// --- the search -------------------------------------------------------------------------------------------------
+
+// The base model fitted to s.rows, restarted once when GSL stops at its iteration limit.
+LeastSquaresFit fit_base(const Setting& s, const Model& m, std::vector<std::string>& warnings) {
+    LeastSquaresFit fit = fit_extended(s, m, m.start);
+    if (!fit.converged) {
+        // GSL also stops at its iteration limit when started at the optimum; only a restart that still improves the
+        // sum of squares means the fit had not converged.
+        const auto again = fit_rows(s, m, s.rows, fit.params);
+        if (again.sse < fit.sse * (1 - 1e-8)) warnings.push_back("the fit of " + m.name + " did not converge");
+        if (again.sse < fit.sse) fit = again;
+    }
+    return fit;
+}
+
+struct Search {
+    Model model;  // the base model with the effects added
+    LeastSquaresFit base_fit, fit;
+    double cv_after = 0;  // CV RMSE of the model found, on the rows searched
+    std::vector<AddedEffect> effects;
+    std::vector<std::vector<CandidateTest>> rounds;
+};
+
+// The rounds of candidate tests on s.rows (F test, Holm, cross-validation), from the base model.
+Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions& options,
+                      std::vector<std::string>& warnings) {
+    Search out{base, fit_base(s, base, warnings), {}, 0, {}, {}};
+    Model& m = out.model;
+    LeastSquaresFit& fit = out.fit;
+    fit = out.base_fit;
+    const std::size_t n = s.rows.size();
+    out.cv_after = cross_validated_rmse(s, m, fit.params);
+    double& cv_now = out.cv_after;
+    std::set<std::string> done;
+    for (int round = 0; round < options.max_effects; ++round) {
+        auto terms = candidates(s, m, done, warnings, round == 0);
+        if (terms.empty()) break;
+        std::vector<CandidateTest> tests;
+        std::vector<LeastSquaresFit> fits;
+        for (const auto& t : terms) {
+            Model bigger = m;
+            bigger.terms.push_back(t);
+            CandidateTest c{t.variable, t.form, t.kind, t.regime, static_cast<int>(t.param_names.size()),
+                            0,          1,      1,      nan,      false};
+            const int dof = static_cast<int>(n) - static_cast<int>(bigger.size());
+            LeastSquaresFit f = dof > 0 ? fit_extended(s, bigger, fit.params) : LeastSquaresFit{};
+            if (dof > 0 && std::isfinite(f.sse) && f.sse < fit.sse) {
+                c.f_statistic = ((fit.sse - f.sse) / c.extra_params) / (f.sse / dof);
+                c.p_value = f.sse > 0 ? gsl_cdf_fdist_Q(c.f_statistic, c.extra_params, dof) : 0.0;
+            }
+            tests.push_back(c);
+            fits.push_back(f);
+        }
+        holm(tests);
+        int best = -1;
+        for (std::size_t i = 0; i < tests.size(); ++i) {
+            if (tests[i].p_holm >= options.family_alpha) continue;  // CV only for the significant ones: it is dearer
+            Model bigger = m;
+            bigger.terms.push_back(terms[i]);
+            tests[i].cv_rmse = cross_validated_rmse(s, bigger, fits[i].params);
+            if (tests[i].cv_rmse < (1.0 - options.min_cv_improvement) * cv_now &&
+                (best < 0 || tests[i].cv_rmse < tests[best].cv_rmse))
+                best = static_cast<int>(i);
+        }
+        // A simpler or more telling candidate that predicts about as well as the best (within min_cv_improvement)
+        // replaces it: x's own plain term replaces x by regime or x*z (extra slopes fitted to a plain effect's noise
+        // would call it regime-dependent), and a physical effect from the library replaces a generic term (it names
+        // the mechanism; the generic one is often its approximation).
+        auto prefer = [&](auto&& qualifies) {
+            for (std::size_t i = 0; i < tests.size(); ++i)
+                if (qualifies(tests[i]) && tests[i].p_holm < options.family_alpha &&
+                    tests[i].cv_rmse < (1.0 - options.min_cv_improvement) * cv_now &&
+                    tests[i].cv_rmse <= (1.0 + options.min_cv_improvement) * tests[best].cv_rmse) {
+                    best = static_cast<int>(i);
+                    return;
+                }
+        };
+        if (best >= 0 && !tests[best].regime.empty()) {
+            const std::string x = tests[best].variable;
+            prefer([&x](const CandidateTest& c) {
+                return c.variable == x && c.regime.empty() && c.kind != "physical";
+            });
+        }
+        if (best >= 0 && tests[best].kind != "physical")
+            prefer([](const CandidateTest& c) { return c.kind == "physical"; });
+        if (best >= 0) tests[best].accepted = true;
+        out.rounds.push_back(tests);
+        if (best < 0) break;
+
+        m.terms.push_back(terms[best]);
+        fit = fits[best];
+        AddedEffect e;
+        e.variable = terms[best].variable;
+        e.form = terms[best].form;
+        e.kind = terms[best].kind;
+        e.regime = terms[best].regime;
+        e.f_statistic = tests[best].f_statistic;
+        e.p_value = tests[best].p_value;
+        e.p_holm = tests[best].p_holm;
+        e.candidates_tried = static_cast<int>(tests.size());
+        e.cv_rmse_before = cv_now;
+        e.cv_rmse_after = tests[best].cv_rmse;
+        cv_now = e.cv_rmse_after;
+        out.effects.push_back(e);
+        done.insert(e.variable);
+    }
+    return out;
+}
+
+// A model fitted to s.rows with its errors (in-sample, cross-validated) and lack of fit.
+struct Scored {
+    LeastSquaresFit fit;
+    ErrorSummary errors;
+    std::optional<LackOfFitTest> lack_of_fit;
+    std::vector<double> fitted;  // every row of the data (rows outside s.rows: predictions)
+};
+
+Scored score(const Setting& s, const Model& m, const std::vector<double>& start) {
+    Scored out;
+    out.fit = fit_rows(s, m, s.rows, start);
+    out.fitted = predictions(s, m, out.fit.params);
+    const auto e = errors_of(s, out.fitted);
+    out.errors = {e.rmse, cross_validated_rmse(s, m, out.fit.params), e.mape};
+    out.lack_of_fit = lack_of_fit(s, m, out.fit.params);
+    return out;
 }
 
 nlohmann::json errors_json(const ErrorSummary& e) {
@@ -498,15 +899,31 @@ MeasuredKind data_kind_of(const std::string& model) {
     throw std::invalid_argument("model '" + model + "' unknown; expected one of " + known);
 }
 
+std::string to_string(FlowMode mode) {
+    switch (mode) {
+        case FlowMode::mass: return "mass";
+        case FlowMode::mixed: return "mixed";
+        case FlowMode::funnel: return "funnel";
+    }
+    return "?";
+}
+
+FlowMode flow_mode_of_angle(double half_angle_deg, double mass_flow_limit_deg) {
+    if (half_angle_deg < mass_flow_limit_deg) return FlowMode::mass;
+    if (half_angle_deg <= mass_flow_limit_deg + mixed_flow_band_deg) return FlowMode::mixed;
+    return FlowMode::funnel;
+}
+
 DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name, const DiagnoseOptions& options) {
     const MeasuredKind kind = data_kind_of(model_name);
     validate_measured(data, kind);
-    Setting s{data, {}, 1.0, {}, 0, {}, 0, {}};
+    Setting s{data, {}, 1.0, {}, 0, {}, 0, {}, {}, {}};
     DiagnoseResult result;
     result.model = model_name;
     result.response = kind == MeasuredKind::discharge ? "W_kg_s" : "tau_Pa";
     s.y = data.at(result.response).values;
     const std::size_t n = data.rows();
+    s.rows = all_rows(n);
     result.n = static_cast<int>(n);
     result.lines = data.lines;
     result.observed = s.y;
@@ -539,9 +956,19 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
     }
     result.folds = s.folds;
 
-    Model m = base_model(model_name, data, s);
-    result.residual_scale = m.relative ? "relative" : "absolute";
-    if (n < m.size() + 2)
+    const Model base = base_model(model_name, data, s);
+    s.regimes = regimes_of(data, kind, options, result.flow_mode_rule);
+    for (const auto& g : s.regimes)
+        if (g.name == "flow_mode")
+            for (int l : *g.level) result.flow_mode_of_row.push_back(g.level_names[l]);
+    if (result.flow_mode_of_row.empty()) {
+        result.flow_mode_rule.clear();
+        if (options.wall_friction_deg)
+            result.warnings.push_back("friction angles given, but the flow mode is no regime here: it needs conical "
+                                      "rows whose angles span more than one mode");
+    }
+    result.residual_scale = base.relative ? "relative" : "absolute";
+    if (n < base.size() + 2)
         throw std::invalid_argument(data.source + ": " + std::to_string(n) + " rows are too few to fit model " +
                                     model_name + " and test its residuals");
     if (model_name == "oldal-rect") {
@@ -560,95 +987,87 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
                                       (count > 10 ? ", ..." : ""));
     }
 
-    LeastSquaresFit fit = fit_extended(s, m, m.start);
-    if (!fit.converged) {
-        // GSL also stops at its iteration limit when started at the optimum; only a restart that still improves the
-        // sum of squares means the fit had not converged.
-        const auto again = fit_rows(s, m, all_rows(s), fit.params);
-        if (again.sse < fit.sse * (1 - 1e-8))
-            result.warnings.push_back("the fit of " + model_name + " did not converge");
-        if (again.sse < fit.sse) fit = again;
+    // Outliers are flagged under the base model, the search runs without them, and the flags are taken again under
+    // the model it found (fitted to every row) until they settle: a row that only looked wild next to a missing
+    // effect is given back, a row that a wrong effect had absorbed is caught.
+    std::vector<std::size_t> flagged = flagged_rows(s, base, fit_base(s, base, result.warnings).params,
+                                                    options.outlier_alpha);
+    Search search;
+    std::vector<double> all_rows_fit;
+    for (int pass = 0;; ++pass) {
+        s.rows.clear();
+        for (std::size_t r = 0; r < n; ++r)
+            if (!std::binary_search(flagged.begin(), flagged.end(), r)) s.rows.push_back(r);
+        search = search_effects(s, base, options, result.warnings);
+        s.rows = all_rows(n);
+        all_rows_fit = fit_rows(s, search.model, s.rows, search.fit.params).params;
+        auto again = flagged_rows(s, search.model, all_rows_fit, options.outlier_alpha);
+        if (again == flagged) break;
+        if (pass == 2) {
+            std::string excluded;
+            for (auto r : flagged) excluded += (excluded.empty() ? "" : ", ") + std::to_string(data.lines[r]);
+            result.warnings.push_back("the outlier flags did not settle in 3 passes; the last search excluded lines " +
+                                      (excluded.empty() ? std::string("none") : excluded));
+            break;
+        }
+        flagged = std::move(again);
     }
-    for (double se : fit.std_errors)
+    result.effects = search.effects;
+    result.rounds = search.rounds;
+
+    // The outlier report: the final model with every row and without the flagged ones.
+    auto& o = result.outliers;
+    o.alpha = options.outlier_alpha;
+    o.threshold = outlier_threshold(n, search.model.size(), options.outlier_alpha);
+    const Scored with_all = score(s, search.model, all_rows_fit);
+    o.with_outliers = with_all.errors;
+    const auto t_all = studentized_residuals(s, search.model, with_all.fit.params);
+    for (auto r : flagged) o.rows.push_back({data.lines[r], s.y[r], with_all.fitted[r], t_all[r]});
+    std::vector<std::size_t> kept;
+    for (std::size_t r = 0; r < n; ++r)
+        if (!std::binary_search(flagged.begin(), flagged.end(), r)) kept.push_back(r);
+    o.dropped = options.drop_outliers && !flagged.empty();
+    if (!flagged.empty()) {
+        s.rows = kept;
+        o.without_outliers = score(s, search.model, search.fit.params).errors;
+    } else {
+        o.without_outliers = o.with_outliers;
+    }
+
+    // The reported fits: on every row, or without the flagged rows when asked. The effects' tests and CV come from
+    // the search (always without them).
+    s.rows = o.dropped ? kept : all_rows(n);
+    const bool no_effect = search.model.terms.empty();  // then before and after are one fit
+    const Scored before = no_effect && !o.dropped ? with_all : score(s, base, search.base_fit.params);
+    const Scored after = no_effect ? before : o.dropped ? score(s, search.model, search.fit.params) : with_all;
+    for (double se : before.fit.std_errors)
         if (!std::isfinite(se)) {
             result.warnings.push_back("some parameters of " + model_name +
                                       " are not identifiable from these data (singular covariance)");
             break;
         }
-    result.params_before = estimates(m, fit);
-    result.fitted_before = predictions(s, m, fit.params);
-    const auto e0 = errors_of(s, result.fitted_before);
-    result.before = {e0.rmse, cross_validated_rmse(s, m, fit.params), e0.mape};
-    result.lack_of_fit_before = lack_of_fit(s, m, fit.params);
-
-    double cv_now = result.before.cv_rmse;
-    std::set<std::string> done;
-    for (int round = 0; round < options.max_effects; ++round) {
-        auto terms = candidates(s, m, done, result.warnings, round == 0);
-        if (terms.empty()) break;
-        std::vector<CandidateTest> tests;
-        std::vector<LeastSquaresFit> fits;
-        for (const auto& t : terms) {
-            Model bigger = m;
-            bigger.terms.push_back(t);
-            CandidateTest c{t.variable, t.form, t.kind, static_cast<int>(t.param_names.size()), 0, 1, 1, nan, false};
-            const int dof = static_cast<int>(n) - static_cast<int>(bigger.size());
-            LeastSquaresFit f = dof > 0 ? fit_extended(s, bigger, fit.params) : LeastSquaresFit{};
-            if (dof > 0 && std::isfinite(f.sse) && f.sse < fit.sse) {
-                c.f_statistic = ((fit.sse - f.sse) / c.extra_params) / (f.sse / dof);
-                c.p_value = f.sse > 0 ? gsl_cdf_fdist_Q(c.f_statistic, c.extra_params, dof) : 0.0;
-            }
-            tests.push_back(c);
-            fits.push_back(f);
-        }
-        holm(tests);
-        int best = -1;
-        for (std::size_t i = 0; i < tests.size(); ++i) {
-            if (tests[i].p_holm >= options.family_alpha) continue;  // CV only for the significant ones: it is dearer
-            Model bigger = m;
-            bigger.terms.push_back(terms[i]);
-            tests[i].cv_rmse = cross_validated_rmse(s, bigger, fits[i].params);
-            if (tests[i].cv_rmse < (1.0 - options.min_cv_improvement) * cv_now &&
-                (best < 0 || tests[i].cv_rmse < tests[best].cv_rmse))
-                best = static_cast<int>(i);
-        }
-        // A physical effect from the library is preferred to a generic term that predicts about as well (within
-        // min_cv_improvement): it names the mechanism, and the generic one is often its approximation.
-        if (best >= 0 && tests[best].kind != "physical")
-            for (std::size_t i = 0; i < tests.size(); ++i)
-                if (tests[i].kind == "physical" && tests[i].p_holm < options.family_alpha &&
-                    tests[i].cv_rmse < (1.0 - options.min_cv_improvement) * cv_now &&
-                    tests[i].cv_rmse <= (1.0 + options.min_cv_improvement) * tests[best].cv_rmse)
-                    best = static_cast<int>(i);
-        if (best >= 0) tests[best].accepted = true;
-        result.rounds.push_back(tests);
-        if (best < 0) break;
-
-        m.terms.push_back(terms[best]);
-        fit = fits[best];
-        AddedEffect e;
-        e.variable = terms[best].variable;
-        e.form = terms[best].form;
-        e.kind = terms[best].kind;
-        const auto all = estimates(m, fit);
-        e.params.assign(all.end() - static_cast<long>(terms[best].param_names.size()), all.end());
-        for (auto& p : e.params) p.name = p.name.substr(e.variable.size() + 2);
-        e.f_statistic = tests[best].f_statistic;
-        e.p_value = tests[best].p_value;
-        e.p_holm = tests[best].p_holm;
-        e.candidates_tried = static_cast<int>(tests.size());
-        e.cv_rmse_before = cv_now;
-        e.cv_rmse_after = tests[best].cv_rmse;
-        cv_now = e.cv_rmse_after;
-        result.effects.push_back(e);
-        done.insert(e.variable);
+    result.params_before = estimates(base, before.fit);
+    result.fitted_before = before.fitted;
+    result.before = before.errors;
+    result.lack_of_fit_before = before.lack_of_fit;
+    result.params_after = estimates(search.model, after.fit);
+    result.fitted_after = after.fitted;
+    result.after = after.errors;
+    result.lack_of_fit_after = after.lack_of_fit;
+    // Each effect's parameters as fitted with the others (the reported fit).
+    auto p = result.params_after.begin() + static_cast<long>(base.param_names.size());
+    for (std::size_t k = 0; k < result.effects.size(); ++k) {
+        auto& e = result.effects[k];
+        const auto count = static_cast<long>(search.model.terms[k].param_names.size());
+        e.params.assign(p, p + count);
+        for (auto& q : e.params) q.name = q.name.substr(e.variable.size() + 2);
+        p += count;
     }
-
-    result.params_after = estimates(m, fit);
-    result.fitted_after = predictions(s, m, fit.params);
-    const auto e1 = errors_of(s, result.fitted_after);
-    result.after = {e1.rmse, cv_now, e1.mape};
-    result.lack_of_fit_after = lack_of_fit(s, m, fit.params);
+    // Repeated searches repeat their warnings.
+    std::vector<std::string> unique;
+    for (auto& w : result.warnings)
+        if (std::find(unique.begin(), unique.end(), w) == unique.end()) unique.push_back(std::move(w));
+    result.warnings = std::move(unique);
     return result;
 }
 
@@ -664,6 +1083,7 @@ nlohmann::json DiagnoseResult::to_json() const {
         j["effects"].push_back({{"variable", e.variable},
                                 {"form", e.form},
                                 {"kind", e.kind},
+                                {"regime", e.regime.empty() ? nlohmann::json(nullptr) : nlohmann::json(e.regime)},
                                 {"params", params},
                                 {"std_errors", se},
                                 {"f_statistic", e.f_statistic},
@@ -688,6 +1108,7 @@ nlohmann::json DiagnoseResult::to_json() const {
             r.push_back({{"variable", c.variable},
                          {"form", c.form},
                          {"kind", c.kind},
+                         {"regime", c.regime.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.regime)},
                          {"extra_params", c.extra_params},
                          {"f_statistic", c.f_statistic},
                          {"p_value", c.p_value},
@@ -697,6 +1118,19 @@ nlohmann::json DiagnoseResult::to_json() const {
         rounds_json.push_back(r);
     }
     j["rounds"] = rounds_json;
+    j["flow_mode_rule"] = flow_mode_rule.empty() ? nlohmann::json(nullptr) : nlohmann::json(flow_mode_rule);
+    nlohmann::json flagged = nlohmann::json::array();
+    for (const auto& o : outliers.rows)
+        flagged.push_back({{"line", o.line},
+                           {"observed", o.observed},
+                           {"fitted", finite_or_null(o.fitted)},
+                           {"studentized_residual", finite_or_null(o.studentized)}});
+    j["outliers"] = {{"alpha", outliers.alpha},
+                     {"threshold", finite_or_null(outliers.threshold)},
+                     {"rows", flagged},
+                     {"with_outliers", errors_json(outliers.with_outliers)},
+                     {"without_outliers", errors_json(outliers.without_outliers)},
+                     {"dropped", outliers.dropped}};
     j["warnings"] = warnings;
     nlohmann::json rows = nlohmann::json::array();
     for (std::size_t i = 0; i < observed.size(); ++i)

@@ -1,5 +1,6 @@
 #include "analytics/diagnose_synthetic.hpp"
 
+#include "analytics/diagnose.hpp"
 #include "analytics/discharge_models.hpp"
 
 #include <algorithm>
@@ -43,11 +44,14 @@ struct Condition {
 const std::vector<std::pair<std::string, std::string>>& synthetic_effects() {
     static const std::vector<std::pair<std::string, std::string>> effects{
         {"moisture", "moisture_pct"}, {"hopper_angle", "theta_deg"}, {"annulus", "d_p_m"},
-        {"drift", "run_order"},       {"operator", "operator"},      {"curved_locus", "sigma_Pa"}};
+        {"drift", "run_order"},       {"operator", "operator"},      {"curved_locus", "sigma_Pa"},
+        {"vibration_by_mode", "vibration_Hz"}, {"hopper_angle+vibration_by_mode", "vibration_Hz"}, {"outlier", ""}};
     return effects;
 }
 
-MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
+MeasuredData make_synthetic_set(const SyntheticSpec& spec) { return make_synthetic(spec).data; }
+
+SyntheticSet make_synthetic(const SyntheticSpec& spec) {
     const bool shear = spec.model == "failure-line";
     const bool rectangular = spec.model == "oldal-rect";
     if (!shear && !rectangular && spec.model != "oldal" && spec.model != "beverloo" && spec.model != "johanson")
@@ -58,6 +62,11 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
     if ((spec.effect == "curved_locus") != shear && (spec.effect == "curved_locus" || spec.effect == "hopper_angle" ||
                                                      spec.effect == "annulus"))
         throw std::invalid_argument("synthetic set: effect " + spec.effect + " does not apply to " + spec.model);
+    const bool by_mode = spec.effect == "vibration_by_mode" || spec.effect == "hopper_angle+vibration_by_mode";
+    const bool hopper_angle = spec.effect == "hopper_angle" || spec.effect == "hopper_angle+vibration_by_mode";
+    if (by_mode && spec.model != "beverloo" && spec.model != "oldal")
+        throw std::invalid_argument("synthetic set: effect " + spec.effect + " needs a conical model that ignores "
+                                    "the angle (beverloo, oldal), not " + spec.model);
     if (spec.replicates < 1) throw std::invalid_argument("synthetic set: replicates must be >= 1");
 
     // A factorial design of conditions, like a lab campaign.
@@ -67,7 +76,9 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
     } else {
         const std::vector<double> outlets = rectangular ? std::vector<double>{0.02, 0.035, 0.05}
                                                         : std::vector<double>{0.025, 0.035, 0.05};
-        const std::vector<double> angles = spec.model == "johanson" ? std::vector<double>{10, 20, 30}
+        // The flow-mode effect needs every mode: the seed's seven angles (mass 10-20, mixed 30-40, funnel 50-70).
+        const std::vector<double> angles = by_mode ? std::vector<double>{10, 20, 30, 40, 50, 60, 70}
+                                           : spec.model == "johanson" ? std::vector<double>{10, 20, 30}
                                            : rectangular            ? std::vector<double>{20, 60}
                                                                     : std::vector<double>{20, 40, 60};
         const std::vector<double> depths = rectangular ? std::vector<double>{0.04, 0.07} : std::vector<double>{0};
@@ -102,6 +113,7 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
                                    std::tan(min_theta * M_PI / 180)) * 180 / M_PI;
     const double mu_b = 0.55, tau_c = 400, sigma0 = 7e3;
 
+    const double max_vibration = 50;  // vibration_Hz is 0, 25 or 50
     std::normal_distribution<double> normal(0, 1);
     std::uniform_real_distribution<double> moisture_dist(10, 16);
     std::uniform_int_distribution<int> operator_dist(0, 2), vibration_dist(0, 2);
@@ -113,7 +125,7 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
         const auto& c = runs[order[i]];
         const double moisture = std::round(moisture_dist(rng) * 10) / 10, temperature = 20 + 2 * normal(rng);
         const std::string op(1, static_cast<char>('A' + operator_dist(rng)));
-        const double vibration = 25.0 * vibration_dist(rng);
+        const double vibration = max_vibration / 2 * vibration_dist(rng);
         double y;
         if (shear) {
             const double n_exp = spec.effect == "curved_locus" ? 1 - spec.effect_size : 1.0;
@@ -130,7 +142,13 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
         if (spec.effect == "moisture") y *= 1 - spec.effect_size * (moisture - 13) / 6;
         if (spec.effect == "drift") y *= 1 - spec.effect_size * i / (n - 1.0);
         if (spec.effect == "operator" && op == "C") y *= 1 + spec.effect_size;
-        if (spec.effect == "hopper_angle") y *= rose_tanaka_factor(c.theta, phi_d);
+        if (hopper_angle) y *= rose_tanaka_factor(c.theta, phi_d);
+        if (by_mode) {
+            // +effect_size/2 in mass flow at the strongest vibration, -effect_size/2 in funnel flow: effect_size apart.
+            const auto mode = flow_mode_by_seed_classes(c.theta);
+            const double sign = mode == FlowMode::mass ? 1.0 : mode == FlowMode::funnel ? -1.0 : 0.0;
+            y *= 1 + sign * spec.effect_size / 2 * vibration / max_vibration;
+        }
         if (spec.effect == "annulus")
             y *= std::pow((c.outlet - k_true * c.dp) / (c.outlet - k0 * c.dp), exponent);
         clean[i] = y;
@@ -159,6 +177,12 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
         t.number("vibration_Hz", vibration);
         t.data.lines.push_back(static_cast<int>(i + 2));
     }
+    SyntheticSet set;
+    if (spec.effect == "outlier") {
+        const std::size_t row = std::uniform_int_distribution<std::size_t>(0, n - 1)(rng);
+        clean[row] *= 1 + (std::bernoulli_distribution(0.5)(rng) ? 1 : -1) * spec.effect_size;
+        set.outlier_line = t.data.lines[row];
+    }
     double mean = 0;
     for (double v : clean) mean += v / n;
     auto& response = t.column(shear ? "tau_Pa" : "W_kg_s", true);
@@ -167,7 +191,8 @@ MeasuredData make_synthetic_set(const SyntheticSpec& spec) {
         response.values[i] = shear ? clean[i] + spec.noise * mean * e : clean[i] * std::exp(spec.noise * e);
         response.text[i] = format(response.values[i]);
     }
-    return t.data;
+    set.data = std::move(t.data);
+    return set;
 }
 
 }  // namespace demcal::analytics

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -85,7 +86,12 @@ constexpr const char* diagnose_help = R"(Data: CSV with a header of column names
 Method: least-squares fit (GSL; discharge on log W), lack of fit against pure error of replicates, every column tried
 as a candidate effect (nested F test, Holm correction over the candidates of a round), cross-validation leaving whole
 conditions out; an effect is added when significant and it cuts the CV RMSE by at least --min-cv-gain; repeated until
-nothing more is. See examples/diagnose/README.md.)";
+nothing more is. Candidates include a covariate whose effect differs by regime: by flow mode (conical hoppers; from
+the angle by the seed's classes, mass < 30 <= mixed <= 40 < funnel deg, or by Jenike's limit with
+--effective-friction-deg and --wall-friction-deg), by the values of a --regime-column, or linearly with a condition
+variable (x*z). Outliers: externally studentized residuals beyond a Bonferroni threshold (--outlier-alpha) are named
+by file line; the effect search never uses them; --drop-outliers also reports the fits without them.
+See examples/diagnose/README.md.)";
 
 std::string sci(double v) {
     if (!std::isfinite(v)) return "n/a";
@@ -94,30 +100,60 @@ std::string sci(double v) {
     return buf;
 }
 
+// "vibration_Hz by flow_mode" for a regime effect, the column otherwise.
+std::string effect_name(const std::string& variable, const std::string& kind, const std::string& regime) {
+    if (regime.empty()) return variable;
+    return variable + (kind == "interaction" ? " x " : " by ") + regime;
+}
+
 // Residual of row i: relative [%] for discharge rates, absolute for shear stresses.
 double residual_of(const analytics::DiagnoseResult& r, double fitted, std::size_t i) {
     return r.residual_scale == "relative" ? 100.0 * (r.observed[i] - fitted) / fitted : r.observed[i] - fitted;
 }
 
+// The regime of each row for the first regime effect added (flow mode or a column's value); empty when none.
+std::vector<std::string> regime_labels(const analytics::DiagnoseResult& r, const analytics::MeasuredData& data) {
+    for (const auto& e : r.effects) {
+        if (e.kind != "regime") continue;
+        if (e.regime == "flow_mode") return r.flow_mode_of_row;
+        if (const auto* c = data.find(e.regime)) return c->text;
+    }
+    return {};
+}
+
 // Residuals against the fitted value and against the first added effect's column (or the file order): before/after.
+// Rows are coloured by the regime of a regime effect, so that its slopes show; outliers are drawn apart.
 void plot_residuals(const analytics::DiagnoseResult& r, const analytics::MeasuredData& data,
                     const std::filesystem::path& dat, const std::filesystem::path& before,
                     const std::filesystem::path& after) {
+    // x: the covariate of a regime effect (its slopes by regime are the finding), else the first effect's column.
     std::string x_name = "row in file";
     const analytics::DataColumn* x_col = nullptr;
-    for (const auto& e : r.effects)
-        if (const auto* c = data.find(e.variable); c && c->numeric) {
-            x_col = c;
-            x_name = e.variable;
-            break;
-        }
+    for (const bool regime_only : {true, false}) {
+        for (const auto& e : r.effects)
+            if (const auto* c = data.find(e.variable); c && c->numeric && (!regime_only || e.kind == "regime")) {
+                x_col = c;
+                x_name = e.variable;
+                break;
+            }
+        if (x_col) break;
+    }
+    const auto labels = regime_labels(r, data);
+    std::vector<std::string> levels;  // in order of appearance
+    for (const auto& l : labels)
+        if (std::find(levels.begin(), levels.end(), l) == levels.end()) levels.push_back(l);
+    if (levels.empty()) levels.push_back("rows");
     {
         std::ofstream out(dat);
-        out << "# line observed fitted_before fitted_after residual_before residual_after x\n";
-        for (std::size_t i = 0; i < r.observed.size(); ++i)
+        out << "# line observed fitted_before fitted_after residual_before residual_after x outlier regime_index\n";
+        for (std::size_t i = 0; i < r.observed.size(); ++i) {
+            const bool outlier = std::any_of(r.outliers.rows.begin(), r.outliers.rows.end(),
+                                             [&](const analytics::Outlier& o) { return o.line == r.lines[i]; });
             out << r.lines[i] << " " << r.observed[i] << " " << r.fitted_before[i] << " " << r.fitted_after[i] << " "
                 << residual_of(r, r.fitted_before[i], i) << " " << residual_of(r, r.fitted_after[i], i) << " "
-                << (x_col ? x_col->values[i] : static_cast<double>(i + 1)) << "\n";
+                << (x_col ? x_col->values[i] : static_cast<double>(i + 1)) << " " << (outlier ? 1 : 0) << " "
+                << (labels.empty() ? 0 : std::find(levels.begin(), levels.end(), labels[i]) - levels.begin()) << "\n";
+        }
         if (!out) throw UserError("cannot write " + dat.string());
     }
     const std::string unit = r.residual_scale == "relative" ? "residual [%]" : "residual [Pa]";
@@ -127,12 +163,23 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
         std::ostringstream g;
         g << "set multiplot layout 1,2 title '" << r.model << " residuals " << title
           << (which == 1 ? " (" + std::to_string(r.effects.size()) + " effect(s) added)" : std::string()) << "' noenhanced\n"
-          << "set grid\nset ylabel '" << unit << "'\nunset key\nset title noenhanced\n"
-          << "set xlabel 'fitted " << r.response << "' noenhanced\n"
-          << "plot " << gnuplot_quote(dat) << " using " << fitted << ":" << col << " with points pt 7 ps 0.8, 0 lt -1\n"
-          << "set xlabel '" << x_name << "' noenhanced\n"
-          << "plot " << gnuplot_quote(dat) << " using 7:" << col << " with points pt 7 ps 0.8, 0 lt -1\n"
-          << "unset multiplot\n";
+          << "set grid\nset ylabel '" << unit << "'\nset key top right\nset title noenhanced\n"
+          << "set xlabel 'fitted " << r.response << "' noenhanced\n";
+        // Outliers (column 8 = 1) drawn apart, so that the eye does not read them as a trend.
+        auto points = [&](const std::string& x) {
+            const std::string q = gnuplot_quote(dat), y = "$" + std::to_string(col);
+            std::string series;
+            for (std::size_t k = 0; k < levels.size(); ++k)
+                series += q + " using " + x + ":($8 == 0 && $9 == " + std::to_string(k) + " ? " + y +
+                          " : 1/0) with points pt 7 ps 0.8 lc " + std::to_string(k + 1) + " title '" + levels[k] +
+                          "', ";
+            if (!r.outliers.rows.empty())
+                series += q + " using " + x + ":($8 == 1 ? " + y +
+                          " : 1/0) with points pt 6 ps 2 lc rgb '#d62728' title 'outliers', ";
+            return series + "0 lt -1 notitle\n";
+        };
+        g << "plot " << points(std::to_string(fitted)) << "set xlabel '" << x_name << "' noenhanced\n"
+          << "plot " << points("7") << "unset multiplot\n";
         render_gnuplot(which == 0 ? before : after, g.str(), 1100, 450);
     }
 }
@@ -158,11 +205,31 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
     md << "## Effects added\n\n";
     if (r.effects.empty()) md << "None: no candidate was significant after Holm's correction and improved the CV RMSE.\n\n";
     for (const auto& e : r.effects) {
-        md << "- **" << e.variable << "** (" << e.kind << "): `" << e.form << "`; ";
+        md << "- **" << effect_name(e.variable, e.kind, e.regime) << "** (" << e.kind << "): `" << e.form << "`; ";
         for (const auto& p : e.params) md << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << "; ";
         md << "F = " << sci(e.f_statistic) << ", p = " << sci(e.p_value) << ", Holm p = " << sci(e.p_holm) << " over "
            << e.candidates_tried << " candidates; CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after)
            << "\n";
+    }
+    if (!r.flow_mode_rule.empty()) md << "\nFlow mode (a regime of the candidates): " << r.flow_mode_rule << ".\n";
+    md << "\n## Outliers\n\nExternally studentized residuals under the final model, Bonferroni threshold |t| > "
+       << sci(r.outliers.threshold) << " (alpha " << sci(r.outliers.alpha) << " over " << r.n
+       << " rows). The effect search ran without the rows flagged.\n\n";
+    if (r.outliers.rows.empty()) {
+        md << "None.\n";
+    } else {
+        md << "| line | observed | fitted | studentized residual |\n|---|---|---|---|\n";
+        for (const auto& o : r.outliers.rows)
+            md << "| " << o.line << " | " << sci(o.observed) << " | " << sci(o.fitted) << " | " << sci(o.studentized)
+               << " |\n";
+        const auto& w = r.outliers.with_outliers;
+        const auto& wo = r.outliers.without_outliers;
+        md << "\n| final model fitted | RMSE | CV RMSE | MAPE [%] |\n|---|---|---|---|\n"
+           << "| with them (" << r.n << " rows) | " << sci(w.rmse) << " | " << sci(w.cv_rmse) << " | " << sci(w.mape)
+           << " |\n| without them (" << r.n - static_cast<int>(r.outliers.rows.size()) << " rows) | " << sci(wo.rmse)
+           << " | " << sci(wo.cv_rmse) << " | " << sci(wo.mape) << " |\n\nThe fits reported above are "
+           << (r.outliers.dropped ? "without them (--drop-outliers)" : "with them (--drop-outliers refits without)")
+           << ".\n";
     }
     md << "\n## Parameters\n\n| parameter | before | after |\n|---|---|---|\n";
     for (std::size_t i = 0; i < r.params_after.size(); ++i) {
@@ -174,10 +241,11 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
     }
     md << "\n## Candidates examined\n\n";
     for (std::size_t k = 0; k < r.rounds.size(); ++k) {
-        md << "Round " << k + 1 << "\n\n| column | kind | form | F | p | Holm p | CV RMSE | added |\n"
+        md << "Round " << k + 1 << "\n\n| effect | kind | form | F | p | Holm p | CV RMSE | added |\n"
            << "|---|---|---|---|---|---|---|---|\n";
         for (const auto& c : r.rounds[k])
-            md << "| " << c.variable << " | " << c.kind << " | `" << c.form << "` | " << sci(c.f_statistic) << " | "
+            md << "| " << effect_name(c.variable, c.kind, c.regime) << " | " << c.kind << " | `" << c.form << "` | "
+               << sci(c.f_statistic) << " | "
                << sci(c.p_value) << " | " << sci(c.p_holm) << " | " << sci(c.cv_rmse) << " | "
                << (c.accepted ? "yes" : "") << " |\n";
         md << "\n";
@@ -195,6 +263,7 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
 struct DiagnoseArgs {
     std::string model, data, json_out, report_out;
     analytics::DiagnoseOptions options;
+    double effective_friction_deg = std::nan(""), wall_friction_deg = std::nan("");  // NaN: not given
     bool no_plots = false;
 };
 
@@ -204,7 +273,10 @@ void run_diagnose(const DiagnoseArgs& a) {
     try {
         const auto kind = analytics::data_kind_of(a.model);
         data = analytics::read_measured_csv(a.data, kind);
-        r = analytics::diagnose(data, a.model, a.options);
+        auto options = a.options;
+        if (!std::isnan(a.effective_friction_deg)) options.effective_friction_deg = a.effective_friction_deg;
+        if (!std::isnan(a.wall_friction_deg)) options.wall_friction_deg = a.wall_friction_deg;
+        r = analytics::diagnose(data, a.model, options);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
@@ -213,7 +285,8 @@ void run_diagnose(const DiagnoseArgs& a) {
               << "before: RMSE " << sci(r.before.rmse) << "  CV RMSE " << sci(r.before.cv_rmse) << "  MAPE "
               << sci(r.before.mape) << " %\n";
     for (const auto& e : r.effects) {
-        std::cout << "  + " << e.variable << " (" << e.kind << "): " << e.form << "\n    ";
+        std::cout << "  + " << effect_name(e.variable, e.kind, e.regime) << " (" << e.kind << "): " << e.form
+                  << "\n    ";
         for (const auto& p : e.params) std::cout << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << "  ";
         std::cout << "p = " << sci(e.p_value) << " (Holm " << sci(e.p_holm) << ", " << e.candidates_tried
                   << " candidates), CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after) << "\n";
@@ -221,6 +294,16 @@ void run_diagnose(const DiagnoseArgs& a) {
     if (r.effects.empty()) std::cout << "  no effect added: nothing significant and better out of sample\n";
     std::cout << "after:  RMSE " << sci(r.after.rmse) << "  CV RMSE " << sci(r.after.cv_rmse) << "  MAPE "
               << sci(r.after.mape) << " %\n";
+    for (const auto& o : r.outliers.rows)
+        std::cout << "outlier: line " << o.line << ": observed " << sci(o.observed) << ", fitted " << sci(o.fitted)
+                  << ", studentized residual " << sci(o.studentized) << " (|t| > " << sci(r.outliers.threshold)
+                  << " flags)\n";
+    if (!r.outliers.rows.empty())
+        std::cout << "  final model with them: RMSE " << sci(r.outliers.with_outliers.rmse) << "  CV RMSE "
+                  << sci(r.outliers.with_outliers.cv_rmse) << "; without: RMSE "
+                  << sci(r.outliers.without_outliers.rmse) << "  CV RMSE " << sci(r.outliers.without_outliers.cv_rmse)
+                  << (r.outliers.dropped ? " (reported fits: without)" : " (reported fits: with; --drop-outliers)")
+                  << "\n";
     for (const auto& w : r.warnings) std::cout << "warning: " << w << "\n";
     if (!a.json_out.empty()) write_text(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
@@ -271,6 +354,21 @@ void add_discharge_commands(CLI::App& app) {
     diagnose->add_option("--max-effects", args->options.max_effects, "most effects to add")
         ->capture_default_str()
         ->check(number_in(0, 10));
+    diagnose->add_option("--regime-column", args->options.regime_columns,
+                         "a column whose values may change a covariate's effect (repeatable); the flow mode is "
+                         "always tried for conical hoppers");
+    diagnose->add_option("--effective-friction-deg", args->effective_friction_deg,
+                         "effective angle of internal friction delta_e: with --wall-friction-deg, the flow mode "
+                         "comes from Jenike's mass-flow limit instead of the seed's classes")
+        ->check(number_in(0, 90));
+    diagnose->add_option("--wall-friction-deg", args->wall_friction_deg, "wall friction angle phi_w (see above)")
+        ->check(number_in(0, 90));
+    diagnose->add_option("--outlier-alpha", args->options.outlier_alpha,
+                         "chance of flagging any row of a set without outliers (Bonferroni over the rows)")
+        ->capture_default_str()
+        ->check(number_in(1e-6, 0.5));
+    diagnose->add_flag("--drop-outliers", args->options.drop_outliers,
+                       "report the fits without the rows flagged as outliers (the search never uses them)");
     diagnose->footer(diagnose_help);
     diagnose->callback([args] { run_diagnose(*args); });
 }
