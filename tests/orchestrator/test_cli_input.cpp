@@ -182,7 +182,7 @@ TEST_CASE("a YADE path that is a folder, empty or not executable is refused befo
     std::ofstream(dir / "not-executable") << "#!/bin/sh\n";
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
     const std::vector<std::pair<std::string, std::string>> cases{
-        {dir.string(), "is a folder, not a program"}, {"", "yade = '': empty"},
+        {dir.string(), "is a folder, not a program"}, {"", "--yade: an empty value"},
         {(dir / "not-executable").string(), "is not executable"}, {(dir / "none").string(), "does not exist"}};
     for (const auto& [yade, expect] : cases) {
         INFO(yade);
