@@ -2,6 +2,7 @@
 // controls with decoy columns (replicate, run_order, moisture, temperature, operator, vibration).
 #include "analytics/diagnose.hpp"
 #include "analytics/diagnose_synthetic.hpp"
+#include "synthetic_spec.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -10,20 +11,8 @@
 #include <sstream>
 
 using namespace demcal::analytics;
+using demcal::analytics::test::spec;
 
-namespace {
-SyntheticSpec spec(const std::string& model, const std::string& effect, double size, std::uint64_t seed,
-                   double noise = 0.03, int replicates = 2) {
-    SyntheticSpec s;
-    s.model = model;
-    s.effect = effect;
-    s.effect_size = size;
-    s.seed = seed;
-    s.noise = noise;
-    s.replicates = replicates;
-    return s;
-}
-}  // namespace
 
 TEST_CASE("diagnose names the column of an undeclared effect and halves the CV error", "[diagnose]") {
     struct Case {

@@ -1,6 +1,7 @@
 // diagnose: outliers named by their file line (externally studentized residuals, Bonferroni), never made an effect.
 #include "analytics/diagnose.hpp"
 #include "analytics/diagnose_synthetic.hpp"
+#include "synthetic_spec.hpp"
 
 #include <catch2/catch.hpp>
 #include <gsl/gsl_fit.h>
@@ -10,19 +11,9 @@
 #include <sstream>
 
 using namespace demcal::analytics;
+using demcal::analytics::test::spec;
 
 namespace {
-SyntheticSpec spec(const std::string& model, const std::string& effect, double size, std::uint64_t seed,
-                   double noise = 0.03, int replicates = 2) {
-    SyntheticSpec s;
-    s.model = model;
-    s.effect = effect;
-    s.effect_size = size;
-    s.seed = seed;
-    s.noise = noise;
-    s.replicates = replicates;
-    return s;
-}
 
 // Multiplies the response of the row at file line `line` by `factor`.
 void spoil(MeasuredData& d, const std::string& response, int line, double factor) {

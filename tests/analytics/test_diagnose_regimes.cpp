@@ -1,6 +1,7 @@
 // diagnose: effects that depend on a regime (flow mode, a categorical column) or on a condition variable (x*z).
 #include "analytics/diagnose.hpp"
 #include "analytics/diagnose_synthetic.hpp"
+#include "synthetic_spec.hpp"
 #include "analytics/discharge_models.hpp"
 
 #include <catch2/catch.hpp>
@@ -11,18 +12,9 @@
 #include <sstream>
 
 using namespace demcal::analytics;
+using demcal::analytics::test::spec;
 
 namespace {
-SyntheticSpec spec(const std::string& model, const std::string& effect, double size, std::uint64_t seed,
-                   double noise = 0.03) {
-    SyntheticSpec s;
-    s.model = model;
-    s.effect = effect;
-    s.effect_size = size;
-    s.seed = seed;
-    s.noise = noise;
-    return s;
-}
 
 DataColumn& column(MeasuredData& d, const std::string& name) {
     for (auto& c : d.columns)
