@@ -1,0 +1,127 @@
+#include "kernel/cases/cohesive_hopper.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include "kernel/silo/input_error.hpp"
+#include "kernel/simulation.hpp"
+
+namespace demcal::kernel::cases {
+
+namespace {
+void check(bool ok, const char* field, double value, const char* rule) {
+  if (!ok || (value != 0 && std::abs(value) < 1e-300))
+    throw std::invalid_argument(std::string(field) + " = " + silo::setting_text(value) + ": " + rule);
+}
+}  // namespace
+
+void validate(const CohesiveHopperCase& c) {
+  check(c.bond_number >= 0 && c.bond_number <= 1e4, "bond_number", c.bond_number, "must be in [0, 1e4]");
+  check(c.frequency >= 0 && c.frequency <= 1000, "frequency", c.frequency, "must be in [0, 1000] Hz");
+  check(c.amplitude >= 0 && c.amplitude <= 0.01, "amplitude", c.amplitude, "must be in [0, 0.01] m");
+  check(c.theta_deg >= 5 && c.theta_deg <= 80, "theta", c.theta_deg, "must be in [5, 80] deg");
+  check(c.grains >= 10 && c.grains <= 20000, "grains", c.grains, "must be in [10, 20000]");
+  check(c.window >= 0.05 && c.window <= 10, "window", c.window, "must be in [0.05, 10] s");
+  if (c.frequency > 0) {
+    // at least 20 steps per period (the time step is about 1.7e-5 s for the default grains)
+    const double dt = 0.25 * M_PI * c.grain_radius * 0.9 * std::sqrt(1000 / (c.young / 2.6)) / (0.1631 * 0.3 + 0.8766);
+    check(1.0 / c.frequency >= 20 * dt, "frequency", c.frequency, "leaves fewer than 20 time steps per period");
+  }
+}
+
+CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
+  validate(c);
+  const auto t0 = std::chrono::steady_clock::now();
+  CohesiveSimulation sim;
+  const int meal = sim.add_material({c.young, 0.3, 1000, "meal"});
+  const int steel = sim.add_material({2e8, 0.3, 7800, "steel"});
+  const double r = c.grain_radius, m = 1000 * 4.0 / 3.0 * M_PI * r * r * r;
+  const double gamma = c.bond_number * m * 9.81 / (3 * M_PI * 0.5 * r);
+  const CohesiveSimulation::PairParams pair{{.restitution = 0.3, .surface_energy = gamma}, {.friction = 0.5},
+                                            {.rolling_friction = 0.05}};
+  sim.set_pair(meal, meal, pair);
+  sim.set_pair(meal, steel, pair);
+  const double th = c.theta_deg * M_PI / 180, hopper_height = (c.bin_radius - c.outlet_radius) / std::tan(th);
+  std::shared_ptr<const WallMotion> shaker;
+  if (c.frequency > 0 && c.amplitude > 0)
+    shaker = std::make_shared<SinusoidalMotion>(Vec3::UnitX(), c.amplitude, c.frequency, c.settle);
+  auto add = [&](const Wall& w) { return sim.add_wall(shaker ? w.moving(shaker) : w); };
+  add(Wall::cone(0, 0, c.outlet_radius, 0, th, c.bin_radius, steel));
+  add(Wall::cylinder(0, 0, c.bin_radius, hopper_height, 0.3, steel));
+  const int plate = add(Wall::disk(0, 0, c.outlet_radius * 1.01, 0, steel));
+  // grains on a jittered lattice inside the hopper, layer by layer from 0.3 of its height up
+  std::mt19937_64 rng(c.seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int placed = 0;
+  for (double z = 0.3 * hopper_height; placed < c.grains; z += 2.2 * r)
+    for (double x = -c.bin_radius; x <= c.bin_radius && placed < c.grains; x += 2.2 * r)
+      for (double y = -c.bin_radius; y <= c.bin_radius && placed < c.grains; y += 2.2 * r) {
+        const double room =
+            c.outlet_radius + (c.bin_radius - c.outlet_radius) * std::min(1.0, z / hopper_height) - 1.5 * r;
+        if (x * x + y * y >= room * room) continue;
+        sim.add_sphere({x + 0.05 * r * u(rng), y + 0.05 * r * u(rng), z}, r * (1 + 0.1 * u(rng)), meal);
+        ++placed;
+      }
+  sim.set_timestep(0.25 * sim.rayleigh_timestep());
+  while (sim.time() < c.settle) sim.step(100);
+  sim.set_wall_enabled(plate, false);
+  const double mass = sim.total_mass();
+  double out = 0;
+  while (sim.time() < c.settle + c.window && out < 0.5 * mass) {
+    sim.step(500);
+    out += sim.remove_bodies_if([](const BodyState& b) { return b.position.z() < -0.02; }).mass;
+  }
+  CohesiveHopperOutcome o;
+  o.discharged_fraction = out / mass;
+  o.peak_acceleration_g = c.amplitude * std::pow(2 * M_PI * c.frequency, 2) / 9.81;
+  o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return o;
+}
+
+void validate(const CohesiveHopperCase& base, const CutoffSearch& s) {
+  if (!(s.lo >= 0 && s.lo < s.hi && s.hi <= 1000))
+    throw std::invalid_argument("bracket = [" + silo::setting_text(s.lo) + ", " + silo::setting_text(s.hi) +
+                                "]: needs 0 <= LO < HI <= 1000 Hz");
+  if (!(s.tol > 0 && s.tol < s.hi - s.lo))
+    throw std::invalid_argument("tol = " + silo::setting_text(s.tol) + ": must be > 0 and below HI - LO");
+  if (s.seeds.empty()) throw std::invalid_argument("seeds: give at least one");
+  CohesiveHopperCase c = base;
+  for (double f : {s.lo, s.hi}) {  // every frequency of the search lies in the bracket: both ends checked
+    c.frequency = f;
+    validate(c);
+  }
+}
+
+CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,
+                         const std::function<void(const CohesiveHopperCase&, const CohesiveHopperOutcome&)>& report) {
+  validate(c, s);
+  auto flows_at = [&](double f) {
+    c.frequency = f;
+    std::size_t flowing = 0;
+    for (unsigned seed : s.seeds) {
+      c.seed = seed;
+      const CohesiveHopperOutcome o = run_cohesive_hopper(c);
+      if (report) report(c, o);
+      flowing += o.flows();
+    }
+    return 2 * flowing >= s.seeds.size();
+  };
+  CutoffResult r;
+  double lo = s.lo, hi = s.hi;
+  if (flows_at(lo)) { r.reason = "flows at the low end of the bracket"; return r; }
+  if (!flows_at(hi)) { r.reason = "arched at the high end of the bracket"; return r; }
+  while (hi - lo > s.tol) {
+    const double mid = 0.5 * (lo + hi);
+    (flows_at(mid) ? hi : lo) = mid;
+  }
+  r.found = true;
+  r.lo = lo;
+  r.hi = hi;
+  return r;
+}
+
+}  // namespace demcal::kernel::cases

@@ -1,0 +1,55 @@
+// A cohesive powder in a small conical hopper, still or vibrating: does the bed arch over the outlet, and from which
+// vibration frequency does it flow (issue 24; the seed's sections 2.1.3 and 3.6). A short case over the kernel: JKR
+// spheres settle with the outlet closed, the outlet opens, and the whole bin vibrates horizontally,
+// x = A sin(2 pi f t), from the opening. The cohesion is the bond number of two equal grains, Bo = F_pulloff / (m g),
+// F_pulloff = 3 pi gamma R*, R* = r/2. Measured results: examples/cohesive_arch/README.md.
+#pragma once
+#include <functional>
+#include <vector>
+
+namespace demcal::kernel::cases {
+
+struct CohesiveHopperCase {
+  double bond_number = 10;       ///< F_pulloff / (m g) of two equal grains [-], >= 0
+  double frequency = 0;          ///< vibration frequency [Hz] (0: still)
+  double amplitude = 1.1e-4;     ///< vibration amplitude [m] (the seed's largest, 0.11 mm)
+  double theta_deg = 30;         ///< hopper half angle from the vertical [deg]
+  double grain_radius = 1e-3;    ///< mean grain radius [m] (+/- 10 %, uniform)
+  double outlet_radius = 6e-3;   ///< [m]
+  double bin_radius = 20e-3;     ///< [m]
+  double young = 5e6;            ///< grains' Young modulus [Pa] (soft: the time step)
+  int grains = 800;
+  unsigned seed = 1;             ///< seed of the jitter of the initial lattice
+  double settle = 0.4;           ///< time with the outlet closed [s]
+  double window = 1.0;           ///< time after the opening within which half the mass must leave to "flow" [s]
+};
+
+/// Throws std::invalid_argument naming the field and the value when a setting is out of range.
+void validate(const CohesiveHopperCase& c);
+
+struct CohesiveHopperOutcome {
+  double discharged_fraction = 0;  ///< of the mass, within the window (the run stops once half has left)
+  double peak_acceleration_g = 0;  ///< A (2 pi f)^2 / g
+  double wall_s = 0;
+  bool flows() const { return discharged_fraction >= 0.5; }  ///< the stated criterion: half the mass out in the window
+};
+
+CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c);
+
+/// The lowest frequency at which the bed flows, by bracketing [lo, hi] and bisection down to `tol` Hz. At each
+/// frequency every seed runs once; the frequency flows when at least half of the seeds flow. `report` sees every run.
+struct CutoffSearch {
+  double lo = 0, hi = 400, tol = 25;
+  std::vector<unsigned> seeds{1};
+};
+struct CutoffResult {
+  bool found = false;
+  double lo = 0, hi = 0;  ///< the bracket: arched at lo, flows at hi [Hz]
+  const char* reason = "";  ///< when not found: which end failed
+};
+/// Throws std::invalid_argument naming the setting when the search or the case at either end of the bracket is invalid.
+void validate(const CohesiveHopperCase& c, const CutoffSearch& s);
+CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,
+                         const std::function<void(const CohesiveHopperCase&, const CohesiveHopperOutcome&)>& report);
+
+}  // namespace demcal::kernel::cases
