@@ -3,6 +3,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
+#include "app/silo_material.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
@@ -35,6 +36,7 @@ constexpr double kDefaultSlotWidth = 0.03;
 
 struct SiloCli {
     std::string geometry_file;
+    std::string material_file;
     // Geometry: a value counts only where its option was given (sub.count); otherwise the --geometry file's, then
     // the default (SiloGeometry's: the seed's silo).
     double theta = 0;
@@ -311,6 +313,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.fill_time_min = std::min(s.fill_time_min, o.fill_time);
     s.time_step = o.dt;
     s.time_step_fraction = o.dt_fraction;
+    if (!o.material_file.empty()) s.materials = read_silo_material(o.material_file);
     s.materials.stiffness_scale = o.stiffness_scale;
     s.stop_fraction = o.stop_fraction;
     s.skin = o.skin;
@@ -679,6 +682,9 @@ void add_silo_command(CLI::App& app) {
         "outlet, then discharged; writes discharge.csv, summary.json (rate, flow pattern), section.png");
     sub->add_option("--theta", o->theta, "hopper half angle from the vertical [deg], 0 < theta < 90 (required unless "
                                          "--geometry gives theta_deg)");
+    sub->add_option("--material", o->material_file,
+                    "material file (grain, wall, grain-grain and grain-wall pairs; default: the seed's Table 2.1, "
+                    "examples/materials/silo_wheat_table21.json)");
     sub->add_option("--geometry", o->geometry_file,
                     "geometry JSON (shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m; see "
                     "examples/silo/); options given on the command line win");

@@ -172,6 +172,24 @@ int add_silo_walls(Simulation& sim, const SiloGeometry& g, int steel, double wal
 }  // namespace
 
 void validate(const SiloCaseSettings& s) {
+    // the materials first: the checks below derive masses and time steps from them
+    const auto solid = [](const Material& m, const std::string& name) {
+        if (!(m.shear_modulus >= 1e3 && m.shear_modulus <= 1e12))
+            reject_setting(name + ".shear_modulus", m.shear_modulus, "must lie in [1e3, 1e12] Pa");
+        if (!(m.poisson > -1 && m.poisson < 0.5)) reject_setting(name + ".poisson", m.poisson, "must lie in (-1, 0.5)");
+        if (!(m.density >= 10 && m.density <= 1e5)) reject_setting(name + ".density", m.density, "must lie in [10, 1e5] kg/m^3");
+    };
+    solid(s.materials.wheat, "grain");
+    solid(s.materials.steel, "wall");
+    const auto pair = [](const PairCoefficients& p, const std::string& name) {
+        if (!(p.restitution > 0 && p.restitution <= 1))
+            reject_setting(name + ".restitution", p.restitution, "must lie in (0, 1]");
+        if (!(p.friction >= 0 && p.friction <= 10)) reject_setting(name + ".friction", p.friction, "must lie in [0, 10]");
+        if (!(p.rolling_friction >= 0 && p.rolling_friction <= 1))
+            reject_setting(name + ".rolling_friction", p.rolling_friction, "must lie in [0, 1]");
+    };
+    pair(s.materials.wheat_wheat, "grain_grain");
+    pair(s.materials.wheat_steel, "grain_wall");
     validate(s.geometry, wheat_length);
     if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
     if (s.fill_mass == 0 && s.particles < 1) reject_setting("particles", double(s.particles), "must be at least 1");

@@ -1,0 +1,79 @@
+#include "app/silo_material.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "app/cli_support.hpp"
+#include "app/commands.hpp"
+
+namespace demcal {
+
+namespace {
+
+namespace ks = kernel::silo;
+using json = nlohmann::json;
+
+// Refuses keys other than `known` (keys starting with '_' are comments) and returns the object at `where`.
+const json& object_with(const json& j, const std::string& file, const std::string& where,
+                        const std::set<std::string>& known) {
+    if (!j.is_object()) throw UserError(file + ": " + where + " must be a JSON object");
+    for (const auto& [key, value] : j.items()) {
+        if (key.rfind("_", 0) == 0 || known.count(key)) continue;
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        throw UserError(file + ": unknown key '" + (where.empty() ? "" : where + ".") + key.substr(0, 40) +
+                        "' (known: " + list + ")");
+    }
+    return j;
+}
+
+double number(const json& j, const std::string& file, const std::string& field, const std::string& key) {
+    if (!j.contains(key)) throw UserError(file + ": " + field + "." + key + " is missing");
+    const json& v = j.at(key);
+    if (!v.is_number()) throw UserError(file + ": " + field + "." + key + " = " + v.dump().substr(0, 40) + ": must be a number");
+    return v.get<double>();
+}
+
+ks::Material solid(const json& root, const std::string& file, const std::string& field, bool grain) {
+    if (!root.contains(field)) throw UserError(file + ": " + field + " is missing");
+    std::set<std::string> keys{"shear_modulus_Pa", "young_Pa", "poisson", "density_kg_m3"};
+    if (grain) keys.insert("shape");
+    const json& j = object_with(root.at(field), file, field, keys);
+    if (grain && j.contains("shape") && j.at("shape") != "wheat-clump")
+        throw UserError(file + ": " + field + ".shape = " + j.at("shape").dump().substr(0, 40) +
+                        ": the silo case has one grain shape, \"wheat-clump\" (the seed's 3-sphere grain)");
+    ks::Material m{};
+    m.poisson = number(j, file, field, "poisson");
+    m.density = number(j, file, field, "density_kg_m3");
+    const bool has_g = j.contains("shear_modulus_Pa"), has_e = j.contains("young_Pa");
+    if (has_g == has_e)
+        throw UserError(file + ": " + field + ": give exactly one of shear_modulus_Pa and young_Pa (G = E / (2 (1 + nu)))");
+    m.shear_modulus = has_g ? number(j, file, field, "shear_modulus_Pa")
+                            : number(j, file, field, "young_Pa") / (2 * (1 + m.poisson));
+    return m;
+}
+
+ks::PairCoefficients pair(const json& root, const std::string& file, const std::string& field) {
+    if (!root.contains(field)) throw UserError(file + ": " + field + " is missing");
+    const json& j = object_with(root.at(field), file, field, {"restitution", "friction", "rolling_friction"});
+    return {number(j, file, field, "restitution"), number(j, file, field, "friction"),
+            number(j, file, field, "rolling_friction")};
+}
+
+}  // namespace
+
+ks::WheatMaterials read_silo_material(const std::string& file) {
+    const json root = read_json_file(file, "material");
+    object_with(root, file, "", {"name", "description", "grain", "wall", "grain_grain", "grain_wall"});
+    ks::WheatMaterials m;
+    m.wheat = solid(root, file, "grain", true);
+    m.steel = solid(root, file, "wall", false);
+    m.wheat_wheat = pair(root, file, "grain_grain");
+    m.wheat_steel = pair(root, file, "grain_wall");
+    return m;
+}
+
+}  // namespace demcal

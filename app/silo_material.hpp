@@ -1,0 +1,15 @@
+// The silo's material file (demcal silo --material FILE.json): the grain, the wall and the two pair sets of the seed's
+// Table 2.1, every field required, E or G for each solid, unknown keys refused. The seed's wheat is
+// examples/materials/silo_wheat_table21.json (equal to the built-in default).
+#pragma once
+#include <string>
+
+#include "kernel/silo/wheat.hpp"
+
+namespace demcal {
+
+/// Reads FILE into the silo's materials (the stiffness scale is left as it is). Throws UserError naming the file, the
+/// field and the value.
+kernel::silo::WheatMaterials read_silo_material(const std::string& file);
+
+}  // namespace demcal
