@@ -66,6 +66,7 @@ struct SiloCli {
     bool no_plots = false;
     double checkpoint_every = 900;
     bool no_checkpoint = false;
+    bool check_only = false;  // validate the settings, write nothing (demcal vibration checks its runs this way)
     double wall_limit = 0;
     std::string resume;
 };
@@ -459,6 +460,10 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
+    if (o.check_only) {
+        std::cout << "silo: the settings are valid (--check: nothing run, nothing written)\n";
+        return;
+    }
     std::error_code ec;
     const bool created_out = fs::create_directories(dir, ec);
     if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
@@ -736,6 +741,7 @@ void add_silo_command(CLI::App& app) {
                     "the outputs are written)")
         ->capture_default_str();
     sub->add_flag("--no-checkpoint", o->no_checkpoint, "write no checkpoint");
+    sub->add_flag("--check", o->check_only, "check the settings and exit (0: valid, 2: refused); nothing is written");
     sub->add_option("--wall-limit", o->wall_limit,
                     "stop after this many wall-clock seconds of this session (0: none), at the end of a record "
                     "interval, with a checkpoint written; exit status 75: not finished, continue with --resume "

@@ -19,6 +19,7 @@ inline constexpr int kExitResumeLater = 75;
 void add_shear_commands(CLI::App& app);        // shear, status, resume            (cmd_shear.cpp)
 void add_silo_command(CLI::App& app);          // silo                              (cmd_silo.cpp)
 void add_cutoff_command(CLI::App& app);        // cutoff                            (cmd_cutoff.cpp)
+void add_vibration_command(CLI::App& app);     // vibration                         (cmd_vibration.cpp)
 void add_discharge_commands(CLI::App& app);    // predict, diagnose                 (cmd_diagnose.cpp)
 void add_calibration_commands(CLI::App& app);  // sensitivity, calibrate, enlarge   (cmd_calibrate.cpp)
 

@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
     demcal::add_shear_commands(app);
     demcal::add_silo_command(app);
     demcal::add_cutoff_command(app);
+    demcal::add_vibration_command(app);
     demcal::add_discharge_commands(app);
     demcal::add_calibration_commands(app);
     demcal::refuse_empty_values(app);

@@ -1,0 +1,84 @@
+// demcal vibration: a sweep of demcal silo runs (angles x frequencies x repeats) into a campaign directory; the same
+// command continues it without running anything twice; other settings and bad input are refused before anything is
+// written.
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+int demcal_run(const std::string& args, const fs::path& log) {
+  const std::string cmd = std::string("'") + DEMCAL_BINARY + "' " + args + " > '" + log.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+const std::string kTiny = "--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
+                          "/examples/silo/reduced_conical_70deg.json' --particles 300 --stiffness-scale 0.001 "
+                          "--fill-time 0.3 --max-time 0.2 --threads 1 --no-plots";
+
+}  // namespace
+
+TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without running anything twice",
+          "[silo][vibration][cli]") {
+  const fs::path dir = fs::temp_directory_path() / ("demcal-test-vibration-sweep-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path campaign = dir / "sweep";
+  const std::string sweep = "vibration --theta 45 --frequency 0,100 --amplitude 1.1e-4 --repeats 2 --campaign '" +
+                            campaign.string() + "' -- " + kTiny;
+  REQUIRE(demcal_run(sweep, dir / "first.log") == 0);
+  const auto report = nlohmann::json::parse(demcal::test::read_file(campaign / "vibration.json"));
+  REQUIRE(report["cells"].size() == 2);
+  for (const auto& cell : report["cells"]) {
+    CHECK(cell["n"] == 2);
+    CHECK(cell["rate_mean_g_s"].get<double>() > 0);
+  }
+  CHECK(report["cells"][1]["peak_acceleration_g"].get<double>() == Approx(1.1e-4 * std::pow(2 * M_PI * 100, 2) / 9.81));
+  // the still and the vibrating runs differ; the two seeds of one cell differ
+  CHECK(report["runs"][0]["rate_g_s"] != report["runs"][1]["rate_g_s"]);
+  CHECK(report["runs"][0]["rate_g_s"] != report["runs"][2]["rate_g_s"]);
+  const auto stamp = fs::last_write_time(campaign / "runs" / "theta45_f100_seed2" / "summary.json");
+  REQUIRE(demcal_run(sweep, dir / "again.log") == 0);
+  CHECK(fs::last_write_time(campaign / "runs" / "theta45_f100_seed2" / "summary.json") == stamp);
+  CHECK_THAT(demcal::test::read_file(dir / "again.log"), !Catch::Matchers::Contains("[1/"));
+  // the same directory with other settings is refused, and left as it was
+  CHECK(demcal_run("vibration --theta 45 --frequency 0,50 --amplitude 1.1e-4 --repeats 2 --campaign '" +
+                       campaign.string() + "' -- " + kTiny,
+                   dir / "other.log") == 2);
+  CHECK_THAT(demcal::test::read_file(dir / "other.log"), Catch::Matchers::Contains("other settings"));
+  CHECK_FALSE(fs::exists(campaign / "runs" / "theta45_f50_seed1"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("demcal vibration: bad input exits 2 naming it before anything is written", "[silo][vibration][cli]") {
+  const fs::path dir = fs::temp_directory_path() / ("demcal-test-vibration-bad-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string campaign = " --campaign '" + (dir / "never").string() + "'";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--theta 45 --frequency 100" + campaign + " -- " + kTiny, "--amplitude"},
+      {"--theta 45 --frequency 0,100 --amplitude 1e-4" + campaign + " -- " + kTiny + " --seed 3", "--seed"},
+      {"--theta 45 --frequency 0,100 --amplitude 1e-4" + campaign + " -- " + kTiny + " --stop-fraction 7",
+       "stop_fraction"},
+      {"--theta 95 --frequency 0" + campaign + " -- " + kTiny, "--theta"},
+      {"--theta 45 --frequency 0,-5 --amplitude 1e-4" + campaign, "--frequency"},
+      {"--theta 45 --frequency 100 --amplitude 1e-4 --direction y" + campaign, "--direction"},
+      {"--theta 45 --frequency 100 --amplitude 1e-4 --repeats 0" + campaign, "--repeats"}};
+  for (const auto& [args, expect] : cases) {
+    INFO(args);
+    CHECK(demcal_run("vibration " + args, dir / "log") == 2);
+    CHECK_THAT(demcal::test::read_file(dir / "log"), Catch::Matchers::Contains(expect));
+    CHECK_FALSE(fs::exists(dir / "never"));
+  }
+  fs::remove_all(dir);
+}
