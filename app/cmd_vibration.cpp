@@ -78,6 +78,18 @@ std::vector<std::string> silo_command(const VibrationCli& o, const RunSpec& r, c
     return a;
 }
 
+// `demcal silo --resume DIR` with the session options of the silo options (the rest is in the checkpoint).
+std::vector<std::string> resume_command(const VibrationCli& o, const fs::path& dir) {
+    std::vector<std::string> a{"silo", "--resume", dir.string()};
+    for (std::size_t k = 0; k < o.silo_args.size(); ++k) {
+        const std::string& arg = o.silo_args[k];
+        if (arg == "--no-plots") a.push_back(arg);
+        if ((arg == "--threads" || arg == "--checkpoint-every" || arg == "--wall-limit") && k + 1 < o.silo_args.size())
+            a.insert(a.end(), {arg, o.silo_args[k + 1]});
+    }
+    return a;
+}
+
 // Runs this demcal with `args`, stdout and stderr to `log`; returns its exit status.
 int run_demcal(const std::vector<std::string>& args, const fs::path& log) {
     std::vector<char*> argv;
@@ -259,7 +271,7 @@ int run(const VibrationCli& o) {
         fs::create_directories(rd);
         std::cout << "[" << done + failed + 1 << "/" << runs.size() << "] " << r.name() << (resume ? " (resumed)" : "")
                   << std::endl;
-        const int rc = resume ? run_demcal({"silo", "--resume", rd.string()}, rd / "silo.log")
+        const int rc = resume ? run_demcal(resume_command(o, rd), rd / "silo.log")
                               : run_demcal(silo_command(o, r, rd, false), rd / "silo.log");
         if (rc == 0 && !g_stop_requested) { ++done; continue; }
         if (rc == 0) ++done;
