@@ -93,7 +93,8 @@ std::vector<std::string> resume_command(const VibrationCli& o, const fs::path& d
 // Runs this demcal with `args`, stdout and stderr to `log`; returns its exit status.
 int run_demcal(const std::vector<std::string>& args, const fs::path& log) {
     std::vector<char*> argv;
-    std::string self = fs::read_symlink("/proc/self/exe").string();
+    // this very binary, even when the file was replaced since it started (a rebuild during a long sweep)
+    std::string self = "/proc/self/exe";
     argv.push_back(self.data());
     std::vector<std::string> copy = args;
     for (auto& a : copy) argv.push_back(a.data());
