@@ -13,6 +13,11 @@
 namespace demcal::kernel::cases {
 
 namespace {
+// The grains' material besides E (the case's fixed choices, stated in examples/cohesive_arch/README.md).
+constexpr double kGrainDensity = 1000, kGrainPoisson = 0.3, kTimestepFraction = 0.25;
+
+Material grain_material(const CohesiveHopperCase& c) { return {c.young, kGrainPoisson, kGrainDensity, "meal"}; }
+
 void check(bool ok, const char* field, double value, const char* rule) {
   if (!ok || (value != 0 && std::abs(value) < 1e-300))
     throw std::invalid_argument(std::string(field) + " = " + silo::setting_text(value) + ": " + rule);
@@ -27,8 +32,9 @@ void validate(const CohesiveHopperCase& c) {
   check(c.grains >= 10 && c.grains <= 20000, "grains", c.grains, "must be in [10, 20000]");
   check(c.window >= 0.05 && c.window <= 10, "window", c.window, "must be in [0.05, 10] s");
   if (c.frequency > 0) {
-    // at least 20 steps per period (the time step is about 1.7e-5 s for the default grains)
-    const double dt = 0.25 * M_PI * c.grain_radius * 0.9 * std::sqrt(1000 / (c.young / 2.6)) / (0.1631 * 0.3 + 0.8766);
+    // at least 20 steps per period (the time step of the smallest grain, 0.9 r; about 1.7e-5 s by default)
+    const Material m = grain_material(c);
+    const double dt = kTimestepFraction * rayleigh_timestep(0.9 * c.grain_radius, m.density, m.shear_modulus(), m.poisson);
     check(1.0 / c.frequency >= 20 * dt, "frequency", c.frequency, "leaves fewer than 20 time steps per period");
   }
 }
@@ -37,9 +43,9 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
   validate(c);
   const auto t0 = std::chrono::steady_clock::now();
   CohesiveSimulation sim;
-  const int meal = sim.add_material({c.young, 0.3, 1000, "meal"});
+  const int meal = sim.add_material(grain_material(c));
   const int steel = sim.add_material({2e8, 0.3, 7800, "steel"});
-  const double r = c.grain_radius, m = 1000 * 4.0 / 3.0 * M_PI * r * r * r;
+  const double r = c.grain_radius, m = kGrainDensity * 4.0 / 3.0 * M_PI * r * r * r;
   const double gamma = c.bond_number * m * 9.81 / (3 * M_PI * 0.5 * r);
   const CohesiveSimulation::PairParams pair{{.restitution = 0.3, .surface_energy = gamma}, {.friction = 0.5},
                                             {.rolling_friction = 0.05}};
@@ -66,7 +72,7 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
         sim.add_sphere({x + 0.05 * r * u(rng), y + 0.05 * r * u(rng), z}, r * (1 + 0.1 * u(rng)), meal);
         ++placed;
       }
-  sim.set_timestep(0.25 * sim.rayleigh_timestep());
+  sim.set_timestep(kTimestepFraction * sim.rayleigh_timestep());
   while (sim.time() < c.settle) sim.step(100);
   sim.set_wall_enabled(plate, false);
   const double mass = sim.total_mass();
