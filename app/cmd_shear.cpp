@@ -32,6 +32,7 @@ struct ShearCliOptions {
     std::string campaign_dir;
     std::string template_path;
     std::string plot_format = "png";
+    std::string engine = "yade";
     ExecutionOptions exec;
 };
 
@@ -199,6 +200,10 @@ void add_shear_commands(CLI::App& app) {
         ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));
     shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<material name>)");
     shear->add_option("--template", opt->template_path, "YADE template (default: yade_scripts/shear_box.py)");
+    shear->add_option("--engine", opt->engine,
+                      "yade (yade_scripts/shear_box.py) or kernel (the same box on demcal's kernel with YADE's laws)")
+        ->check(CLI::IsMember({"yade", "kernel"}))
+        ->capture_default_str();
     shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     shear->add_flag("--force", opt->exec.force, "recompute runs already in the store");
     add_execution_options(shear, opt->exec);
@@ -217,9 +222,12 @@ void add_shear_commands(CLI::App& app) {
         spec.replicates = opt->replicates;
         spec.base_seed = opt->seed;
         spec.template_path = opt->template_path;
+        spec.engine = parse_shear_engine(opt->engine);
+        if (spec.engine == ShearEngine::kernel && !opt->template_path.empty())
+            throw UserError("template = '" + opt->template_path + "' is a YADE script: it applies to --engine yade only");
         try {
             validate_shear_spec(spec);  // everything is checked before anything is written
-            find_yade(opt->exec.yade);
+            if (spec.engine == ShearEngine::yade) find_yade(opt->exec.yade);
         } catch (const std::invalid_argument& e) {
             throw UserError(e.what());
         }
@@ -228,8 +236,8 @@ void add_shear_commands(CLI::App& app) {
                                  : fs::path(opt->campaign_dir);
         ShearCampaignRunner runner(dir, opt->exec);
         std::cout << "campaign directory " << runner.dir().string() << ": " << spec.normal_stresses.size()
-                  << " normal stresses x " << spec.replicates << " replicates, " << opt->exec.executor
-                  << " executor\n";
+                  << " normal stresses x " << spec.replicates << " replicates, " << to_string(spec.engine)
+                  << " engine, " << opt->exec.executor << " executor\n";
         const auto outcome = runner.run(spec, print_progress);
         const int code = report_campaign(runner.dir(), outcome, opt->plot_format);
         if (code == 130) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";

@@ -112,6 +112,10 @@ class BasicSimulation {
   void bond_contacts_now()
     requires Law::has_bonds;
 
+  /// Laws with bonds: how many particle-particle contacts are bonded now (at the last force evaluation).
+  std::size_t bonded_contact_count() const
+    requires Law::has_bonds;
+
   /// Sets the velocity [m/s] of a wall without a prescribed motion law (a driver's servo or a shear frame): it moves by
   /// velocity * dt each step from then on. Throws for a wall that follows a law.
   void set_wall_velocity(int id, const Vec3& velocity);
@@ -133,6 +137,12 @@ class BasicSimulation {
   BodyId add_clump(int tmpl, int material, const Vec3& com, const Quat& orientation = Quat::Identity(),
                    const Vec3& velocity = Vec3::Zero(), const Vec3& omega = Vec3::Zero());
 
+  /// Scales every particle about its own centre of mass by `factor` (> 0): sphere radii, clump members' offsets and
+  /// radii, masses (factor^3) and moments of inertia (factor^5); velocities and angular velocities are kept, and so are
+  /// the contact histories. YADE's utils.growParticles(factor, updateMass = True), with which a packing procedure grows
+  /// a loose cloud in place. The clump templates are scaled with them (every body grows alike).
+  void scale_particles(double factor);
+
   // ---------------------------------------------------------------- run
   /// Advances n steps of the time step (velocity Verlet; forces at half-step velocities, as LAMMPS/LIGGGHTS).
   void step(long n = 1);
@@ -153,6 +163,14 @@ class BasicSimulation {
   SphereState sphere(std::size_t k) const;
   const std::vector<Vec3>& sphere_positions() const { return x_; }  ///< all sphere centres [m]
   const std::vector<double>& sphere_radii() const { return r_; }    ///< all sphere radii [m]
+
+  /// The spheres touching wall `id` at the last force evaluation (a sphere keeps up to 3 wall contacts with history;
+  /// contacts beyond that act but are not listed), in ascending sphere index.
+  std::vector<std::size_t> wall_contact_spheres(int id) const;
+  /// YADE's utils.unbalancedForce(): the mean over bodies of |contact force + m g| divided by the mean magnitude of
+  /// the contact forces (particle pairs and wall contacts acting at the last force evaluation), both before local
+  /// damping. A quasi-static packing has a small value (YADE's scripts wait for 0.01-0.05). 0 without contacts.
+  double unbalanced_force() const;
 
   /// Translational + rotational kinetic energy of all bodies [J].
   double kinetic_energy() const;

@@ -728,6 +728,17 @@ void BasicSimulation<Law>::bond_contacts_now()
 }
 
 template <class Law>
+std::size_t BasicSimulation<Law>::bonded_contact_count() const
+  requires Law::has_bonds
+{
+  // the bond flag is the normal model's first history entry, zeroed when the bond fails or the contact ends
+  std::size_t count = 0;
+  for (std::size_t p = 0; p < nl_.num_pairs(); ++p)
+    if (nl_.hist[p * kHist] != 0.0) ++count;
+  return count;
+}
+
+template <class Law>
 void BasicSimulation<Law>::step(long nsteps) {
   prepare();
   if (!forces_valid_) {
@@ -747,6 +758,83 @@ void BasicSimulation<Law>::step(long nsteps) {
     ++steps_;
   }
   if (nsteps > 0) kick();
+}
+
+template <class Law>
+void BasicSimulation<Law>::scale_particles(double factor) {
+  if (!(factor > 0 && std::isfinite(factor)))
+    throw std::invalid_argument("scale_particles: factor must be finite and > 0, got " + std::to_string(factor));
+  const double f3 = factor * factor * factor, f5 = f3 * factor * factor;
+  for (ClumpTemplate& t : templates_) scale_clump_template(t, factor);
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    r_[i] *= factor;
+    mass_[i] *= f3;  // a member's m* is its clump's mass
+    if (clump_[i] < 0) {
+      inv_mass_[i] /= f3;
+      inv_inertia_[i] /= f5;
+    }
+  }
+  for (std::size_t c = 0; c < cx_.size(); ++c) {
+    cm_[c] *= f3;
+    cI_[c] *= f5;
+    cL_[c] *= f5;  // the same angular velocity
+    update_members(c, cq_[c].toRotationMatrix(), true);
+  }
+  omega_norm_fresh_ = false;
+  forces_valid_ = false;
+  nl_.invalidate();  // the cells must hold the new largest sphere
+}
+
+template <class Law>
+std::vector<std::size_t> BasicSimulation<Law>::wall_contact_spheres(int id) const {
+  if (id < 0 || id >= int(walls_.size())) throw std::out_of_range("wall_contact_spheres: no wall " + std::to_string(id));
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    for (int k = 0; k < kWallSlots; ++k)
+      if (wall_slot_id_[i * kWallSlots + k] == id) out.push_back(i);
+  return out;
+}
+
+template <class Law>
+double BasicSimulation<Law>::unbalanced_force() const {
+  // The forces as the contacts gave them (apply_local_damping has rescaled f_ since): rebuilt from the pair loads of
+  // the last evaluation and the wall slots.
+  const std::size_t n = x_.size();
+  std::vector<Vec3> contact(n, Vec3::Zero());
+  double sum_contact = 0;
+  std::size_t contacts = 0;
+  const std::size_t pairs = std::min<std::size_t>(pair_load_.size(), nl_.num_pairs());
+  if (nl_.row.size() == n + 1)
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::uint32_t p = nl_.row[i]; p < nl_.row[i + 1] && p < pairs; ++p) {
+        const Vec3& fp = pair_load_[p].force_i;
+        if (fp == Vec3::Zero()) continue;
+        contact[i] += fp;
+        contact[std::size_t(nl_.nbr[p])] -= fp;
+        sum_contact += fp.norm();
+        ++contacts;
+      }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < kWallSlots; ++k)
+      if (wall_slot_id_[i * kWallSlots + k] >= 0) {
+        const Vec3& fw = wall_slot_f_[i * kWallSlots + k];
+        contact[i] += fw;
+        sum_contact += fw.norm();
+        ++contacts;
+      }
+  if (contacts == 0 || body_ref_.empty()) return 0.0;
+  double sum_body = 0;
+  for (const std::int32_t ref : body_ref_) {
+    if (ref >= 0) {
+      sum_body += (contact[std::size_t(ref)] + mass_[std::size_t(ref)] * gravity_).norm();
+    } else {
+      const std::size_t c = std::size_t(-ref - 1);
+      Vec3 F = cm_[c] * gravity_;
+      for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) F += contact[cmem_[k]];
+      sum_body += F.norm();
+    }
+  }
+  return (sum_body / double(body_ref_.size())) / (sum_contact / double(contacts));
 }
 
 template <class Law>
