@@ -207,7 +207,8 @@ class BasicSimulation {
   void prepare();
   void compute_forces(bool rebuild, double dt_history);
   bool kick_drift(double kick);
-  void kick();
+  void kick(double sign = 1.0);  // the second half kick of velocity Verlet; -1 takes it back
+  void refresh_forces();         // forces of the current state after a change (step() calls it)
   void update_members(std::size_t c, const Mat3& R, bool positions);  // R: the clump's rotation matrix
   void rebuild_body_index();
   // Every per-sphere array (with its entries per sphere) and every per-clump array, listed once: renumbering and
@@ -285,6 +286,9 @@ class BasicSimulation {
   std::size_t min_parallel_ = 2000;
   int nt() const { return x_.size() >= min_parallel_ ? threads_ : 1; }
   bool forces_valid_ = false, prepared_ = false;
+  // The change that invalidated the forces leaves the state (positions, velocities) as it was: the last half kick,
+  // taken with the forces before the change, is taken again with the new ones (see refresh_forces).
+  bool rekick_on_refresh_ = false;
 };
 
 extern template class BasicSimulation<HertzMindlinEdem>;

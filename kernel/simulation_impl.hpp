@@ -103,6 +103,7 @@ int BasicSimulation<Law>::add_wall(const Wall& w) {
   nl_.invalidate();  // the wall candidates are found at the neighbour build
   prepared_ = false;
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   return int(walls_.size()) - 1;
 }
 
@@ -110,6 +111,7 @@ template <class Law>
 void BasicSimulation<Law>::set_wall_enabled(int id, bool enabled) {
   walls_.at(id).enabled = enabled;
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
 }
 
 template <class Law>
@@ -118,6 +120,7 @@ void BasicSimulation<Law>::set_wall_velocity(int id, const Vec3& velocity) {
   if (w.motion) throw std::logic_error("set_wall_velocity: wall " + std::to_string(id) + " follows a motion law");
   if (!velocity.allFinite()) throw std::invalid_argument("set_wall_velocity: the velocity must be finite");
   w.velocity = velocity;
+  if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
 }
 
@@ -183,6 +186,7 @@ BodyId BasicSimulation<Law>::add_sphere(const Vec3& position, double radius, int
   body_id_.push_back(next_id_);
   sphere_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   nl_.invalidate();
   return next_id_++;
 }
@@ -219,6 +223,7 @@ BodyId BasicSimulation<Law>::add_clump(int tmpl, int material, const Vec3& com, 
   clump_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   for (std::size_t k = 0; k < t.offsets.size(); ++k) sphere_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   nl_.invalidate();
   return next_id_++;
 }
@@ -363,8 +368,8 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
 }
 
 template <class Law>
-void BasicSimulation<Law>::kick() {
-  const double h = 0.5 * dt_;
+void BasicSimulation<Law>::kick(double sign) {
+  const double h = 0.5 * dt_ * sign;
   const Vec3 g = gravity_;
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
 #pragma omp parallel num_threads(nt())
@@ -716,6 +721,7 @@ template <class Law>
 void BasicSimulation<Law>::set_local_damping(double damping) {
   if (!(damping >= 0 && damping < 1)) throw std::invalid_argument("set_local_damping: damping must be in [0, 1)");
   local_damping_ = damping;
+  if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
 }
 
@@ -724,6 +730,7 @@ void BasicSimulation<Law>::bond_contacts_now()
   requires Law::has_bonds
 {
   bond_next_evaluation_ = true;
+  if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
 }
 
@@ -739,16 +746,27 @@ std::size_t BasicSimulation<Law>::bonded_contact_count() const
 }
 
 template <class Law>
+void BasicSimulation<Law>::refresh_forces() {
+  // Forces of the current state (after an insertion, a removal, a wall toggled, velocities set): time does not
+  // advance, so neither do the tangential springs; a wall on a law moves at its velocity of this instant.
+  // After a change that keeps the state (particles grown, a wall's velocity or the damping set, bonds made) the last
+  // half kick is taken back and taken again with the new forces, so the change acts on the whole step as in a
+  // leapfrog integrator (YADE's, where a PyRunner's change acts before the next force evaluation); without this the
+  // step that follows a change got half the old force, which made the kernel's shear box drift from YADE's.
+  const bool rekick = rekick_on_refresh_ && steps_ > 0;
+  rekick_on_refresh_ = false;
+  if (rekick) kick(-1.0);
+  for (Wall& w : walls_)
+    if (w.motion) w.velocity = w.motion->velocity(time_);
+  compute_forces(nl_.needs_rebuild(x_, nt()), 0.0);
+  if (rekick) kick(1.0);
+  forces_valid_ = true;
+}
+
+template <class Law>
 void BasicSimulation<Law>::step(long nsteps) {
   prepare();
-  if (!forces_valid_) {
-    // forces of the current state (after an insertion, a removal, a wall toggled, velocities set): time does not
-    // advance, so neither do the tangential springs; a wall on a law moves at its velocity of this instant
-    for (Wall& w : walls_)
-      if (w.motion) w.velocity = w.motion->velocity(time_);
-    compute_forces(nl_.needs_rebuild(x_, nt()), 0.0);
-    forces_valid_ = true;
-  }
+  if (!forces_valid_) refresh_forces();
   // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass
   for (long s = 0; s < nsteps; ++s) {
     const bool moved = kick_drift(s == 0 ? 1.0 : 2.0);
@@ -781,6 +799,7 @@ void BasicSimulation<Law>::scale_particles(double factor) {
     update_members(c, cq_[c].toRotationMatrix(), true);
   }
   omega_norm_fresh_ = false;
+  if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
   nl_.invalidate();  // the cells must hold the new largest sphere
 }
@@ -881,6 +900,8 @@ void BasicSimulation<Law>::set_body_velocity(std::size_t b, const Vec3& velocity
     update_members(c, R, false);
   }
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
+  rekick_on_refresh_ = false;  // (the state itself changed)
 }
 
 template <class Law>
@@ -959,6 +980,7 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   nl_.renumber(s_old2new, ns, &Law::swap_history);
   // forces of the remaining spheres are still valid except for the contacts with removed ones; recompute
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   return res;
 }
 
