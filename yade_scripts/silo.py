@@ -292,28 +292,32 @@ def kernel_pair_moduli(g1, nu1, g2, nu2):
     return e_star, g_star
 
 
-def wall_material_matching_kernel(g_grain, nu_grain, g_wall, nu_wall):
-    """A wall (E', nu') for which YADE's mixing gives the kernel's grain-wall constants exactly.
+def stiffness_against_kernel(moduli):
+    """YADE's Hertz-Mindlin constants of the first grain-grain and grain-facet contacts over the kernel's.
 
-    YADE's Ip2_FrictMat_FrictMat_MindlinPhys: kn coefficient 4/3 E* sqrt(R) with the same harmonic E* as the kernel,
-    but ks coefficient 4 Gm sqrt(R) / (2 - num) with the ARITHMETIC means Gm, num of G and nu, where the kernel has
-    8 G* sqrt(R). The wall's material enters only grain-wall contacts (facets never touch each other), so a wall
-    with the same E* term (1 - nu'^2) / E' and with Gm / (2 - num) = 2 G* reproduces both; the second condition is
-    linear in nu'. Returns (E', nu', True), or the real wall and False when nu' falls outside (-1, 0.5].
+    The kernel: kn coefficient 4/3 E* sqrt(R*), ks coefficient 8 G* sqrt(R*), R* = r1 r2 / (r1 + r2) (a wall: r).
+    `moduli`: (E*, G*) of the kernel for "grain_grain" and "grain_wall". Ratios 1 (to 1e-8, the hertzian facet's
+    R* = r / (1 + 1e-8)) show the installed YADE mixes the pair as the kernel does; None: no such contact yet.
     """
-    e_wall = 2 * g_wall * (1 + nu_wall)
-    e_star, g_star = kernel_pair_moduli(g_grain, nu_grain, g_wall, nu_wall)
-    # E' = (1 - nu'^2) c with c = E_wall / (1 - nu_wall^2), so G' = E' / (2 (1 + nu')) = (1 - nu') c / 2 and
-    # (G_grain + G') / 2 = 2 G* (2 - (nu_grain + nu') / 2), i.e. G_grain / 2 + a (1 - nu') = b - g_star nu'.
-    c = e_wall / (1 - nu_wall ** 2)
-    a = c / 4.0
-    b = 2 * g_star * (2 - nu_grain / 2.0)
-    if abs(g_star - a) < 1e-12 * a:
-        return e_wall, nu_wall, False
-    nu_eq = (b - g_grain / 2.0 - a) / (g_star - a)
-    if not -1.0 < nu_eq <= 0.5:
-        return e_wall, nu_wall, False
-    return (1 - nu_eq ** 2) * c, nu_eq, True
+    ratios = {"grain_grain": None, "grain_wall": None}
+    for inter in O.interactions:
+        if not inter.isReal:
+            continue
+        b1, b2 = O.bodies[inter.id1], O.bodies[inter.id2]
+        facet = isinstance(b1.shape, Facet) or isinstance(b2.shape, Facet)
+        pair = "grain_wall" if facet else "grain_grain"
+        if ratios[pair] is not None:
+            continue
+        if facet:
+            r_star = (b2 if isinstance(b1.shape, Facet) else b1).shape.radius
+        else:
+            r_star = b1.shape.radius * b2.shape.radius / (b1.shape.radius + b2.shape.radius)
+        e_star, g_star = moduli[pair]
+        ratios[pair] = {"kn": inter.phys.kno / (4.0 / 3.0 * e_star * math.sqrt(r_star)),
+                        "ks": inter.phys.kso / (8.0 * g_star * math.sqrt(r_star))}
+        if all(v is not None for v in ratios.values()):
+            break
+    return ratios
 
 
 def rayleigh_time_step(radius, density, g, nu):
@@ -510,12 +514,11 @@ def main():
     g_wall = shear_modulus(p, "material.wall") * scale
     nu_grain, nu_wall = p["material.grain.poisson"], p["material.wall.poisson"]
     rho_grain = p["material.grain.density_kg_m3"]
-    e_wall_yade, nu_wall_yade, wall_pair_matched = wall_material_matching_kernel(g_grain, nu_grain, g_wall, nu_wall)
     grain_material = O.materials.append(FrictMat(young=2 * g_grain * (1 + nu_grain), poisson=nu_grain,
                                                  density=rho_grain,
                                                  frictionAngle=math.atan(p["material.grain_grain.friction"]),
                                                  label="grain"))
-    wall_material = O.materials.append(FrictMat(young=e_wall_yade, poisson=nu_wall_yade,
+    wall_material = O.materials.append(FrictMat(young=2 * g_wall * (1 + nu_wall), poisson=nu_wall,
                                                 density=p["material.wall.density_kg_m3"],
                                                 frictionAngle=math.atan(p["material.grain_wall.friction"]),
                                                 label="wall"))
@@ -570,6 +573,7 @@ def main():
     times, masses, counts = [0.0], [0.0], [0]
     in_silo = set(clump_ids)
     discharged_mass, last_out_time, stop_reason = 0.0, 0.0, ""
+    stiffness_check = None
     while True:
         O.run(chunk, True)
         leaving = []
@@ -588,6 +592,10 @@ def main():
             discharged_mass += mass_of[clump_id]
         if leaving:
             last_out_time = O.time
+        if stiffness_check is None:  # the bed's contacts exist after the first chunk
+            stiffness_check = stiffness_against_kernel(
+                {"grain_grain": kernel_pair_moduli(g_grain, nu_grain, g_grain, nu_grain),
+                 "grain_wall": kernel_pair_moduli(g_grain, nu_grain, g_wall, nu_wall)})
         times.append(O.time)
         masses.append(discharged_mass)
         counts.append(len(clump_ids) - len(in_silo))
@@ -630,8 +638,7 @@ def main():
             "hertzian_facets": p["run.hertzian_facets"] == 1,
             "rolling_moment": rolling,
             "rolling_stiffness_N_m_rad": rolling_stiffness,
-            "wall_pair_matched": wall_pair_matched,
-            "wall_material_in_yade": {"young_Pa": e_wall_yade, "poisson": nu_wall_yade},
+            "stiffness_over_kernel": stiffness_check,
             "betan_grain_grain": damping_ratio(p["material.grain_grain.restitution"]),
             "betan_grain_wall": damping_ratio(p["material.grain_wall.restitution"]),
             "facet_segments": p["run.facet_segments"],
