@@ -362,76 +362,125 @@ def build_silo(p, wall_top, wall_material):
 
 # ---------------------------------------------------------------------------------------------------- grains
 def world_inertia_times(q, principal_inertia, w):
-    """I_world w for a body of principal moments `principal_inertia` turned by q (principal -> world)."""
+    """I_world w for a body of principal moments `principal_inertia` turned by q (body frame -> world)."""
     local = q.conjugate() * w
     return q * Vector3(principal_inertia[0] * local[0], principal_inertia[1] * local[1],
                        principal_inertia[2] * local[2])
 
 
-def add_grains(bed, grain_material, grain_density):
-    """One rigid clump per bed grain, exactly in the kernel's state; returns [(clump id, mass)].
+def quaternion_wxyz(q):
+    return [q[3], q[0], q[1], q[2]]  # minieigen indexes x, y, z, w
 
-    YADE computes a clump's centre and axes from its members; built at the origin in the principal frame with
-    discretization 0 (centre = mass-weighted sphere centres, exactly 0 for the wheat grain's symmetric spheres; axes
-    = identity), its members' local positions are the template's offsets. Mass and inertia are then set to the
-    kernel's (union of the spheres on the kernel's grid, scaled to this density), the clump's state to the bed's,
-    and its members placed with YADE's own rule x_i = X + q r_i. Members get the clump's mass: YADE uses a member's
-    mass only for the contact damping's m* (NewtonIntegrator moves members with their clump), and the kernel's m* is
-    that of the clumps.
+
+class TemplateFrame:
+    """YADE's own clump frame of the bed's template, relative to the template's principal frame.
+
+    YADE puts a clump's reference point at ITS centroid of the member spheres and its axes along ITS principal axes
+    (appendClumped, discretization 0: the spheres summed) and fixes the members' local positions from them; neither
+    can be set from Python. The kernel's centre and axes come from its grid integration of the union: for the wheat
+    grain they differ by about 1e-13 m and by the grain's symmetry (a half turn). Built once at the origin in the
+    principal frame: `centre` [m] and `orientation` (YADE's body frame -> principal frame) give every grain's YADE
+    state from the kernel's, X_yade = X + q centre, q_yade = q orientation, which leaves every sphere exactly where
+    the kernel has it; `inertia` is the kernel's principal tensor in YADE's axes (it must be diagonal there).
+    """
+
+    def __init__(self, members, grain_material, kernel_inertia):
+        clump_id, _ = O.bodies.appendClumped([utils.sphere(offset, radius, material=grain_material)
+                                              for offset, radius in members], discretization=0)
+        clump = O.bodies[clump_id]
+        self.centre = Vector3(clump.state.pos)
+        self.orientation = Quaternion(clump.state.ori)
+        self.local_positions = sorted(tuple(rel_pos) for rel_pos, _ in clump.shape.members.values())
+        O.bodies.erase(clump_id, True)
+        axes = self.orientation.toRotationMatrix()  # columns: YADE's axes in the principal frame
+        tensor = [[sum(axes[k, i] * kernel_inertia[k] * axes[k, j] for k in range(3)) for j in range(3)]
+                  for i in range(3)]
+        off_diagonal = max(abs(tensor[i][j]) for i in range(3) for j in range(3) if i != j)
+        if off_diagonal > 1e-9 * sum(kernel_inertia):
+            raise RunFailure("bed_import", "YADE's principal axes of the template's spheres are not the kernel's "
+                             "(off-diagonal inertia %.3g kg m^2 in YADE's axes): the clump's inertia cannot be set"
+                             % off_diagonal)
+        self.inertia = Vector3(tensor[0][0], tensor[1][1], tensor[2][2])
+
+    def check_same(self, clump):
+        """Every clump of the template must get the same frame (it is built the same way)."""
+        if sorted(tuple(rel_pos) for rel_pos, _ in clump.shape.members.values()) != self.local_positions:
+            raise RunFailure("bed_import", "clump %d got other member positions than the template's frame" % clump.id)
+
+
+def add_grains(bed, grain_material, grain_density):
+    """One rigid clump per bed grain in the kernel's state; returns ([(clump id, mass)], TemplateFrame).
+
+    Each clump is built at the origin in the template's principal frame (so its members' local positions are YADE's
+    for the template), then put into the kernel's state through TemplateFrame; mass and inertia are the kernel's
+    (its grid integration of the union of the spheres, scaled to this density); the members are placed with YADE's
+    rule x_i = X + q r_i. Members get the clump's mass: YADE uses a member's mass only for the contact damping's m*
+    (NewtonIntegrator moves members with their clump), and the kernel's m* is that of the clumps.
     """
     template = bed["clump_template"]
     scale = grain_density / template["density_kg_m3"]
     mass = template["mass_kg"] * scale
-    inertia = Vector3(*[i * scale for i in template["principal_inertia_kg_m2"]])
     members = [(Vector3(*m["offset_m"]), m["radius_m"]) for m in template["members"]]
+    frame = TemplateFrame(members, grain_material, [i * scale for i in template["principal_inertia_kg_m2"]])
     grains = bed["grains"]
     clumps = []
     for i in range(grains["count"]):
-        spheres = [utils.sphere(offset, radius, material=grain_material) for offset, radius in members]
-        clump_id, member_ids = O.bodies.appendClumped(spheres, discretization=0)
+        clump_id, _ = O.bodies.appendClumped([utils.sphere(offset, radius, material=grain_material)
+                                              for offset, radius in members], discretization=0)
         clump = O.bodies[clump_id]
-        canonical_ori = clump.state.ori
-        if clump.state.pos.norm() > 1e-12 * template["members"][0]["radius_m"] or \
-                canonical_ori.toAxisAngle()[1] > 1e-12:
-            raise RunFailure("bed_import", "YADE put the template's centre at %s and its axes at %s, not at the "
-                             "principal frame's origin and axes: the template is not in its principal frame"
-                             % (clump.state.pos, canonical_ori))
+        frame.check_same(clump)
         w, x, y, z = grains["orientation_wxyz"][i]
         q = Quaternion(w, x, y, z)
         com = Vector3(*grains["position_m"][i])
         vel = Vector3(*grains["velocity_m_s"][i])
         spin = Vector3(*grains["angular_velocity_rad_s"][i])
-        clump.state.mass = mass
-        clump.state.inertia = inertia
-        clump.state.pos = com
-        clump.state.ori = q
-        clump.state.vel = vel
-        clump.state.angVel = spin
-        clump.state.angMom = world_inertia_times(q, inertia, spin)  # the aspherical integrator advances this
+        state = clump.state
+        state.pos = com + q * frame.centre
+        state.ori = q * frame.orientation
+        state.mass = mass
+        state.inertia = frame.inertia
+        state.vel = vel + spin.cross(state.pos - com)
+        state.angVel = spin
+        state.angMom = world_inertia_times(state.ori, frame.inertia, spin)  # the aspherical integrator advances this
         for member_id, (local_pos, local_ori) in clump.shape.members.items():
             member = O.bodies[member_id].state
-            member.pos = com + q * local_pos
-            member.ori = q * local_ori
-            member.vel = vel + spin.cross(member.pos - com)
+            member.pos = state.pos + state.ori * local_pos
+            member.ori = state.ori * local_ori
+            member.vel = state.vel + spin.cross(member.pos - state.pos)
             member.angVel = spin
             member.mass = mass
         clumps.append((clump_id, mass))
-    return clumps
+    return clumps, frame
 
 
 def state_columns(clump_ids):
-    """The clumps' state as YADE holds it, in the bed file's column layout (sphere centres: YADE's members)."""
+    """The clumps' state as YADE holds it (its own frame), in the bed's column layout; sphere_centres_m: YADE's
+    members."""
     columns = {"position_m": [], "orientation_wxyz": [], "velocity_m_s": [], "angular_velocity_rad_s": [],
                "sphere_centres_m": []}
     for clump_id in clump_ids:
         state = O.bodies[clump_id].state
-        q = state.ori
         columns["position_m"].append(list(state.pos))
-        columns["orientation_wxyz"].append([q[3], q[0], q[1], q[2]])  # minieigen: x, y, z, w
+        columns["orientation_wxyz"].append(quaternion_wxyz(state.ori))
         columns["velocity_m_s"].append(list(state.vel))
         columns["angular_velocity_rad_s"].append(list(state.angVel))
         columns["sphere_centres_m"].append([list(O.bodies[m].state.pos) for m in O.bodies[clump_id].shape.members])
     return columns
+
+
+def in_kernel_frame(columns, frame):
+    """YADE's clump states turned back into the kernel's frame of the template: q = q_yade conj(frame orientation),
+    X = X_yade - q frame centre, V = V_yade - omega x (q frame centre)."""
+    back = dict(columns, position_m=[], orientation_wxyz=[], velocity_m_s=[])
+    undo = frame.orientation.conjugate()
+    for pos, ori, vel, spin in zip(columns["position_m"], columns["orientation_wxyz"], columns["velocity_m_s"],
+                                   columns["angular_velocity_rad_s"]):
+        q = Quaternion(*ori) * undo
+        arm = q * frame.centre
+        back["position_m"].append(list(Vector3(*pos) - arm))
+        back["orientation_wxyz"].append(quaternion_wxyz(q))
+        back["velocity_m_s"].append(list(Vector3(*vel) - Vector3(*spin).cross(arm)))
+    return back
 
 
 def rotation_between(a, b):
@@ -550,13 +599,17 @@ def main():
 
     wall_top = max(bed["geometry"]["wall_top_m"], hopper_height(p) + p["geometry.body_height_m"])
     plate_ids = build_silo(p, wall_top, wall_material)
-    clumps = add_grains(bed, grain_material, rho_grain)
+    clumps, frame = add_grains(bed, grain_material, rho_grain)
     clump_ids = [c for c, _ in clumps]
     columns = state_columns(clump_ids)
-    errors = import_errors(bed, columns)
+    errors = import_errors(bed, in_kernel_frame(columns, frame))
     if p["run.readback_file"]:
-        write_json_atomically(p["run.readback_file"], {"schema": READBACK_SCHEMA, "time_s": O.time,
-                                                       "grains": dict(columns, count=len(clump_ids))})
+        write_json_atomically(p["run.readback_file"], {
+            "schema": READBACK_SCHEMA, "time_s": O.time, "grains": dict(columns, count=len(clump_ids)),
+            "yade_template_frame": {"centre_m": list(frame.centre),
+                                    "orientation_wxyz": quaternion_wxyz(frame.orientation),
+                                    "note": "YADE's clump frame in the template's principal frame: kernel q = "
+                                            "q_yade conj(orientation), kernel X = X_yade - q centre_m"}})
     print("bed: %d grains imported from %s; largest import errors %s" % (len(clump_ids), p["bed_file"], errors),
           flush=True)
 
@@ -628,6 +681,7 @@ def main():
         "stop_reason": stop_reason,
         "discharge_time_s": O.time,
         "import_errors": errors,
+        "yade_template_frame": {"centre_m": list(frame.centre), "orientation_wxyz": quaternion_wxyz(frame.orientation)},
         "steps": O.iter,
         "time_step_s": dt,
         "kernel_time_step_s": bed["time_step_s"],
