@@ -550,6 +550,165 @@ def fit_rate(times, masses):
     return fit
 
 
+# ---------------------------------------------------------------------------------------------------- set-up
+class Contact:
+    """Materials, time step and Hertz-Mindlin engines set to the kernel's law (README: silo, contact law)."""
+
+    def __init__(self, p, bed):
+        self.p = p
+        scale = p["run.stiffness_scale"]
+        self.g_grain = shear_modulus(p, "material.grain") * scale
+        self.g_wall = shear_modulus(p, "material.wall") * scale
+        self.nu_grain, self.nu_wall = p["material.grain.poisson"], p["material.wall.poisson"]
+        self.rho_grain = p["material.grain.density_kg_m3"]
+        self.grain_material = O.materials.append(FrictMat(young=2 * self.g_grain * (1 + self.nu_grain),
+                                                          poisson=self.nu_grain, density=self.rho_grain,
+                                                          label="grain"))
+        self.wall_material = O.materials.append(FrictMat(young=2 * self.g_wall * (1 + self.nu_wall),
+                                                         poisson=self.nu_wall,
+                                                         density=p["material.wall.density_kg_m3"], label="wall"))
+        template = bed["clump_template"]
+        self.dt = p["run.time_step_fraction"] * rayleigh_time_step(min(m["radius_m"] for m in template["members"]),
+                                                                   self.rho_grain, self.g_grain, self.nu_grain)
+        self.rolling = p["run.rolling_moment"] == 1
+        lightest_inertia = min(template["principal_inertia_kg_m2"]) * self.rho_grain / template["density_kg_m3"]
+        self.rolling_stiffness = lightest_inertia * (2 * math.pi / (ROLLING_SPRING_PERIOD_STEPS * self.dt)) ** 2 \
+            if self.rolling else 0.0
+
+    def per_pair(self, value_of_pair):
+        """A MatchMaker giving value_of_pair("grain_grain") and value_of_pair("grain_wall") to the two pairs."""
+        return MatchMaker(matches=((self.grain_material, self.grain_material, value_of_pair("grain_grain")),
+                                   (self.grain_material, self.wall_material, value_of_pair("grain_wall"))))
+
+    def install(self, gravity):
+        p = self.p
+        damping = self.per_pair(lambda pair: damping_ratio(p["material.%s.restitution" % pair]))
+        O.engines = [
+            ForceResetter(),
+            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb()]),
+            InteractionLoop(
+                [Ig2_Sphere_Sphere_ScGeom(), Ig2_Facet_Sphere_ScGeom(hertzian=p["run.hertzian_facets"] == 1)],
+                [Ip2_FrictMat_FrictMat_MindlinPhys(
+                    frictAngle=self.per_pair(lambda pair: math.atan(p["material.%s.friction" % pair])),
+                    betan=damping, betas=damping, krot=self.rolling_stiffness, ktwist=0.0,
+                    eta=p["material.grain_grain.rolling_friction"] if self.rolling else 0.0)],
+                [Law2_ScGeom_MindlinPhys_Mindlin(includeMoment=self.rolling)]),
+            NewtonIntegrator(damping=0.0, gravity=(0, 0, -gravity)),
+        ]
+        O.dt = self.dt
+
+    def stiffness_check(self):
+        return stiffness_against_kernel(
+            {"grain_grain": kernel_pair_moduli(self.g_grain, self.nu_grain, self.g_grain, self.nu_grain),
+             "grain_wall": kernel_pair_moduli(self.g_grain, self.nu_grain, self.g_wall, self.nu_wall)})
+
+    def summary(self):
+        p = self.p
+        return {"hertzian_facets": p["run.hertzian_facets"] == 1, "rolling_moment": self.rolling,
+                "rolling_stiffness_N_m_rad": self.rolling_stiffness,
+                "betan_grain_grain": damping_ratio(p["material.grain_grain.restitution"]),
+                "betan_grain_wall": damping_ratio(p["material.grain_wall.restitution"]),
+                "facet_segments": p["run.facet_segments"]}
+
+
+def import_bed(p, bed, contact):
+    """The grains into YADE; the import errors, and the readback file when asked for."""
+    clumps, frame = add_grains(bed, contact.grain_material, contact.rho_grain)
+    columns = state_columns([c for c, _ in clumps])
+    errors = import_errors(bed, in_kernel_frame(columns, frame))
+    if p["run.readback_file"]:
+        write_json_atomically(p["run.readback_file"], {
+            "schema": READBACK_SCHEMA, "time_s": O.time, "grains": dict(columns, count=len(clumps)),
+            "yade_template_frame": {"centre_m": list(frame.centre),
+                                    "orientation_wxyz": quaternion_wxyz(frame.orientation),
+                                    "note": "YADE's clump frame in the template's principal frame: kernel q = "
+                                            "q_yade conj(orientation), kernel X = X_yade - q centre_m"}})
+    print("bed: %d grains imported from %s; largest import errors %s" % (len(clumps), p["bed_file"], errors),
+          flush=True)
+    return clumps, frame, errors
+
+
+# ---------------------------------------------------------------------------------------------------- discharge
+class DischargeRecord:
+    """The discharged mass against time; grains below the removal plane counted and erased (the kernel's rule)."""
+
+    def __init__(self, p, bed, clumps, wall_top):
+        self.p = p
+        self.mass_of = dict(clumps)
+        self.grains = len(clumps)
+        self.in_silo = set(self.mass_of)
+        self.initial_mass = sum(m for _, m in clumps)
+        self.removal_z = -p["run.removal_depth_m"]
+        members = bed["clump_template"]["members"]
+        self.bounding_radius = max(Vector3(*m["offset_m"]).norm() + m["radius_m"] for m in members)
+        self.escape_radius = p["geometry.D_m"] / 2.0 + ESCAPE_MARGIN_BOUNDING_RADII * self.bounding_radius
+        self.wall_top = wall_top
+        self.times, self.masses, self.counts = [0.0], [0.0], [0]
+        self.discharged_mass, self.last_out_time = 0.0, 0.0
+
+    def leaving_grains(self):
+        """The grains below the removal plane; a grain that is not finite or outside the silo fails the run."""
+        leaving = []
+        for clump_id in self.in_silo:
+            pos = O.bodies[clump_id].state.pos
+            if not (math.isfinite(pos[0]) and math.isfinite(pos[1]) and math.isfinite(pos[2])):
+                raise RunFailure("nan", "grain %d at %s at t = %.6g s (step %d)" % (clump_id, pos, O.time, O.iter))
+            if pos[2] < self.removal_z:
+                leaving.append(clump_id)
+            elif math.hypot(pos[0], pos[1]) > self.escape_radius or pos[2] > self.wall_top + self.bounding_radius:
+                raise RunFailure("escaped", "grain %d at (%.4g, %.4g, %.4g) m is outside the silo at t = %.6g s"
+                                 % (clump_id, pos[0], pos[1], pos[2], O.time))
+        return leaving
+
+    def sample(self):
+        leaving = self.leaving_grains()
+        for clump_id in leaving:
+            O.bodies.erase(clump_id, True)  # the clump and its members
+            self.in_silo.discard(clump_id)
+            self.discharged_mass += self.mass_of[clump_id]
+        if leaving:
+            self.last_out_time = O.time
+        self.times.append(O.time)
+        self.masses.append(self.discharged_mass)
+        self.counts.append(self.grains - len(self.in_silo))
+
+    def stop_reason(self):
+        """Why the discharge ends now (the kernel's rules), or "" to go on."""
+        p = self.p
+        if not self.in_silo:
+            return "empty"
+        if self.discharged_mass >= p["run.stop_fraction"] * self.initial_mass * (1 - 1e-12):
+            return "stop fraction %g of the initial mass discharged" % p["run.stop_fraction"]
+        if O.time - self.last_out_time > p["run.stall_time_s"]:
+            return "flow stopped: no grain left for %g s, %d grains remain" % (p["run.stall_time_s"],
+                                                                               len(self.in_silo))
+        if O.time >= p["run.discharge_time_s"] * (1 - 1e-12):
+            return "time limit %g s" % p["run.discharge_time_s"]
+        return ""
+
+    def remaining_mass(self):
+        return sum(O.bodies[c].state.mass for c in self.in_silo)
+
+
+def discharge(p, record, contact):
+    """Runs sampling interval after sampling interval until a stop rule holds; returns (stop reason, the stiffness
+    check taken once the bed's contacts exist, after the first interval)."""
+    chunk = max(1, int(round(p["run.sample_interval_s"] / contact.dt)))
+    stiffness = None
+    while True:
+        O.run(chunk, True)
+        record.sample()
+        if stiffness is None:
+            stiffness = contact.stiffness_check()
+        reason = record.stop_reason()
+        if reason:
+            return reason, stiffness
+        if len(record.times) % 50 == 0:
+            print("t = %.4f s: %d grains discharged, %.4g kg, %d steps" % (O.time, record.counts[-1],
+                                                                           record.discharged_mass, O.iter),
+                  flush=True)
+
+
 # ---------------------------------------------------------------------------------------------------- main
 def main():
     params_path = sys.argv[1] if len(sys.argv) > 1 else "params.json"
@@ -558,155 +717,48 @@ def main():
     bed = read_bed(p["bed_file"])
     check_bed_geometry(p, bed, p["bed_file"])
 
-    scale = p["run.stiffness_scale"]
-    g_grain = shear_modulus(p, "material.grain") * scale
-    g_wall = shear_modulus(p, "material.wall") * scale
-    nu_grain, nu_wall = p["material.grain.poisson"], p["material.wall.poisson"]
-    rho_grain = p["material.grain.density_kg_m3"]
-    grain_material = O.materials.append(FrictMat(young=2 * g_grain * (1 + nu_grain), poisson=nu_grain,
-                                                 density=rho_grain,
-                                                 frictionAngle=math.atan(p["material.grain_grain.friction"]),
-                                                 label="grain"))
-    wall_material = O.materials.append(FrictMat(young=2 * g_wall * (1 + nu_wall), poisson=nu_wall,
-                                                density=p["material.wall.density_kg_m3"],
-                                                frictionAngle=math.atan(p["material.grain_wall.friction"]),
-                                                label="wall"))
-
-    radii = [m["radius_m"] for m in bed["clump_template"]["members"]]
-    dt = p["run.time_step_fraction"] * rayleigh_time_step(min(radii), rho_grain, g_grain, nu_grain)
-    inertia_min = min(bed["clump_template"]["principal_inertia_kg_m2"]) * rho_grain / \
-        bed["clump_template"]["density_kg_m3"]
-    rolling = p["run.rolling_moment"] == 1
-    rolling_stiffness = inertia_min * (2 * math.pi / (ROLLING_SPRING_PERIOD_STEPS * dt)) ** 2 if rolling else 0.0
-
-    pairs = lambda key: MatchMaker(matches=((grain_material, grain_material, key("grain_grain")),
-                                            (grain_material, wall_material, key("grain_wall"))))
-    O.engines = [
-        ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb()]),
-        InteractionLoop(
-            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Facet_Sphere_ScGeom(hertzian=p["run.hertzian_facets"] == 1)],
-            [Ip2_FrictMat_FrictMat_MindlinPhys(
-                frictAngle=pairs(lambda pair: math.atan(p["material.%s.friction" % pair])),
-                betan=pairs(lambda pair: damping_ratio(p["material.%s.restitution" % pair])),
-                betas=pairs(lambda pair: damping_ratio(p["material.%s.restitution" % pair])),
-                krot=rolling_stiffness, ktwist=0.0,
-                eta=p["material.grain_grain.rolling_friction"] if rolling else 0.0)],
-            [Law2_ScGeom_MindlinPhys_Mindlin(includeMoment=rolling)]),
-        NewtonIntegrator(damping=0.0, gravity=(0, 0, -bed["gravity_m_s2"])),
-    ]
-    O.dt = dt
-
+    contact = Contact(p, bed)
+    contact.install(bed["gravity_m_s2"])
     wall_top = max(bed["geometry"]["wall_top_m"], hopper_height(p) + p["geometry.body_height_m"])
-    plate_ids = build_silo(p, wall_top, wall_material)
-    clumps, frame = add_grains(bed, grain_material, rho_grain)
-    clump_ids = [c for c, _ in clumps]
-    columns = state_columns(clump_ids)
-    errors = import_errors(bed, in_kernel_frame(columns, frame))
-    if p["run.readback_file"]:
-        write_json_atomically(p["run.readback_file"], {
-            "schema": READBACK_SCHEMA, "time_s": O.time, "grains": dict(columns, count=len(clump_ids)),
-            "yade_template_frame": {"centre_m": list(frame.centre),
-                                    "orientation_wxyz": quaternion_wxyz(frame.orientation),
-                                    "note": "YADE's clump frame in the template's principal frame: kernel q = "
-                                            "q_yade conj(orientation), kernel X = X_yade - q centre_m"}})
-    print("bed: %d grains imported from %s; largest import errors %s" % (len(clump_ids), p["bed_file"], errors),
-          flush=True)
-
-    # --- the opening: the plate goes before the first step, as the kernel disables its plate at the opening
+    plate_ids = build_silo(p, wall_top, contact.wall_material)
+    clumps, frame, errors = import_bed(p, bed, contact)
+    # the opening: the plate goes before the first step, as the kernel disables its plate at the opening
     for plate_id in plate_ids:
         O.bodies.erase(plate_id)
+    record = DischargeRecord(p, bed, clumps, wall_top)
+    stop_reason, stiffness = discharge(p, record, contact)
 
-    mass_of = dict(clumps)
-    initial_mass = sum(m for _, m in clumps)
-    removal_z = -p["run.removal_depth_m"]
-    bounding_radius = max(Vector3(*m["offset_m"]).norm() + m["radius_m"] for m in bed["clump_template"]["members"])
-    escape_radius = p["geometry.D_m"] / 2.0 + ESCAPE_MARGIN_BOUNDING_RADII * bounding_radius
-    chunk = max(1, int(round(p["run.sample_interval_s"] / dt)))
-    times, masses, counts = [0.0], [0.0], [0]
-    in_silo = set(clump_ids)
-    discharged_mass, last_out_time, stop_reason = 0.0, 0.0, ""
-    stiffness_check = None
-    while True:
-        O.run(chunk, True)
-        leaving = []
-        for clump_id in in_silo:
-            pos = O.bodies[clump_id].state.pos
-            if not (math.isfinite(pos[0]) and math.isfinite(pos[1]) and math.isfinite(pos[2])):
-                raise RunFailure("nan", "grain %d at %s at t = %.6g s (step %d)" % (clump_id, pos, O.time, O.iter))
-            if pos[2] < removal_z:
-                leaving.append(clump_id)
-            elif math.hypot(pos[0], pos[1]) > escape_radius or pos[2] > wall_top + bounding_radius:
-                raise RunFailure("escaped", "grain %d at (%.4g, %.4g, %.4g) m is outside the silo at t = %.6g s"
-                                 % (clump_id, pos[0], pos[1], pos[2], O.time))
-        for clump_id in leaving:
-            O.bodies.erase(clump_id, True)  # the clump and its members
-            in_silo.discard(clump_id)
-            discharged_mass += mass_of[clump_id]
-        if leaving:
-            last_out_time = O.time
-        if stiffness_check is None:  # the bed's contacts exist after the first chunk
-            stiffness_check = stiffness_against_kernel(
-                {"grain_grain": kernel_pair_moduli(g_grain, nu_grain, g_grain, nu_grain),
-                 "grain_wall": kernel_pair_moduli(g_grain, nu_grain, g_wall, nu_wall)})
-        times.append(O.time)
-        masses.append(discharged_mass)
-        counts.append(len(clump_ids) - len(in_silo))
-        if not in_silo:
-            stop_reason = "empty"
-        elif discharged_mass >= p["run.stop_fraction"] * initial_mass * (1 - 1e-12):
-            stop_reason = "stop fraction %g of the initial mass discharged" % p["run.stop_fraction"]
-        elif O.time - last_out_time > p["run.stall_time_s"]:
-            stop_reason = "flow stopped: no grain left for %g s, %d grains remain" % (p["run.stall_time_s"],
-                                                                                      len(in_silo))
-        elif O.time >= p["run.discharge_time_s"] * (1 - 1e-12):
-            stop_reason = "time limit %g s" % p["run.discharge_time_s"]
-        if stop_reason:
-            break
-        if len(times) % 50 == 0:
-            print("t = %.4f s: %d grains discharged, %.4g kg, %d steps" % (O.time, counts[-1], discharged_mass,
-                                                                           O.iter), flush=True)
-
-    remaining_mass = sum(O.bodies[c].state.mass for c in in_silo)
+    fit = fit_rate(record.times, record.masses)
     result = {
         "schema": SCHEMA,
-        "curve": {"time_s": times, "discharged_mass_kg": masses, "grains_discharged": counts},
-        "rate": fit_rate(times, masses),
-        "initial_mass_kg": initial_mass,
-        "discharged_mass_kg": discharged_mass,
-        "remaining_mass_kg": remaining_mass,
-        "grains_initial": len(clump_ids),
-        "grains_discharged": counts[-1],
-        "grains_remaining": len(in_silo),
+        "curve": {"time_s": record.times, "discharged_mass_kg": record.masses, "grains_discharged": record.counts},
+        "rate": fit,
+        "initial_mass_kg": record.initial_mass,
+        "discharged_mass_kg": record.discharged_mass,
+        "remaining_mass_kg": record.remaining_mass(),
+        "grains_initial": record.grains,
+        "grains_discharged": record.counts[-1],
+        "grains_remaining": len(record.in_silo),
         "stop_reason": stop_reason,
         "discharge_time_s": O.time,
         "import_errors": errors,
         "yade_template_frame": {"centre_m": list(frame.centre), "orientation_wxyz": quaternion_wxyz(frame.orientation)},
         "steps": O.iter,
-        "time_step_s": dt,
+        "time_step_s": contact.dt,
         "kernel_time_step_s": bed["time_step_s"],
         "wall_time_s": time.time() - WALL_CLOCK_START,
         "cpu_time_s": time.process_time() - CPU_START,
         "yade_version": str(version),
-        "contact_setup": {
-            "hertzian_facets": p["run.hertzian_facets"] == 1,
-            "rolling_moment": rolling,
-            "rolling_stiffness_N_m_rad": rolling_stiffness,
-            "stiffness_over_kernel": stiffness_check,
-            "betan_grain_grain": damping_ratio(p["material.grain_grain.restitution"]),
-            "betan_grain_wall": damping_ratio(p["material.grain_wall.restitution"]),
-            "facet_segments": p["run.facet_segments"],
-        },
+        "contact_setup": dict(contact.summary(), stiffness_over_kernel=stiffness),
         # False: a deliberate mismatch (another material than the kernel's run): the comparison then measures it
         "material_as_bed": material_values(flatten(bed["material"], "material.")) == material_values(p)
-        and bed["stiffness_scale"] == scale,
+        and bed["stiffness_scale"] == p["run.stiffness_scale"],
     }
     write_json_atomically(result_path, result)
-    fit = result["rate"]
     print("discharged %d of %d grains (%.6g of %.6g kg) in %.4f s (%s); rate %s; %d steps of %.4g s, wall %.1f s"
-          % (counts[-1], len(clump_ids), discharged_mass, initial_mass, O.time, stop_reason,
-             "%.6g kg/s" % fit["rate_kg_s"] if fit["ok"] else "not determined (%s)" % fit["message"], O.iter, dt,
-             result["wall_time_s"]), flush=True)
+          % (record.counts[-1], record.grains, record.discharged_mass, record.initial_mass, O.time, stop_reason,
+             "%.6g kg/s" % fit["rate_kg_s"] if fit["ok"] else "not determined (%s)" % fit["message"], O.iter,
+             contact.dt, result["wall_time_s"]), flush=True)
 
 
 try:
