@@ -1,6 +1,6 @@
-// yade_scripts/silo.py against the kernel's bed (issue 22): `demcal silo --export-bed` writes a tiny filled bed, real
-// YADE discharges it; the bed YADE holds at t = 0 must be the kernel's to round-off, and the mass must be conserved.
-// Needs the demcal binary (built with the project) and the installed YADE.
+// The kernel's bed in YADE (issue 22): `demcal silo --export-bed` writes a tiny filled bed, real YADE discharges it
+// with yade_scripts/silo.py; the bed YADE holds at t = 0 must be the kernel's to round-off, and the mass must be
+// conserved. Needs the demcal binary (built with the project) and, for the [yade] cases, the installed YADE.
 #include <catch2/catch.hpp>
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -191,5 +191,22 @@ TEST_CASE("silo.py: bad params exit 2 naming the field", "[yade][silo]") {
         CHECK_THAT(log, Catch::Matchers::Contains("DEMCAL_FAILURE params: " + c.expect));
         CHECK_FALSE(fs::exists(dir / "result.json"));
     }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal silo --export-bed: a path that cannot be written is refused before the run", "[silo][cli]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-export-path-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    REQUIRE(fs::exists(DEMCAL_BINARY));
+    const fs::path out = dir / "never";
+    const int rc = run(std::string("'") + DEMCAL_BINARY + "' silo --theta 45 --particles 10 --out '" + out.string() +
+                           "' --export-bed '" + (dir / "no_such_folder/bed.json").string() + "'",
+                       dir / "demcal.log");
+    CHECK(rc == 2);
+    CHECK_THAT(demcal::test::read_file(dir / "demcal.log"),
+               Catch::Matchers::Contains("--export-bed = '" + (dir / "no_such_folder/bed.json").string() +
+                                         "': the folder " + (dir / "no_such_folder").string() + " does not exist"));
+    CHECK_FALSE(fs::exists(out));
     fs::remove_all(dir);
 }
