@@ -35,6 +35,7 @@ struct CampaignCli {
     std::string template_path;
     std::string line = "peak";
     std::string plot_format = "png";
+    std::string engine = "yade";
     orchestrator::ExecutionOptions exec;
 };
 
@@ -48,6 +49,9 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
         ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
     cmd->add_option("--campaign,-c", c.campaign_dir, "campaign directory (store, runs, results)")->capture_default_str();
     cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
+    cmd->add_option("--engine", c.engine, "yade or kernel (the same shear box on demcal's kernel with YADE's laws)")
+        ->check(CLI::IsMember({"yade", "kernel"}))
+        ->capture_default_str();
     cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
     cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     add_execution_options(cmd, c.exec);
@@ -81,7 +85,7 @@ std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<
 }
 
 CampaignSettings settings_of(const CampaignCli& c, const std::string& label) {
-    return {c.normal_stresses, c.replicates, c.seed, c.template_path, label};
+    return {c.normal_stresses, c.replicates, c.seed, c.template_path, label, orchestrator::parse_shear_engine(c.engine)};
 }
 
 // The campaign every failure line will run (stresses, replicates, seeds, template), checked on `material` before the
@@ -90,6 +94,8 @@ void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
     if (c.normal_stresses.size() < 2)
         throw UserError("normal-stress: a failure line needs at least 2 normal stresses, got " +
                         std::to_string(c.normal_stresses.size()));
+    if (c.engine == "kernel" && !c.template_path.empty())
+        throw UserError("template = '" + c.template_path + "' is a YADE script: it applies to --engine yade only");
     orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));
 }
 
@@ -109,7 +115,7 @@ struct CampaignSession {
     std::unique_ptr<orchestrator::ShearCampaignRunner> runner;
     FailureLineEvaluator evaluate;
     CampaignSession(const CampaignCli& c, const std::string& label) {
-        orchestrator::find_yade(c.exec.yade);
+        if (c.engine == "yade") orchestrator::find_yade(c.exec.yade);
         runner = std::make_unique<orchestrator::ShearCampaignRunner>(c.campaign_dir, c.exec);
         const CampaignSettings settings = settings_of(c, label);
         auto progress = [](const orchestrator::CampaignProgress& p) {
