@@ -120,6 +120,7 @@ void BasicSimulation<Law>::set_wall_velocity(int id, const Vec3& velocity) {
   if (w.motion) throw std::logic_error("set_wall_velocity: wall " + std::to_string(id) + " follows a motion law");
   if (!velocity.allFinite()) throw std::invalid_argument("set_wall_velocity: the velocity must be finite");
   w.velocity = velocity;
+  if (!Law::forces_depend_on_velocity) return;  // the forces of this state are the same: nothing to refresh
   if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
 }

@@ -75,6 +75,16 @@ struct ComposedLaw {
     if constexpr (requires { Tangential::uses_centre_velocities; }) return Tangential::uses_centre_velocities;
     else return false;
   }();
+  /// Whether a force evaluation that does not advance time (dt = 0) depends on the velocities (viscous damping,
+  /// rolling torques along omega): if not, a wall's new velocity changes no force until the next step, and the kernel
+  /// skips the re-evaluation (a sub-model says `velocity_free_at_rest = true`; by default it is assumed to depend).
+  static constexpr bool forces_depend_on_velocity = [] {
+    auto free = []<class M>() {
+      if constexpr (requires { M::velocity_free_at_rest; }) return M::velocity_free_at_rest; else return false;
+    };
+    return !(free.template operator()<Normal>() && free.template operator()<Tangential>() &&
+             free.template operator()<Rolling>());
+  }();
   /// Whether the law has bonds that a driver sets (bond_now below).
   static constexpr bool has_bonds =
       requires(const typename Normal::Coeffs& nc, const ContactGeometry& g, double* h) { Normal::bond(nc, g, h); };

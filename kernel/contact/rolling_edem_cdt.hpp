@@ -52,6 +52,7 @@ struct NoRolling {
   static constexpr int history_size = 0;
   static void swap_history(double*) {}
   static constexpr bool uses_omega_norm = false;
+  static constexpr bool velocity_free_at_rest = true;
   [[gnu::always_inline]] static inline void torque(const Coeffs&, const NormalState&, const ContactGeometry&,
                                                    const ContactKinematics&, Vec3&, Vec3&, bool) {}
 };

@@ -39,6 +39,7 @@ struct YadeCohesiveNormal {
   }
   static constexpr int history_size = 3;  ///< [0]: 1 while bonded; [1], [2]: the bond's normal and shear strength [N]
   static constexpr bool beyond_contact = true;
+  static constexpr bool velocity_free_at_rest = true;  ///< a linear spring, no damping
   static void swap_history(double*) {}
 
   /// The radius YADE gives body j: its own, or the sphere's for a wall (radius_j = 0).

@@ -40,6 +40,7 @@ struct YadeIncrementalTangential {
   }
   static constexpr bool lever_at_overlap_middle = true;
   static constexpr bool uses_centre_velocities = true;
+  static constexpr bool velocity_free_at_rest = true;  ///< velocities enter only as dt * v (nothing at dt = 0)
 
   [[gnu::always_inline]] static inline Vec3 force(const Coeffs& c, const ContactGeometry& g, const ContactKinematics& k,
                                                   const Vec3&, NormalState& nrm, double* h, double dt, bool wall) {
