@@ -254,6 +254,7 @@ int run_crosscheck(const CrosscheckOptions& opt) {
 void add_crosscheck_command(CLI::App& app) {
     auto* crosscheck = app.add_subcommand("crosscheck", "run one case on YADE and on the kernel, compare the results");
     crosscheck->require_subcommand(1);
+    add_crosscheck_silo_subcommand(*crosscheck);
     auto opt = std::make_shared<CrosscheckOptions>();
     auto* shear = crosscheck->add_subcommand(
         "shear", "the same shear campaign on both engines: failure lines, their difference, time per run");

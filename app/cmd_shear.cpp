@@ -142,7 +142,7 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
     if (outcome.interrupted) return 130;
     if (!outcome.infrastructure_failure.empty()) {
         std::cout << "the simulator could not be started (" << outcome.infrastructure_failure
-                  << "); the runs it hit stay pending: fix --yade, then `demcal resume " << dir.string() << "`\n";
+                  << "); the runs it hit stay pending: fix it (--yade; the kernel engine: the demcal program), then `demcal resume " << dir.string() << "`\n";
         return kExitResumeLater;
     }
     return outcome.failed > 0 ? 1 : 0;

@@ -24,7 +24,7 @@ FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runne
             throw std::runtime_error("interrupted; every finished run is stored: run the same command again to resume");
         if (!ev.outcome.infrastructure_failure.empty())
             throw std::runtime_error("the simulator could not be started (" + ev.outcome.infrastructure_failure +
-                                     "); every finished run is stored: fix --yade and run the same command again");
+                                     "); every finished run is stored: fix it (--yade; the kernel engine: the demcal program) and run the same command again");
         return ev;
     };
 }

@@ -171,6 +171,21 @@ void write_kernel_run_directory(const PlannedRun& r, const EngineSetup& engine) 
     write_params(r);
 }
 
+// The kernel engine's program is copied into the campaign (DIR/.kernel-engine/, replaced atomically when it
+// changed): a rebuild of demcal while a campaign runs then neither fails the runs it starts ("cannot start:
+// permission denied" while the linker writes the file: measured, an overnight campaign stopped at 182 of 300 runs)
+// nor mixes two builds within one campaign call.
+std::string pinned_program(const std::string& program, const fs::path& dir) {
+    fs::create_directories(dir);
+    const fs::path copy = dir / fs::path(program).filename();
+    const std::string bytes = read_text_file(program);
+    if (fs::exists(copy) && fs::file_size(copy) == bytes.size() && read_text_file(copy) == bytes) return copy.string();
+    write_text_file_atomically(copy, bytes);
+    fs::permissions(copy, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                              fs::perms::others_read | fs::perms::others_exec);
+    return copy.string();
+}
+
 EngineSetup engine_setup(const ShearCampaignSpec& spec, const ExecutionOptions& o) {
     if (spec.engine == ShearEngine::kernel) {
         if (o.kernel_command.empty() || o.kernel_engine.empty())
@@ -295,7 +310,8 @@ void ShearCampaignRunner::recover_stale_runs() {
 ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, const ProgressCallback& progress) {
     validate_shear_spec(spec_in);
     const ShearCampaignSpec spec = resolved(spec_in);
-    const EngineSetup engine = engine_setup(spec, options_);
+    EngineSetup engine = engine_setup(spec, options_);
+    if (spec.engine == ShearEngine::kernel) engine.command[0] = pinned_program(engine.command[0], dir_ / ".kernel-engine");
     const auto plan = plan_runs(spec, engine.identity_text, dir_);
 
     ShearCampaignOutcome out;

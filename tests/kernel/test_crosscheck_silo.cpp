@@ -1,0 +1,55 @@
+// demcal crosscheck silo end to end with real YADE: the kernel fills and discharges a tiny reduced silo, YADE
+// discharges the same bed; the report holds both rates (within 25 % of each other on 300 grains), the curve gap, the
+// costs; the same command again reuses both runs (nothing started); a bad angle is refused before anything runs.
+#include "test_files.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace fs = std::filesystem;
+using demcal::test::read_file;
+
+namespace {
+int run_demcal(const std::string& args, const fs::path& log) {
+    const std::string cmd = std::string("'") + DEMCAL_BINARY + "' " + args + " > '" + log.string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+}  // namespace
+
+TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both", "[yade]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-xsilo-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string args = "crosscheck silo --theta 45 --particles 300 --stiffness-scale 1e-3 --geometry '" +
+                             (fs::path(DEMCAL_SOURCE_DIR) / "examples/silo/reduced_conical_70deg.json").string() +
+                             "' --max-time 3 --jobs 1 -c '" + (dir / "c").string() + "'";
+    REQUIRE(run_demcal(args, dir / "first.log") == 0);
+    INFO(read_file(dir / "first.log"));
+    const auto report = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
+    REQUIRE(report["angles"].size() == 1);
+    const auto& a = report["angles"][0];
+    CHECK(a["kernel"]["rate_kg_s"].get<double>() > 0);
+    CHECK(a["yade"]["rate_kg_s"].get<double>() > 0);
+    CHECK(a["rate_ratio_yade_over_kernel"].get<double>() > 0.8);
+    CHECK(a["rate_ratio_yade_over_kernel"].get<double>() < 1.25);
+    CHECK(a["largest_curve_gap_of_filled_mass"].get<double>() < 0.2);
+    CHECK(a["cpu_ratio_yade_over_kernel"].get<double>() > 1);
+    CHECK(fs::exists(dir / "c" / "theta_45" / "bed.json"));
+    CHECK(fs::exists(dir / "c" / "crosscheck_silo.md"));
+    // the same command again: both runs reused
+    REQUIRE(run_demcal(args, dir / "second.log") == 0);
+    CHECK(read_file(dir / "second.log").find("started") == std::string::npos);
+    // a bad angle: exit 2, named, nothing run
+    CHECK(run_demcal("crosscheck silo --theta 95 -c '" + (dir / "bad").string() + "'", dir / "bad.log") == 2);
+    CHECK(read_file(dir / "bad.log").find("theta") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "bad"));
+    fs::remove_all(dir);
+}
