@@ -12,6 +12,7 @@ orchestrator::ShearCampaignSpec CampaignSettings::spec_for(const nlohmann::json&
     spec.base_seed = base_seed;
     spec.template_path = template_path;
     spec.label = label;
+    spec.engine = engine;
     return spec;
 }
 

@@ -17,6 +17,7 @@ struct CampaignSettings {
     long base_seed = 1;                    // fixed: common random numbers across materials
     std::filesystem::path template_path;   // empty: the installed yade_scripts/shear_box.py
     std::string label;                     // campaign label prefix, e.g. "sensitivity" or "calibrate"
+    std::string engine = "yade";           // the shear-box simulator (orchestrator::shear_engines())
 
     // The campaign of one failure line of `material`.
     orchestrator::ShearCampaignSpec spec_for(const nlohmann::json& material) const;

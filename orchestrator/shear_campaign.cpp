@@ -12,6 +12,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <deque>
@@ -25,8 +26,11 @@ namespace demcal::orchestrator {
 namespace fs = std::filesystem;
 
 nlohmann::json ShearCampaignSpec::to_json() const {
-    return {{"material", material},       {"normal_stresses", normal_stresses}, {"replicates", replicates},
-            {"base_seed", base_seed},     {"template", template_path.string()}, {"label", label}};
+    nlohmann::json j = {{"material", material},   {"normal_stresses", normal_stresses}, {"replicates", replicates},
+                        {"base_seed", base_seed}, {"template", template_path.string()}, {"label", label}};
+    // YADE, the first engine, is left out: the campaign names (hashes of this JSON) of existing stores stay valid
+    if (engine != "yade") j["engine"] = engine;
+    return j;
 }
 
 ShearCampaignSpec ShearCampaignSpec::from_json(const nlohmann::json& j) {
@@ -37,7 +41,13 @@ ShearCampaignSpec ShearCampaignSpec::from_json(const nlohmann::json& j) {
     s.base_seed = j.at("base_seed").get<long>();
     s.template_path = j.at("template").get<std::string>();
     s.label = j.value("label", "");
+    s.engine = j.value("engine", "yade");
     return s;
+}
+
+const std::vector<std::string>& shear_engines() {
+    static const std::vector<std::string> engines = {"yade"};
+    return engines;
 }
 
 fs::path default_shear_template() {
@@ -168,6 +178,13 @@ void check_run_count(double runs, long max_runs, const std::string& breakdown) {
 }
 
 void validate_shear_spec(const ShearCampaignSpec& spec) {
+    const auto& engines = shear_engines();
+    if (std::find(engines.begin(), engines.end(), spec.engine) == engines.end())
+    {
+        std::string known;
+        for (const auto& e : engines) known += (known.empty() ? "" : ", ") + e;
+        throw std::invalid_argument("engine = '" + spec.engine + "' is not a shear engine of this build (" + known + ")");
+    }
     if (spec.normal_stresses.empty()) throw std::invalid_argument("normal_stress: at least one normal stress is needed");
     for (double s : spec.normal_stresses)
         if (!(s > 0) || !std::isfinite(s))

@@ -25,6 +25,7 @@ struct ShearCampaignSpec {
     long base_seed = 1;
     std::filesystem::path template_path;     // empty: the installed yade_scripts/shear_box.py
     std::string label;                       // optional human name, e.g. "sensitivity density level 2"
+    std::string engine = "yade";             // the shear-box simulator, one of shear_engines()
 
     nlohmann::json to_json() const;
     static ShearCampaignSpec from_json(const nlohmann::json& j);
@@ -67,6 +68,9 @@ struct ShearCampaignOutcome {
     std::string infrastructure_failure;
     bool complete() const { return !interrupted && failed == 0 && infrastructure_failure.empty(); }
 };
+
+// The shear-box simulators a campaign can run; a new engine is one more name here (and its runner).
+const std::vector<std::string>& shear_engines();
 
 std::filesystem::path default_shear_template();
 // Throws std::invalid_argument when the YADE launcher cannot be found (naming it and how to install it).
