@@ -6,6 +6,7 @@
 #include <gsl/gsl_fit.h>
 #include <gsl/gsl_multifit.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -103,8 +104,10 @@ double log_log_curvature_p_value(std::span<const double> r, std::span<const doub
 }
 
 // Why the points cannot determine the power law, or empty.
-std::string power_law_undetermined(const ScalingLawFit& fit, double curvature_p) {
+std::string power_law_undetermined(const ScalingLawFit& fit, std::span<const double> y, double curvature_p) {
     const auto& d = fit.params[1];
+    if (std::all_of(y.begin(), y.end(), [&](double v) { return v == y[0]; }))
+        return "the same value at every radius: a constant, with no exponent to estimate";
     if (!fit.converged) return "the nonlinear fit did not converge";
     if (!std::isfinite(fit.params[0].std_error) || !std::isfinite(d.std_error))
         return "the covariance is singular: C and D cannot be separated";
@@ -192,7 +195,7 @@ ScalingLawFit fit_power_law(std::span<const double> r, std::span<const double> y
     fit.params = {parameter("C", ls.params[0], ls.covariance[0], t), parameter("D", ls.params[1], ls.covariance[3], t)};
     fit.residual_sd = std::sqrt(ls.sse / fit.dof);
     fit.r_squared = weighted_r_squared(y, w, ls.sse);
-    fit.undetermined = power_law_undetermined(fit, log_log_curvature_p_value(r, y, w));
+    fit.undetermined = power_law_undetermined(fit, y, log_log_curvature_p_value(r, y, w));
     return fit;
 }
 

@@ -163,7 +163,14 @@ RadiusCalibration calibrate_radius(const nlohmann::json& base, double r, const s
     RadiusCalibration c;
     c.radius = r;
     const auto material = material_at_radius(base, r);
-    c.study = run_sensitivity_study(material, evaluate, study_options(o));
+    c.study = run_sensitivity_study(material, evaluate, study_options(o),
+                                    [&](const std::string& param, const SensitivityLevel& l) {
+                                        std::ostringstream line;
+                                        line.precision(4);
+                                        line << "    study " << param << " = " << l.value << ": mu_b " << l.mu_b
+                                             << ", tau_c " << l.tau_c << " Pa";
+                                        say(progress, line.str());
+                                    });
     CalibrationOptions search = o.calibration;
     search.tolerance = o.tolerance;  // one tolerance for the search and the verification
     search.line = o.line;
