@@ -29,6 +29,7 @@ struct ScaleCli {
     std::vector<std::string> ranges, bounds;
     int max_evaluations = 6;
     bool strict = false;
+    bool point_targets = false;
     bool allow_unconverged = false;
     bool no_plot = false;
     std::string output;  // default CAMPAIGN/scale.json
@@ -48,6 +49,7 @@ calibration::EnlargementOptions enlargement_options(const ScaleCli& o) {
     e.calibration.accept_simulated_interval = !o.strict;
     e.bounds = parse_ranges(o.bounds, "bounds");
     e.fit_unconverged = o.allow_unconverged;
+    e.point_targets = o.point_targets;
     return e;
 }
 
@@ -123,7 +125,11 @@ void add_scale_command(CLI::App& app) {
     cmd->add_option("--bounds", o->bounds, "search bounds NAME=LOW:HIGH (default: the studied range)");
     cmd->add_option("--max-evaluations", o->max_evaluations, "failure lines per calibration at most (start included)")
         ->capture_default_str();
-    cmd->add_flag("--strict", o->strict, "accept a calibration on the tolerance (and the reference's interval) only");
+    cmd->add_flag("--strict", o->strict, "accept a calibration on the tolerance (and the reference's interval) only, "
+                                         "not because the target lies inside the simulated line's interval");
+    cmd->add_flag("--point-targets", o->point_targets,
+                  "aim at the reference line's mu_b and tau_c within --tol only, not widened by the reference's own "
+                  "interval");
     cmd->add_flag("--allow-unconverged", o->allow_unconverged,
                   "fit the laws through unconverged calibrations' best points too, and exit 0 when a fit is not "
                   "determined (reported all the same)");
@@ -135,8 +141,8 @@ void add_scale_command(CLI::App& app) {
         const auto options = enlargement_options(*o);
         check_scale(base, *o, options);
         CampaignSession session(o->campaign, "scale");
-        const auto study = calibration::run_enlargement_study(base, session.evaluate, options,
-                                                              [](const std::string& line) { std::cout << line << std::endl; });
+        const auto print = [](const std::string& line) { std::cout << line << std::endl; };
+        const auto study = calibration::run_enlargement_study(base, session.evaluate, options, print);
         write_outputs(study, *o);
         print_summary(study, *o);
         if (!study.problems.empty() && !o->allow_unconverged) {

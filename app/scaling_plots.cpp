@@ -48,15 +48,17 @@ std::string trend_expression(const analytics::ResponseShapeResult& t) {
 }  // namespace
 
 void plot_macro_trends(const fs::path& picture, const calibration::EnlargementStudy& s) {
-    const fs::path data = data_beside(picture), verified = picture.parent_path() / (picture.stem().string() + "_laws.dat");
+    const fs::path data = data_beside(picture);
+    const fs::path verified = picture.parent_path() / (picture.stem().string() + "_verified.dat");
     std::ostringstream d, v;
     d << "# r_m mu_b se_mu_b tau_c_Pa se_tau_c_Pa (base parameters)\n" << std::setprecision(10);
-    for (const auto& b : s.bases)
-        d << b.radius << " " << b.line.mu_b << " " << b.line.se_mu_b << " " << b.line.tau_c << " " << b.line.se_tau_c << "\n";
+    const auto row = [](std::ostream& out, double r, const analytics::FailureLine& l) {
+        out << r << " " << l.mu_b << " " << l.se_mu_b << " " << l.tau_c << " " << l.se_tau_c << "\n";
+    };
+    for (const auto& b : s.bases) row(d, b.radius, b.line);
     v << "# r_m mu_b se_mu_b tau_c_Pa se_tau_c_Pa (the laws' materials)\n" << std::setprecision(10);
     for (const auto& x : s.verifications)
-        if (x.not_run_because.empty())
-            v << x.radius << " " << x.line.mu_b << " " << x.line.se_mu_b << " " << x.line.tau_c << " " << x.line.se_tau_c << "\n";
+        if (x.not_run_because.empty()) row(v, x.radius, x.line);
     orchestrator::write_text_file_atomically(data, d.str());
     orchestrator::write_text_file_atomically(verified, v.str());
     const auto& ref = s.bases.front().line;

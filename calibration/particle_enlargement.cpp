@@ -80,7 +80,8 @@ void check_radii(const std::vector<double>& radii) {
 // Every evaluation of the study goes through here: counts, and CPU of each distinct failure line once.
 class CountingEvaluator {
 public:
-    CountingEvaluator(const FailureLineEvaluator& evaluate, EnlargementStudy& study) : evaluate_(evaluate), study_(study) {}
+    CountingEvaluator(const FailureLineEvaluator& evaluate, EnlargementStudy& study)
+        : evaluate_(evaluate), study_(study) {}
     FailureLineEvaluation operator()(const nlohmann::json& material) {
         auto ev = evaluate_(material);
         ++study_.evaluations;
@@ -149,12 +150,24 @@ void fit_cost_and_trends(EnlargementStudy& s) {
     }
 }
 
-std::vector<MacroTarget> reference_targets(const analytics::FailureLine& reference) {
+std::vector<MacroTarget> reference_targets(const analytics::FailureLine& reference, bool point_targets) {
     std::vector<MacroTarget> targets;
-    // The reference is itself a simulated line: a difference inside its own interval cannot be resolved.
+    // The reference is itself a simulated line: a difference inside its own interval cannot be resolved, so by
+    // default that interval widens the acceptance (as for a measured line).
     for (const auto& q : macro_quantities())
-        targets.push_back({q, macro_value(reference, q), macro_half_width(reference, q)});
+        targets.push_back({q, macro_value(reference, q),
+                           point_targets ? std::nullopt : std::optional<double>(macro_half_width(reference, q))});
     return targets;
+}
+
+// Whether the base material at this radius already restores the reference line: the loop's own acceptance rule on a
+// budget of one evaluation (the start, already run in step 1).
+CalibrationResult start_if_accepted(const nlohmann::json& material, const std::vector<MacroTarget>& targets,
+                                    const std::vector<ControlParameter>& controls, const FailureLineEvaluator& evaluate,
+                                    CalibrationOptions search) {
+    search.method = SearchMethod::coordinate;
+    search.max_evaluations = 1;
+    return calibrate(material, targets, controls, nullptr, evaluate, search);
 }
 
 RadiusCalibration calibrate_radius(const nlohmann::json& base, double r, const std::vector<MacroTarget>& targets,
@@ -163,26 +176,35 @@ RadiusCalibration calibrate_radius(const nlohmann::json& base, double r, const s
     RadiusCalibration c;
     c.radius = r;
     const auto material = material_at_radius(base, r);
-    c.study = run_sensitivity_study(material, evaluate, study_options(o),
-                                    [&](const std::string& param, const SensitivityLevel& l) {
-                                        std::ostringstream line;
-                                        line.precision(4);
-                                        line << "    study " << param << " = " << l.value << ": mu_b " << l.mu_b
-                                             << ", tau_c " << l.tau_c << " Pa";
-                                        say(progress, line.str());
-                                    });
+    const auto controls = controls_at(material, o);
     CalibrationOptions search = o.calibration;
     search.tolerance = o.tolerance;  // one tolerance for the search and the verification
     search.line = o.line;
-    c.result = calibrate(material, targets, controls_at(material, o), &c.study, evaluate, search,
-                         [&](const CalibrationIteration& it) {
-                             std::ostringstream line;
-                             line.precision(4);
-                             line << "    #" << it.evaluation << " E " << it.values.at("young_modulus") << " Pa, nu "
-                                  << it.values.at("poisson_ratio") << ": mu_b " << it.mu_b << ", tau_c " << it.tau_c
-                                  << " Pa" << (it.accepted ? " accepted (" + it.accepted_by + ")" : "");
-                             say(progress, line.str());
-                         });
+    auto report = [&](const CalibrationIteration& it) {
+        std::ostringstream line;
+        line.precision(4);
+        line << "    #" << it.evaluation << " E " << it.values.at("young_modulus") << " Pa, nu "
+             << it.values.at("poisson_ratio") << ": mu_b " << it.mu_b << ", tau_c " << it.tau_c << " Pa"
+             << (it.accepted ? " accepted (" + it.accepted_by + ")" : "");
+        say(progress, line.str());
+    };
+    c.result = start_if_accepted(material, targets, controls, evaluate, search);
+    if (c.result.status == CalibrationStatus::converged) {
+        // nothing to calibrate: the study of E and nu would cost its runs for no search
+        c.result.method = search.method;
+        c.result.iterations.front().phase = "start";
+        report(c.result.iterations.front());
+    } else {
+        c.study = run_sensitivity_study(material, evaluate, study_options(o),
+                                        [&](const std::string& param, const SensitivityLevel& l) {
+                                            std::ostringstream line;
+                                            line.precision(4);
+                                            line << "    study " << param << " = " << l.value << ": mu_b " << l.mu_b
+                                                 << ", tau_c " << l.tau_c << " Pa";
+                                            say(progress, line.str());
+                                        });
+        c.result = calibrate(material, targets, controls, &c.study, evaluate, search, report);
+    }
     c.young_modulus = c.result.material.at("young_modulus").get<double>();
     c.poisson_ratio = c.result.material.at("poisson_ratio").get<double>();
     return c;
@@ -373,7 +395,7 @@ EnlargementStudy run_enlargement_study(const nlohmann::json& base_in, const Fail
     }
     fit_cost_and_trends(s);
 
-    const auto targets = reference_targets(s.bases.front().line);
+    const auto targets = reference_targets(s.bases.front().line, options.point_targets);
     say(progress, "2. calibration of young_modulus and poisson_ratio to the reference line (" +
                       line_text(s.bases.front().line) + ")");
     for (std::size_t i = 1; i < options.radii.size(); ++i) {
@@ -416,7 +438,7 @@ nlohmann::json EnlargementStudy::to_json() const {
                                 {"poisson_ratio", c.poisson_ratio},
                                 {"evaluations", c.result.evaluations},
                                 {"best", c.result.iterations.at(c.result.best).to_json()},
-                                {"study", c.study.to_json()}};
+                                {"study", c.study.parameters.empty() ? nlohmann::json(nullptr) : c.study.to_json()}};
         }
         for (const auto& v : verifications)
             if (v.radius == b.radius) {
@@ -499,8 +521,8 @@ std::string EnlargementStudy::markdown() const {
     std::ostringstream o;
     o.precision(4);
     o << "## Base parameters per radius (" << to_string(options.line) << " line)\n\n"
-      << "| r [mm] | box/d across | box/d height | particles | steps | dt [s] | CPU/run [s] | wall/run [s] | mu_b +/- SE "
-         "| tau_c +/- SE [Pa] |\n|---|---|---|---|---|---|---|---|---|---|\n";
+      << "| r [mm] | box/d across | box/d height | particles | steps | dt [s] | CPU/run [s] | wall/run [s] "
+         "| mu_b +/- SE | tau_c +/- SE [Pa] |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& b : bases)
         o << "| " << b.radius * 1e3 << " | " << b.box.across << (b.box.adequate() ? "" : " (!)") << " | "
           << b.box.height << " | " << b.cost.particles << " | " << b.cost.steps << " | " << b.cost.timestep_s << " | "
@@ -515,7 +537,8 @@ std::string EnlargementStudy::markdown() const {
     }
     if (!verifications.empty()) {
         o << "\n## Verification: the laws' materials\n\n| r [mm] | E [Pa] | " << kPoissonLabel
-          << " | mu_b (dev.) | tau_c [Pa] (dev.) | within " << 100 * options.tolerance << " % | cost saved |\n|---|---|---|---|---|---|---|\n";
+          << " | mu_b (dev.) | tau_c [Pa] (dev.) | within " << 100 * options.tolerance
+          << " % | cost saved |\n|---|---|---|---|---|---|---|\n";
         for (const auto& v : verifications) {
             o << "| " << v.radius * 1e3 << " | " << v.young_modulus << " | " << v.poisson_ratio << " | ";
             if (!v.not_run_because.empty()) {
@@ -527,7 +550,8 @@ std::string EnlargementStudy::markdown() const {
               << 100 * v.cost_saved << " % |\n";
         }
     }
-    o << "\n## Laws (r in m; " << 100 * options.confidence << " % intervals)\n\n| law | constants | R^2 | determined |\n"
+    o << "\n## Laws (r in m; " << 100 * options.confidence
+      << " % intervals)\n\n| law | constants | R^2 | determined |\n"
       << "|---|---|---|---|\n"
       << law_row("CPU per run = C r^-D [s]", cpu_law) << trend_row("mu_b(r)", mu_b_trend)
       << trend_row("tau_c(r) [Pa]", tau_c_trend) << law_row("E(r) = A r + B [Pa]", young_law)

@@ -60,6 +60,8 @@ struct EnlargementOptions {
     CalibrationOptions calibration;      // max_evaluations, strict, method...
     std::map<std::string, std::pair<double, double>> bounds;  // search bounds overriding the studied range
     bool fit_unconverged = false;        // fit the laws through the best points of unconverged calibrations too
+    bool point_targets = false;          // aim at the reference's values with the tolerance only (not widened by
+                                         // the reference line's own interval)
 };
 
 // The material of one radius: the base with particle_radius = r, validated (the box against the particle size).
