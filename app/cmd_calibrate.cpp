@@ -370,10 +370,11 @@ void add_enlarge(CLI::App& app) {
         if (r.size() < 3) throw UserError("materials: " + std::to_string(r.size()) + " given, need at least 3 radii");
         const auto e_law = analytics::fit_linear_law(r, e);
         const auto nu_law = analytics::fit_power_law(r, nu);
-        if (!nu_law.converged && !o->allow_unconverged)  // e.g. nu equal at every radius: D is not identifiable
-            throw std::runtime_error("enlarge: the power law nu(r) = C r^-D did not converge (" + nu_law.formula() +
-                                     "): D is not identifiable from these " + std::to_string(r.size()) +
-                                     " points; nothing written (--allow-unconverged writes it anyway)");
+        for (const auto* law : {&e_law, &nu_law})  // e.g. nu equal at every radius: D is not identifiable
+            if (!law->determined() && !o->allow_unconverged)
+                throw std::runtime_error("enlarge: " + law->formula() + " is not determined by these " +
+                                         std::to_string(r.size()) + " points: " + law->undetermined +
+                                         "; nothing written (--allow-unconverged writes it anyway)");
         nlohmann::json j = {{"young_modulus", e_law.to_json()},
                             {"poisson_ratio", nu_law.to_json()},
                             {"note", "r in m; poisson_ratio is YADE's ks/kn stiffness ratio, so nu(r) is a law for it"},
