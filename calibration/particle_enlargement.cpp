@@ -129,6 +129,20 @@ std::vector<double> usable_sigmas(const std::vector<double>& se) {
     return se;
 }
 
+// cost(r) = C r^-D; a fit that fails or is not determined is listed in the study's problems.
+std::optional<analytics::ScalingLawFit> fit_cost_law(const std::string& name, const std::vector<double>& r,
+                                                     const std::vector<double>& cost, EnlargementStudy& s) {
+    try {
+        // Costs scatter in proportion to themselves (timings on a shared machine): each point weighs 1 / y^2.
+        auto law = analytics::fit_power_law(r, cost, cost, s.options.confidence);
+        if (!law.determined()) s.problems.push_back(name + " = C r^-D: " + law.undetermined);
+        return law;
+    } catch (const std::invalid_argument& e) {
+        s.problems.push_back(name + " = C r^-D not fitted: " + e.what());
+        return std::nullopt;
+    }
+}
+
 void fit_cost_and_trends(EnlargementStudy& s) {
     std::vector<double> r, cpu, mu, se_mu, tau, se_tau;
     for (const auto& b : s.bases) {
@@ -139,15 +153,13 @@ void fit_cost_and_trends(EnlargementStudy& s) {
     for (const auto& b : s.bases) radii.push_back(b.radius);
     s.mu_b_trend = analytics::classify_response(radii, mu, usable_sigmas(se_mu), radii.front(), s.options.trend);
     s.tau_c_trend = analytics::classify_response(radii, tau, usable_sigmas(se_tau), radii.front(), s.options.trend);
-    for (const auto& b : s.bases)
+    std::vector<double> r_work, work;
+    for (const auto& b : s.bases) {
         if (b.cost.runs > 0 && b.cost.cpu_s > 0) r.push_back(b.radius), cpu.push_back(b.cost.cpu_s);
-    try {
-        // Timings on a shared machine scatter in proportion to themselves: each point weighs 1 / y^2 (relative).
-        s.cpu_law = analytics::fit_power_law(r, cpu, cpu, s.options.confidence);
-        if (!s.cpu_law->determined()) s.problems.push_back("cost(r) = C r^-D: " + s.cpu_law->undetermined);
-    } catch (const std::invalid_argument& e) {
-        s.problems.push_back(std::string("cost(r) = C r^-D not fitted: ") + e.what());
+        if (b.cost.particle_steps > 0) r_work.push_back(b.radius), work.push_back(b.cost.particle_steps);
     }
+    s.cpu_law = fit_cost_law("CPU per run", r, cpu, s);
+    s.work_law = fit_cost_law("particle-steps per run", r_work, work, s);
 }
 
 std::vector<MacroTarget> reference_targets(const analytics::FailureLine& reference, bool point_targets) {
@@ -292,9 +304,12 @@ std::string BoxRatio::warning() const {
     if (adequate()) return {};
     std::ostringstream o;
     o.precision(3);
-    o << "box/particle ratio " << across << " across, " << height << " in height: below ASTM D3080's " << min_across
-      << " and " << min_height << " largest particle lengths; the failure line may measure the box (the seed's "
-      << "cohesion drift at 5 and 7 mm)";
+    o << "the box is";
+    if (across < min_across)
+        o << " " << across << " particle lengths across (ASTM D3080: at least " << min_across << ")";
+    if (across < min_across && height < min_height) o << " and";
+    if (height < min_height) o << " " << height << " high (ASTM D3080: at least " << min_height << ")";
+    o << "; the failure line may measure the box (the seed's cohesion drift at 5 and 7 mm)";
     return o.str();
 }
 
@@ -312,23 +327,25 @@ BoxRatio box_ratio(const nlohmann::json& m) {
 }
 
 nlohmann::json RunCost::to_json() const {
-    return {{"runs", runs},           {"cpu_s_per_run", cpu_s}, {"cpu_s_sd", cpu_sd},     {"wall_s_per_run", wall_s},
-            {"particles", particles}, {"steps", steps},         {"timestep_s", timestep_s}};
+    return {{"runs", runs},           {"cpu_s_per_run", cpu_s}, {"cpu_s_sd", cpu_sd},
+            {"wall_s_per_run", wall_s}, {"particles", particles}, {"steps", steps},
+            {"timestep_s", timestep_s}, {"particle_steps", particle_steps}};
 }
 
 RunCost run_cost(const FailureLineEvaluation& ev) {
-    std::vector<double> cpu, wall, particles, steps, dt;
+    std::vector<double> cpu, wall, particles, steps, dt, work;
     for (const auto& r : ev.outcome.runs) {
         if (r.state != orchestrator::RunState::done) continue;
         if (r.cpu_s > 0) cpu.push_back(r.cpu_s), wall.push_back(r.wall_s);
         particles.push_back(r.result.value("particle_count", NAN));
         steps.push_back(r.result.value("steps", NAN));
         dt.push_back(r.result.value("timestep", NAN));
+        work.push_back(particles.back() * steps.back());
     }
     RunCost c;
     c.runs = static_cast<int>(cpu.size());
     c.cpu_s = mean(cpu), c.cpu_sd = sample_sd(cpu), c.wall_s = mean(wall);
-    c.particles = mean(particles), c.steps = mean(steps), c.timestep_s = mean(dt);
+    c.particles = mean(particles), c.steps = mean(steps), c.timestep_s = mean(dt), c.particle_steps = mean(work);
     return c;
 }
 
@@ -462,7 +479,10 @@ nlohmann::json EnlargementStudy::to_json() const {
             }
         radii.push_back(j);
     }
-    nlohmann::json cost = {{"law", optional_json(cpu_law)}, {"quantity", "CPU seconds per run"}};
+    nlohmann::json cost = {{"law", optional_json(cpu_law)},
+                           {"quantity", "CPU seconds per run"},
+                           {"work_law", optional_json(work_law)},
+                           {"work_quantity", "particles x steps per run (machine-independent; no start-up)"}};
     if (cpu_law) {  // the seed's claim: doubling the radius saved 94.9 % (cost ratio 2^-D)
         const auto& d = cpu_law->params[1];
         cost["saved_by_doubling"] = {{"value", 1 - std::pow(2.0, -d.value)},
@@ -553,7 +573,8 @@ std::string EnlargementStudy::markdown() const {
     o << "\n## Laws (r in m; " << 100 * options.confidence
       << " % intervals)\n\n| law | constants | R^2 | determined |\n"
       << "|---|---|---|---|\n"
-      << law_row("CPU per run = C r^-D [s]", cpu_law) << trend_row("mu_b(r)", mu_b_trend)
+      << law_row("CPU per run = C r^-D [s]", cpu_law) << law_row("particle-steps per run = C r^-D", work_law)
+      << trend_row("mu_b(r)", mu_b_trend)
       << trend_row("tau_c(r) [Pa]", tau_c_trend) << law_row("E(r) = A r + B [Pa]", young_law)
       << law_row(std::string(kPoissonLabel) + "(r) = C r^-D", poisson_law);
     if (!problems.empty()) {

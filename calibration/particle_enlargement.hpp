@@ -2,7 +2,8 @@
 // program: stored, cached, resumable shear campaigns):
 //  1. at each radius with the base parameters: the failure line, the box-to-particle size ratio and the computing
 //     cost per run (CPU and wall time, particles, steps, time step);
-//  2. fits: cost(r) = C r^-D (seed fig. 3.5), mu_b(r) and tau_c(r) linear or constant by an F test (fig. 3.4);
+//  2. fits: cost(r) = C r^-D (seed fig. 3.5) for the CPU time and for the work (particles x steps), mu_b(r) and
+//     tau_c(r) linear or constant by an F test (fig. 3.4);
 //  3. at each radius above the reference (the smallest), the calibration loop on young_modulus and poisson_ratio
 //     (a sensitivity study of both at that radius, then calibration/calibration_loop's NLopt search) aiming at the
 //     reference failure line; then E(r) = A r + B and nu(r) = C r^-D through the reference and the calibrated radii
@@ -46,6 +47,7 @@ struct RunCost {
     double cpu_s = 0, cpu_sd = 0;   // mean and standard deviation per run
     double wall_s = 0;
     double particles = 0, steps = 0, timestep_s = 0;
+    double particle_steps = 0;      // mean of particles x steps: the work, without the simulator's start-up
     nlohmann::json to_json() const;
 };
 RunCost run_cost(const FailureLineEvaluation& ev);
@@ -107,6 +109,7 @@ struct EnlargementStudy {
     EnlargementOptions options;
     std::vector<RadiusBase> bases;                        // one per radius
     std::optional<analytics::ScalingLawFit> cpu_law;      // CPU per run = C r^-D
+    std::optional<analytics::ScalingLawFit> work_law;     // particles x steps per run = C r^-D
     // mu_b(r), tau_c(r): linear, or constant when the slope's F test is not significant (x_ref = the reference radius)
     std::optional<analytics::ResponseShapeResult> mu_b_trend, tau_c_trend;
     std::vector<RadiusCalibration> calibrations;          // one per radius above the reference

@@ -100,6 +100,9 @@ TEST_CASE("the enlargement study recovers known laws, and their materials restor
     CHECK(study.cpu_law->determined());
     CHECK(covers(study.cpu_law->params[1], cost_p));
     CHECK(study.bases.front().cost.particles > study.bases.back().cost.particles);
+    // the work (particles x steps, r^-3 r^-1 here) follows its own power law, free of timing noise
+    REQUIRE(study.work_law);
+    CHECK(study.work_law->params[1].value == Approx(4).margin(0.05));
 
     // step 3: A, B, C, D inside their intervals, and the intervals are informative (not +/- everything)
     REQUIRE(study.young_law);
