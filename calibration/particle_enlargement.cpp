@@ -143,22 +143,26 @@ std::optional<analytics::ScalingLawFit> fit_cost_law(const std::string& name, co
     }
 }
 
-void fit_cost_and_trends(EnlargementStudy& s) {
-    std::vector<double> r, cpu, mu, se_mu, tau, se_tau;
+// mu_b(r) and tau_c(r) of the base parameters, weighted by their lines' standard errors.
+void fit_trends(EnlargementStudy& s) {
+    std::vector<double> radii, mu, se_mu, tau, se_tau;
     for (const auto& b : s.bases) {
+        radii.push_back(b.radius);
         mu.push_back(b.line.mu_b), se_mu.push_back(b.line.se_mu_b);
         tau.push_back(b.line.tau_c), se_tau.push_back(b.line.se_tau_c);
     }
-    std::vector<double> radii;
-    for (const auto& b : s.bases) radii.push_back(b.radius);
     s.mu_b_trend = analytics::classify_response(radii, mu, usable_sigmas(se_mu), radii.front(), s.options.trend);
     s.tau_c_trend = analytics::classify_response(radii, tau, usable_sigmas(se_tau), radii.front(), s.options.trend);
-    std::vector<double> r_work, work;
+}
+
+// CPU time and work (particles x steps) per run against r, over the radii that measured them.
+void fit_costs(EnlargementStudy& s) {
+    std::vector<double> r_cpu, cpu, r_work, work;
     for (const auto& b : s.bases) {
-        if (b.cost.runs > 0 && b.cost.cpu_s > 0) r.push_back(b.radius), cpu.push_back(b.cost.cpu_s);
+        if (b.cost.runs > 0 && b.cost.cpu_s > 0) r_cpu.push_back(b.radius), cpu.push_back(b.cost.cpu_s);
         if (b.cost.particle_steps > 0) r_work.push_back(b.radius), work.push_back(b.cost.particle_steps);
     }
-    s.cpu_law = fit_cost_law("CPU per run", r, cpu, s);
+    s.cpu_law = fit_cost_law("CPU per run", r_cpu, cpu, s);
     s.work_law = fit_cost_law("particle-steps per run", r_work, work, s);
 }
 
@@ -410,7 +414,8 @@ EnlargementStudy run_enlargement_study(const nlohmann::json& base_in, const Fail
         say(progress, line.str());
         if (!b.box.adequate()) s.warnings.push_back("r = " + num(r) + " m: " + b.box.warning());
     }
-    fit_cost_and_trends(s);
+    fit_trends(s);
+    fit_costs(s);
 
     const auto targets = reference_targets(s.bases.front().line, options.point_targets);
     say(progress, "2. calibration of young_modulus and poisson_ratio to the reference line (" +
