@@ -19,8 +19,8 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
     cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(positive_number());
     cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)")
         ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
-    cmd->add_option("--engine", c.engine, "shear-box simulator")
-        ->check(CLI::IsMember(orchestrator::shear_engines()))
+    cmd->add_option("--engine", c.engine, "yade or kernel (the same shear box on demcal's kernel with YADE's laws)")
+        ->check(CLI::IsMember({"yade", "kernel"}))
         ->capture_default_str();
     cmd->add_option("--campaign,--dir,-c", c.campaign_dir, "campaign directory (store, runs, results)")
         ->capture_default_str();
@@ -57,13 +57,15 @@ std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<
 }
 
 calibration::CampaignSettings settings_of(const CampaignCli& c, const std::string& label) {
-    return {c.normal_stresses, c.replicates, c.seed, c.template_path, label, c.engine};
+    return {c.normal_stresses, c.replicates, c.seed, c.template_path, label, orchestrator::parse_shear_engine(c.engine)};
 }
 
 void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
     if (c.normal_stresses.size() < 2)
         throw UserError("normal-stress: a failure line needs at least 2 normal stresses, got " +
                         std::to_string(c.normal_stresses.size()));
+    if (c.engine == "kernel" && !c.template_path.empty())
+        throw UserError("template = '" + c.template_path + "' is a YADE script: it applies to --engine yade only");
     orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));
 }
 
@@ -79,7 +81,7 @@ std::string cpu_duration(double s) {
 }
 
 CampaignSession::CampaignSession(const CampaignCli& c, const std::string& label) {
-    orchestrator::find_yade(c.exec.yade);
+    if (c.engine == "yade") orchestrator::find_yade(c.exec.yade);
     runner = std::make_unique<orchestrator::ShearCampaignRunner>(c.campaign_dir, c.exec);
     const calibration::CampaignSettings settings = settings_of(c, label);
     auto progress = [](const orchestrator::CampaignProgress& p) {

@@ -37,7 +37,7 @@ std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<
 calibration::CampaignSettings settings_of(const CampaignCli& c, const std::string& label);
 
 // The campaign every failure line will run (stresses, replicates, seeds, engine, template), checked on `material`
-// before the campaign directory exists.
+// before the campaign directory exists (a --template is YADE's: refused with --engine kernel).
 void check_campaign(const CampaignCli& c, const nlohmann::json& material);
 
 // "12 s", "3.4 min", "1.2 h": a total CPU time in a summary line.

@@ -3,6 +3,7 @@
 #include "app/commands.hpp"
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
+#include "app/shear_report.hpp"
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
@@ -32,46 +33,9 @@ struct ShearCliOptions {
     std::string campaign_dir;
     std::string template_path;
     std::string plot_format = "png";
+    std::string engine = "yade";
     ExecutionOptions exec;
 };
-
-void print_progress(const CampaignProgress& p) {
-    if (p.event == "started") return;  // one line per finished run keeps an overnight log readable
-    std::ostringstream line;
-    line << "[" << std::setw(6) << duration_text(p.elapsed_s) << "] " << std::left << std::setw(11) << p.event
-         << std::right;
-    if (p.run) {
-        line << " sigma=" << p.run->label.value("normal_stress", 0.0) << " Pa rep " << p.run->label.value("replicate", 0);
-        if (p.run->state == RunState::done)
-            line << "  peak " << std::setprecision(4) << p.run->result.value("peak_shear_stress", 0.0) << " Pa ("
-                 << duration_text(p.run->wall_s) << ")";
-        else if (!p.run->cause.empty())
-            line << "  " << p.run->cause << ": " << p.run->message;
-    }
-    line << "  | " << p.done << "/" << p.total << " done, " << p.running << " running, " << p.failed << " failed";
-    if (p.reused) line << " (" << p.reused << " reused)";
-    if (p.remaining_s >= 0 && p.pending + p.running > 0) line << ", ~" << duration_text(p.remaining_s) << " left";
-    std::cout << line.str() << std::endl;
-}
-
-void print_line(const char* title, const analytics::FailureLine& fl) {
-    std::ios saved(nullptr);
-    saved.copyfmt(std::cout);  // restored at the end: later output keeps cout's default format
-    std::cout << std::fixed << std::setprecision(4) << title << ": tau = " << fl.mu_b << " sigma + "
-              << std::setprecision(1) << fl.tau_c << " Pa\n"
-              << std::setprecision(4) << "  mu_b  = " << fl.mu_b << " +/- " << fl.se_mu_b << "  (95% CI "
-              << fl.mu_b_low << " .. " << fl.mu_b_high << "),  phi_b = " << std::setprecision(2) << fl.phi_b_deg
-              << " +/- " << fl.se_phi_b_deg << " deg\n"
-              << std::setprecision(1) << "  tau_c = " << fl.tau_c << " +/- " << fl.se_tau_c << " Pa  (95% CI "
-              << fl.tau_c_low << " .. " << fl.tau_c_high << "),  R^2 = " << std::setprecision(4) << fl.r_squared
-              << ", n = " << fl.n << "\n";
-    if (fl.lack_of_fit)
-        std::cout << "  lack of fit: F = " << std::setprecision(3) << fl.lack_of_fit->f_statistic << " ("
-                  << fl.lack_of_fit->df_lack_of_fit << ", " << fl.lack_of_fit->df_pure_error
-                  << " dof), p = " << fl.lack_of_fit->p_value
-                  << (fl.lack_of_fit->p_value < 0.05 ? "  -> the line does not fit the means" : "") << "\n";
-    std::cout.copyfmt(saved);
-}
 
 // Failure line with its points and 95 % band, and the shear curves, for one campaign.
 void write_plots(const fs::path& dir, const std::string& stem, const calibration::FailureLineEvaluation& ev,
@@ -199,6 +163,10 @@ void add_shear_commands(CLI::App& app) {
         ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));
     shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<material name>)");
     shear->add_option("--template", opt->template_path, "YADE template (default: yade_scripts/shear_box.py)");
+    shear->add_option("--engine", opt->engine,
+                      "yade (yade_scripts/shear_box.py) or kernel (the same box on demcal's kernel with YADE's laws)")
+        ->check(CLI::IsMember({"yade", "kernel"}))
+        ->capture_default_str();
     shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     shear->add_flag("--force", opt->exec.force, "recompute runs already in the store");
     add_execution_options(shear, opt->exec);
@@ -217,9 +185,12 @@ void add_shear_commands(CLI::App& app) {
         spec.replicates = opt->replicates;
         spec.base_seed = opt->seed;
         spec.template_path = opt->template_path;
+        spec.engine = parse_shear_engine(opt->engine);
+        if (spec.engine == ShearEngine::kernel && !opt->template_path.empty())
+            throw UserError("template = '" + opt->template_path + "' is a YADE script: it applies to --engine yade only");
         try {
             validate_shear_spec(spec);  // everything is checked before anything is written
-            find_yade(opt->exec.yade);
+            if (spec.engine == ShearEngine::yade) find_yade(opt->exec.yade);
         } catch (const std::invalid_argument& e) {
             throw UserError(e.what());
         }
@@ -228,8 +199,8 @@ void add_shear_commands(CLI::App& app) {
                                  : fs::path(opt->campaign_dir);
         ShearCampaignRunner runner(dir, opt->exec);
         std::cout << "campaign directory " << runner.dir().string() << ": " << spec.normal_stresses.size()
-                  << " normal stresses x " << spec.replicates << " replicates, " << opt->exec.executor
-                  << " executor\n";
+                  << " normal stresses x " << spec.replicates << " replicates, " << to_string(spec.engine)
+                  << " engine, " << opt->exec.executor << " executor\n";
         const auto outcome = runner.run(spec, print_progress);
         const int code = report_campaign(runner.dir(), outcome, opt->plot_format);
         if (code == 130) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";

@@ -3,6 +3,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
+#include "app/silo_bed_export.hpp"
 #include "app/silo_material.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
@@ -69,6 +70,7 @@ struct SiloCli {
     bool check_only = false;  // validate the settings, write nothing (demcal vibration checks its runs this way)
     double wall_limit = 0;
     std::string resume;
+    std::string export_bed;  // the filled bed at the opening, for yade_scripts/silo.py
 };
 
 // Exit status of a run stopped at --wall-limit (EX_TEMPFAIL): not finished, resume it. A job script can loop on it.
@@ -329,18 +331,6 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     return s;
 }
 
-nlohmann::json geometry_json(const ks::SiloGeometry& g) {
-    nlohmann::json j;
-    if (g.shape == ks::SiloShape::conical)
-        j = {{"shape", "conical"}, {"D_m", g.diameter}, {"outlet_m", g.outlet}};
-    else
-        j = {{"shape", "rectangular"}, {"a_m", g.outlet}, {"b_m", g.depth}, {"c_m", g.width}};
-    j["theta_deg"] = g.half_angle_deg;
-    j["body_height_m"] = g.body_height;
-    j["hopper_height_m"] = g.hopper_height();
-    return j;
-}
-
 // The settings as given (a still bin too: a sweep reads every run the same way) and the peak acceleration.
 nlohmann::json vibration_json(const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
     const ks::BinVibration& v = s.vibration;
@@ -460,6 +450,12 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
+    if (!o.export_bed.empty()) {
+        check_output_file(o.export_bed, "--export-bed");
+        s.at_opening = [file = o.export_bed, settings = s](const ks::OpenedBed& bed) {
+            write_silo_bed(file, bed, settings);
+        };
+    }
     if (o.check_only) {
         std::cout << "silo: the settings are valid (--check: nothing run, nothing written)\n";
         return;
@@ -556,7 +552,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
         throw CLI::RuntimeError(kExitSuspended);
     }
     nlohmann::json j;
-    j["geometry"] = geometry_json(s.geometry);
+    j["geometry"] = silo_geometry_json(s.geometry);
     j["grains"] = r.grains;
     j["grain_mass_kg"] = r.grain_mass;
     j["filled_mass_kg"] = r.filled_mass;
@@ -735,6 +731,9 @@ void add_silo_command(CLI::App& app) {
                     "the vibration starts this many simulated seconds after the outlet opens; the bin is still "
                     "while it fills")
         ->capture_default_str();
+    sub->add_option("--export-bed", o->export_bed,
+                    "write the filled bed at the opening (every grain's centre, orientation, velocities; the clump, "
+                    "materials, geometry) to this JSON file, for yade_scripts/silo.py");
     sub->add_flag("--no-plots", o->no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o->checkpoint_every,
                     "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "

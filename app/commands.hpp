@@ -17,6 +17,8 @@ struct UserError : std::runtime_error {
 inline constexpr int kExitResumeLater = 75;
 
 void add_shear_commands(CLI::App& app);        // shear, status, resume            (cmd_shear.cpp)
+void add_shear_run_command(CLI::App& app);     // shear-run (one kernel shear box)   (cmd_shear_run.cpp)
+void add_crosscheck_command(CLI::App& app);    // crosscheck shear                   (cmd_crosscheck.cpp)
 void add_silo_command(CLI::App& app);          // silo                              (cmd_silo.cpp)
 void add_cutoff_command(CLI::App& app);        // cutoff                            (cmd_cutoff.cpp)
 void add_vibration_command(CLI::App& app);     // vibration                         (cmd_vibration.cpp)

@@ -1,10 +1,19 @@
 #include "app/execution_options.hpp"
 
 #include "app/cli_support.hpp"
+#include "kernel/cases/shear_box.hpp"
+
+#include <filesystem>
 
 namespace demcal {
 
 void add_execution_options(CLI::App* cmd, orchestrator::ExecutionOptions& e) {
+    // The kernel engine's runs are this very program (its path now, so a rebuild during a campaign runs the new one
+    // only where the identity, which names the engine's version, says it is the same engine).
+    std::error_code ec;
+    const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) e.kernel_command = {self.string(), "shear-run"};
+    e.kernel_engine = kernel::cases::kShearBoxEngine;
     cmd->add_option("--jobs,-j", e.jobs, "runs in parallel (0 = one per core)")->check(non_negative_number());
     cmd->add_option("--timeout", e.timeout_s, "per-run wall-clock limit [s]")->check(positive_number());
     cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout")->check(non_negative_number());

@@ -8,6 +8,8 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "demcal 0.1");
     demcal::add_shear_commands(app);
+    demcal::add_shear_run_command(app);
+    demcal::add_crosscheck_command(app);
     demcal::add_silo_command(app);
     demcal::add_cutoff_command(app);
     demcal::add_vibration_command(app);

@@ -77,7 +77,9 @@ void plot_macro_trends(const fs::path& picture, const calibration::EnlargementSt
         return g.str() + "\n";
     };
     std::ostringstream g;
+    // offsets: the end radii's error bars off the frame
     g << "set multiplot layout 1,2 title 'Particle enlargement (error bars: 1 standard error)'\nset grid\n"
+      << "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n"
       << "set xlabel 'particle radius r_p [mm]'\nset key top left\n"
       << panel("mu_b [-]", 2, ref.mu_b, s.mu_b_trend) << panel("tau_c [Pa]", 4, ref.tau_c, s.tau_c_trend)
       << "unset multiplot\n";
@@ -94,7 +96,8 @@ void plot_run_cost(const fs::path& picture, const calibration::EnlargementStudy&
               << b.cost.particles << "\n";
     orchestrator::write_text_file_atomically(data, d.str());
     std::ostringstream g;
-    g << std::setprecision(10) << "set grid\nset xlabel 'particle radius r_p [mm]'\nset ylabel 'time per run [s]'\n"
+    g << std::setprecision(10) << "set grid\nset offsets graph 0.05, graph 0.05, 0, 0\n"
+      << "set xlabel 'particle radius r_p [mm]'\nset ylabel 'time per run [s]'\n"
       << "set title 'Computing cost against particle radius'\nset key top right\nset yrange [0:*]\n"
       << "plot " << gnuplot_quote(data) << " using ($1*1e3):2:3 with yerrorbars pt 7 lc rgb '#08519c' title 'CPU', "
       << gnuplot_quote(data) << " using ($1*1e3):4 with points pt 6 lc rgb '#636363' title 'wall'";

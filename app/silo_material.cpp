@@ -76,4 +76,17 @@ ks::WheatMaterials read_silo_material(const std::string& file) {
     return m;
 }
 
+json silo_material_json(const ks::WheatMaterials& m) {
+    const auto solid = [](const ks::Material& s) {
+        return json{{"shear_modulus_Pa", s.shear_modulus}, {"poisson", s.poisson}, {"density_kg_m3", s.density}};
+    };
+    const auto pair = [](const ks::PairCoefficients& p) {
+        return json{{"restitution", p.restitution}, {"friction", p.friction}, {"rolling_friction", p.rolling_friction}};
+    };
+    json grain = solid(m.wheat);
+    grain["shape"] = "wheat-clump";
+    return {{"grain", grain}, {"wall", solid(m.steel)}, {"grain_grain", pair(m.wheat_wheat)},
+            {"grain_wall", pair(m.wheat_steel)}};
+}
+
 }  // namespace demcal

@@ -2,6 +2,8 @@
 // Table 2.1, every field required, E or G for each solid, unknown keys refused. The seed's wheat is
 // examples/materials/silo_wheat_table21.json (equal to the built-in default).
 #pragma once
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 #include "kernel/silo/wheat.hpp"
@@ -11,5 +13,9 @@ namespace demcal {
 /// Reads FILE into the silo's materials (the stiffness scale is left as it is). Throws UserError naming the file, the
 /// field and the value.
 kernel::silo::WheatMaterials read_silo_material(const std::string& file);
+
+/// The materials as a material file spells them (G for each solid, unscaled; the stiffness scale is not part of it):
+/// read_silo_material reads it back to the same values.
+nlohmann::json silo_material_json(const kernel::silo::WheatMaterials& m);
 
 }  // namespace demcal

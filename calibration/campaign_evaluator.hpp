@@ -1,4 +1,4 @@
-// The calibration's evaluator over real YADE shear campaigns: each material becomes one campaign of the orchestrator
+// The calibration's evaluator over shear campaigns (YADE or the kernel engine): each material becomes one campaign of the orchestrator
 // (stored, cached by run hash, resumable), always at the same normal stresses and packing seeds, so that every
 // material of a study or a calibration sees the same packings (common random numbers).
 #pragma once
@@ -17,7 +17,7 @@ struct CampaignSettings {
     long base_seed = 1;                    // fixed: common random numbers across materials
     std::filesystem::path template_path;   // empty: the installed yade_scripts/shear_box.py
     std::string label;                     // campaign label prefix, e.g. "sensitivity" or "calibrate"
-    std::string engine = "yade";           // the shear-box simulator (orchestrator::shear_engines())
+    orchestrator::ShearEngine engine = orchestrator::ShearEngine::yade;  // which engine runs the boxes
 
     // The campaign of one failure line of `material`.
     orchestrator::ShearCampaignSpec spec_for(const nlohmann::json& material) const;

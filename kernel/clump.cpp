@@ -70,4 +70,16 @@ ClumpTemplate wheat_clump_template(double density, int cells) {
                              density, cells);
 }
 
+void scale_clump_template(ClumpTemplate& t, double factor) {
+  const double f3 = factor * factor * factor, f5 = f3 * factor * factor;
+  for (Vec3& p : t.positions) p *= factor;
+  for (Vec3& o : t.offsets) o *= factor;
+  for (double& r : t.radii) r *= factor;
+  t.com *= factor;
+  t.volume *= f3;
+  t.mass *= f3;
+  t.inertia *= f5;
+  t.bounding_radius *= factor;
+}
+
 }  // namespace demcal::kernel

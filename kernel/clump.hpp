@@ -27,6 +27,10 @@ struct ClumpTemplate {
 ClumpTemplate make_clump_template(const std::vector<Vec3>& positions, const std::vector<double>& radii, double density,
                                   int cells = 240);
 
+/// Scales a template about its centre of mass by `factor`: positions, offsets and radii (x factor), volume and mass
+/// (x factor^3), moments of inertia (x factor^5). Cheaper than integrating the larger union again, and exact.
+void scale_clump_template(ClumpTemplate& t, double factor);
+
 /// The seed's wheat grain (thesis section 2.3.1): three spheres in a row along x, the middle one r = 1.5 mm at the
 /// origin, the end ones r = 1.25 mm at +-1.5 mm; rho = 1430 kg/m^3 unless given.
 ClumpTemplate wheat_clump_template(double density = 1430.0, int cells = 240);

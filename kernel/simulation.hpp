@@ -112,6 +112,10 @@ class BasicSimulation {
   void bond_contacts_now()
     requires Law::has_bonds;
 
+  /// Laws with bonds: how many particle-particle contacts are bonded now (at the last force evaluation).
+  std::size_t bonded_contact_count() const
+    requires Law::has_bonds;
+
   /// Sets the velocity [m/s] of a wall without a prescribed motion law (a driver's servo or a shear frame): it moves by
   /// velocity * dt each step from then on. Throws for a wall that follows a law.
   void set_wall_velocity(int id, const Vec3& velocity);
@@ -133,6 +137,12 @@ class BasicSimulation {
   BodyId add_clump(int tmpl, int material, const Vec3& com, const Quat& orientation = Quat::Identity(),
                    const Vec3& velocity = Vec3::Zero(), const Vec3& omega = Vec3::Zero());
 
+  /// Scales every particle about its own centre of mass by `factor` (> 0): sphere radii, clump members' offsets and
+  /// radii, masses (factor^3) and moments of inertia (factor^5); velocities and angular velocities are kept, and so are
+  /// the contact histories. YADE's utils.growParticles(factor, updateMass = True), with which a packing procedure grows
+  /// a loose cloud in place. The clump templates are scaled with them (every body grows alike).
+  void scale_particles(double factor);
+
   // ---------------------------------------------------------------- run
   /// Advances n steps of the time step (velocity Verlet; forces at half-step velocities, as LAMMPS/LIGGGHTS).
   void step(long n = 1);
@@ -153,6 +163,14 @@ class BasicSimulation {
   SphereState sphere(std::size_t k) const;
   const std::vector<Vec3>& sphere_positions() const { return x_; }  ///< all sphere centres [m]
   const std::vector<double>& sphere_radii() const { return r_; }    ///< all sphere radii [m]
+
+  /// The spheres touching wall `id` at the last force evaluation (a sphere keeps up to 3 wall contacts with history;
+  /// contacts beyond that act but are not listed), in ascending sphere index.
+  std::vector<std::size_t> wall_contact_spheres(int id) const;
+  /// YADE's utils.unbalancedForce(): the mean over bodies of |contact force + m g| divided by the mean magnitude of
+  /// the contact forces (particle pairs and wall contacts acting at the last force evaluation), both before local
+  /// damping. A quasi-static packing has a small value (YADE's scripts wait for 0.01-0.05). 0 without contacts.
+  double unbalanced_force() const;
 
   /// Translational + rotational kinetic energy of all bodies [J].
   double kinetic_energy() const;
@@ -189,7 +207,8 @@ class BasicSimulation {
   void prepare();
   void compute_forces(bool rebuild, double dt_history);
   bool kick_drift(double kick);
-  void kick();
+  void kick(double sign = 1.0);  // the second half kick of velocity Verlet; -1 takes it back
+  void refresh_forces();         // forces of the current state after a change (step() calls it)
   void update_members(std::size_t c, const Mat3& R, bool positions);  // R: the clump's rotation matrix
   void rebuild_body_index();
   // Every per-sphere array (with its entries per sphere) and every per-clump array, listed once: renumbering and
@@ -267,6 +286,9 @@ class BasicSimulation {
   std::size_t min_parallel_ = 2000;
   int nt() const { return x_.size() >= min_parallel_ ? threads_ : 1; }
   bool forces_valid_ = false, prepared_ = false;
+  // The change that invalidated the forces leaves the state (positions, velocities) as it was: the last half kick,
+  // taken with the forces before the change, is taken again with the new ones (see refresh_forces).
+  bool rekick_on_refresh_ = false;
 };
 
 extern template class BasicSimulation<HertzMindlinEdem>;

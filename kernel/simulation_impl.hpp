@@ -103,6 +103,7 @@ int BasicSimulation<Law>::add_wall(const Wall& w) {
   nl_.invalidate();  // the wall candidates are found at the neighbour build
   prepared_ = false;
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   return int(walls_.size()) - 1;
 }
 
@@ -110,6 +111,7 @@ template <class Law>
 void BasicSimulation<Law>::set_wall_enabled(int id, bool enabled) {
   walls_.at(id).enabled = enabled;
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
 }
 
 template <class Law>
@@ -118,6 +120,7 @@ void BasicSimulation<Law>::set_wall_velocity(int id, const Vec3& velocity) {
   if (w.motion) throw std::logic_error("set_wall_velocity: wall " + std::to_string(id) + " follows a motion law");
   if (!velocity.allFinite()) throw std::invalid_argument("set_wall_velocity: the velocity must be finite");
   w.velocity = velocity;
+  if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
 }
 
@@ -183,6 +186,7 @@ BodyId BasicSimulation<Law>::add_sphere(const Vec3& position, double radius, int
   body_id_.push_back(next_id_);
   sphere_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   nl_.invalidate();
   return next_id_++;
 }
@@ -219,6 +223,7 @@ BodyId BasicSimulation<Law>::add_clump(int tmpl, int material, const Vec3& com, 
   clump_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   for (std::size_t k = 0; k < t.offsets.size(); ++k) sphere_body_.push_back(std::uint32_t(body_ref_.size() - 1));
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   nl_.invalidate();
   return next_id_++;
 }
@@ -363,8 +368,8 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
 }
 
 template <class Law>
-void BasicSimulation<Law>::kick() {
-  const double h = 0.5 * dt_;
+void BasicSimulation<Law>::kick(double sign) {
+  const double h = 0.5 * dt_ * sign;
   const Vec3 g = gravity_;
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
 #pragma omp parallel num_threads(nt())
@@ -716,6 +721,7 @@ template <class Law>
 void BasicSimulation<Law>::set_local_damping(double damping) {
   if (!(damping >= 0 && damping < 1)) throw std::invalid_argument("set_local_damping: damping must be in [0, 1)");
   local_damping_ = damping;
+  if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
 }
 
@@ -724,20 +730,43 @@ void BasicSimulation<Law>::bond_contacts_now()
   requires Law::has_bonds
 {
   bond_next_evaluation_ = true;
+  if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
+}
+
+template <class Law>
+std::size_t BasicSimulation<Law>::bonded_contact_count() const
+  requires Law::has_bonds
+{
+  // the bond flag is the normal model's first history entry, zeroed when the bond fails or the contact ends
+  std::size_t count = 0;
+  for (std::size_t p = 0; p < nl_.num_pairs(); ++p)
+    if (nl_.hist[p * kHist] != 0.0) ++count;
+  return count;
+}
+
+template <class Law>
+void BasicSimulation<Law>::refresh_forces() {
+  // Forces of the current state (after an insertion, a removal, a wall toggled, velocities set): time does not
+  // advance, so neither do the tangential springs; a wall on a law moves at its velocity of this instant.
+  // After a change that keeps the state (particles grown, a wall's velocity or the damping set, bonds made) the last
+  // half kick is taken back and taken again with the new forces, so the change acts on the whole step as in a
+  // leapfrog integrator (YADE's, where a PyRunner's change acts before the next force evaluation); without this the
+  // step that follows a change got half the old force, which made the kernel's shear box drift from YADE's.
+  const bool rekick = rekick_on_refresh_ && steps_ > 0;
+  rekick_on_refresh_ = false;
+  if (rekick) kick(-1.0);
+  for (Wall& w : walls_)
+    if (w.motion) w.velocity = w.motion->velocity(time_);
+  compute_forces(nl_.needs_rebuild(x_, nt()), 0.0);
+  if (rekick) kick(1.0);
+  forces_valid_ = true;
 }
 
 template <class Law>
 void BasicSimulation<Law>::step(long nsteps) {
   prepare();
-  if (!forces_valid_) {
-    // forces of the current state (after an insertion, a removal, a wall toggled, velocities set): time does not
-    // advance, so neither do the tangential springs; a wall on a law moves at its velocity of this instant
-    for (Wall& w : walls_)
-      if (w.motion) w.velocity = w.motion->velocity(time_);
-    compute_forces(nl_.needs_rebuild(x_, nt()), 0.0);
-    forces_valid_ = true;
-  }
+  if (!forces_valid_) refresh_forces();
   // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass
   for (long s = 0; s < nsteps; ++s) {
     const bool moved = kick_drift(s == 0 ? 1.0 : 2.0);
@@ -747,6 +776,84 @@ void BasicSimulation<Law>::step(long nsteps) {
     ++steps_;
   }
   if (nsteps > 0) kick();
+}
+
+template <class Law>
+void BasicSimulation<Law>::scale_particles(double factor) {
+  if (!(factor > 0 && std::isfinite(factor)))
+    throw std::invalid_argument("scale_particles: factor must be finite and > 0, got " + std::to_string(factor));
+  const double f3 = factor * factor * factor, f5 = f3 * factor * factor;
+  for (ClumpTemplate& t : templates_) scale_clump_template(t, factor);
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    r_[i] *= factor;
+    mass_[i] *= f3;  // a member's m* is its clump's mass
+    if (clump_[i] < 0) {
+      inv_mass_[i] /= f3;
+      inv_inertia_[i] /= f5;
+    }
+  }
+  for (std::size_t c = 0; c < cx_.size(); ++c) {
+    cm_[c] *= f3;
+    cI_[c] *= f5;
+    cL_[c] *= f5;  // the same angular velocity
+    update_members(c, cq_[c].toRotationMatrix(), true);
+  }
+  omega_norm_fresh_ = false;
+  if (forces_valid_) rekick_on_refresh_ = true;
+  forces_valid_ = false;
+  nl_.invalidate();  // the cells must hold the new largest sphere
+}
+
+template <class Law>
+std::vector<std::size_t> BasicSimulation<Law>::wall_contact_spheres(int id) const {
+  if (id < 0 || id >= int(walls_.size())) throw std::out_of_range("wall_contact_spheres: no wall " + std::to_string(id));
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    for (int k = 0; k < kWallSlots; ++k)
+      if (wall_slot_id_[i * kWallSlots + k] == id) out.push_back(i);
+  return out;
+}
+
+template <class Law>
+double BasicSimulation<Law>::unbalanced_force() const {
+  // The forces as the contacts gave them (apply_local_damping has rescaled f_ since): rebuilt from the pair loads of
+  // the last evaluation and the wall slots.
+  const std::size_t n = x_.size();
+  std::vector<Vec3> contact(n, Vec3::Zero());
+  double sum_contact = 0;
+  std::size_t contacts = 0;
+  const std::size_t pairs = std::min<std::size_t>(pair_load_.size(), nl_.num_pairs());
+  if (nl_.row.size() == n + 1)
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::uint32_t p = nl_.row[i]; p < nl_.row[i + 1] && p < pairs; ++p) {
+        const Vec3& fp = pair_load_[p].force_i;
+        if (fp == Vec3::Zero()) continue;
+        contact[i] += fp;
+        contact[std::size_t(nl_.nbr[p])] -= fp;
+        sum_contact += fp.norm();
+        ++contacts;
+      }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < kWallSlots; ++k)
+      if (wall_slot_id_[i * kWallSlots + k] >= 0) {
+        const Vec3& fw = wall_slot_f_[i * kWallSlots + k];
+        contact[i] += fw;
+        sum_contact += fw.norm();
+        ++contacts;
+      }
+  if (contacts == 0 || body_ref_.empty()) return 0.0;
+  double sum_body = 0;
+  for (const std::int32_t ref : body_ref_) {
+    if (ref >= 0) {
+      sum_body += (contact[std::size_t(ref)] + mass_[std::size_t(ref)] * gravity_).norm();
+    } else {
+      const std::size_t c = std::size_t(-ref - 1);
+      Vec3 F = cm_[c] * gravity_;
+      for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) F += contact[cmem_[k]];
+      sum_body += F.norm();
+    }
+  }
+  return (sum_body / double(body_ref_.size())) / (sum_contact / double(contacts));
 }
 
 template <class Law>
@@ -793,6 +900,8 @@ void BasicSimulation<Law>::set_body_velocity(std::size_t b, const Vec3& velocity
     update_members(c, R, false);
   }
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
+  rekick_on_refresh_ = false;  // (the state itself changed)
 }
 
 template <class Law>
@@ -871,6 +980,7 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   nl_.renumber(s_old2new, ns, &Law::swap_history);
   // forces of the remaining spheres are still valid except for the contacts with removed ones; recompute
   forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed)
   return res;
 }
 

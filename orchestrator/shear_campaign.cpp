@@ -12,7 +12,6 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <deque>
@@ -25,11 +24,22 @@ namespace demcal::orchestrator {
 
 namespace fs = std::filesystem;
 
+std::string to_string(ShearEngine e) { return e == ShearEngine::kernel ? "kernel" : "yade"; }
+
+ShearEngine parse_shear_engine(const std::string& name) {
+    if (name == "yade") return ShearEngine::yade;
+    if (name == "kernel") return ShearEngine::kernel;
+    throw std::invalid_argument("engine = '" + analytics::shortened_text(name) + "' is not one of: yade, kernel");
+}
+
 nlohmann::json ShearCampaignSpec::to_json() const {
-    nlohmann::json j = {{"material", material},   {"normal_stresses", normal_stresses}, {"replicates", replicates},
-                        {"base_seed", base_seed}, {"template", template_path.string()}, {"label", label}};
-    // YADE, the first engine, is left out: the campaign names (hashes of this JSON) of existing stores stay valid
-    if (engine != "yade") j["engine"] = engine;
+    nlohmann::json j = {{"material", material},       {"normal_stresses", normal_stresses}, {"replicates", replicates},
+                        {"base_seed", base_seed},     {"template", template_path.string()}, {"label", label}};
+    // Written for the kernel only: a YADE campaign keeps the spec, and so the name, it had before engines existed.
+    if (engine == ShearEngine::kernel) {
+        j["engine"] = to_string(engine);
+        j["template"] = "";
+    }
     return j;
 }
 
@@ -41,13 +51,8 @@ ShearCampaignSpec ShearCampaignSpec::from_json(const nlohmann::json& j) {
     s.base_seed = j.at("base_seed").get<long>();
     s.template_path = j.at("template").get<std::string>();
     s.label = j.value("label", "");
-    s.engine = j.value("engine", "yade");
+    s.engine = parse_shear_engine(j.value("engine", "yade"));
     return s;
-}
-
-const std::vector<std::string>& shear_engines() {
-    static const std::vector<std::string> engines = {"yade"};
-    return engines;
 }
 
 fs::path default_shear_template() {
@@ -106,8 +111,12 @@ struct PlannedRun {
 
 ShearCampaignSpec resolved(const ShearCampaignSpec& spec) {
     ShearCampaignSpec s = spec;
-    if (s.template_path.empty()) s.template_path = default_shear_template();
-    s.template_path = fs::absolute(s.template_path).lexically_normal();
+    if (s.engine == ShearEngine::kernel) {
+        s.template_path.clear();  // the kernel has no script
+    } else {
+        if (s.template_path.empty()) s.template_path = default_shear_template();
+        s.template_path = fs::absolute(s.template_path).lexically_normal();
+    }
     s.material = validate_material(spec.material);
     return s;
 }
@@ -128,6 +137,19 @@ std::vector<PlannedRun> plan_runs(const ShearCampaignSpec& spec, const std::stri
     return plan;
 }
 
+// What one engine needs to plan and start its runs.
+struct EngineSetup {
+    std::string identity_text;           // the script (YADE) or the engine's name and version (kernel)
+    std::string wrapper_text;            // YADE: run_clean.py
+    std::vector<std::string> command;    // to which the run's files are appended
+};
+
+void write_params(const PlannedRun& r) {
+    const fs::path params = r.dir / "params.json";
+    const std::string p = r.params.dump(2) + "\n";
+    if (!fs::exists(params) || read_text_file(params) != p) write_text_file_atomically(params, p);
+}
+
 // The run directory holds everything needed to repeat the run by hand: `cd DIR && yade -n -x shear_box.py`; the
 // orchestrator runs it through run_clean.py, which removes the temporary directory YADE leaves in /tmp.
 void write_run_directory(const PlannedRun& r, const std::string& template_text, const std::string& wrapper_text) {
@@ -135,8 +157,29 @@ void write_run_directory(const PlannedRun& r, const std::string& template_text, 
     const fs::path script = r.dir / "shear_box.py", params = r.dir / "params.json", wrapper = r.dir / kWrapperName;
     if (!fs::exists(script) || read_text_file(script) != template_text) write_text_file_atomically(script, template_text);
     if (!fs::exists(wrapper) || read_text_file(wrapper) != wrapper_text) write_text_file_atomically(wrapper, wrapper_text);
-    const std::string p = r.params.dump(2) + "\n";
-    if (!fs::exists(params) || read_text_file(params) != p) write_text_file_atomically(params, p);
+    write_params(r);
+}
+
+// A kernel run's directory: params.json and ENGINE, which says which engine ran it and how to repeat it by hand.
+void write_kernel_run_directory(const PlannedRun& r, const EngineSetup& engine) {
+    fs::create_directories(r.dir);
+    std::string how = "engine: " + engine.identity_text + "\nrepeat by hand in this directory:";
+    for (const auto& a : engine.command) how += " " + a;
+    how += " params.json result.json\n";
+    const fs::path file = r.dir / "ENGINE";
+    if (!fs::exists(file) || read_text_file(file) != how) write_text_file_atomically(file, how);
+    write_params(r);
+}
+
+EngineSetup engine_setup(const ShearCampaignSpec& spec, const ExecutionOptions& o) {
+    if (spec.engine == ShearEngine::kernel) {
+        if (o.kernel_command.empty() || o.kernel_engine.empty())
+            throw std::invalid_argument("engine = 'kernel': this program does not say how to run the kernel engine");
+        return {o.kernel_engine, "", o.kernel_command};
+    }
+    return {read_text_file(spec.template_path),
+            read_text_file(default_shear_template().parent_path() / kWrapperName),
+            {find_yade(o.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py"}};
 }
 
 // The executors append to DIR/stdout.log and DIR/stderr.log and read the failure cause from stderr.log: an earlier
@@ -178,13 +221,6 @@ void check_run_count(double runs, long max_runs, const std::string& breakdown) {
 }
 
 void validate_shear_spec(const ShearCampaignSpec& spec) {
-    const auto& engines = shear_engines();
-    if (std::find(engines.begin(), engines.end(), spec.engine) == engines.end())
-    {
-        std::string known;
-        for (const auto& e : engines) known += (known.empty() ? "" : ", ") + e;
-        throw std::invalid_argument("engine = '" + spec.engine + "' is not a shear engine of this build (" + known + ")");
-    }
     if (spec.normal_stresses.empty()) throw std::invalid_argument("normal_stress: at least one normal stress is needed");
     for (double s : spec.normal_stresses)
         if (!(s > 0) || !std::isfinite(s))
@@ -196,7 +232,7 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
     const nlohmann::json material = validate_material(spec.material);
     for (double s : spec.normal_stresses) make_run_params(material, s, spec.base_seed + spec.replicates - 1);
     const ShearCampaignSpec s = resolved(spec);
-    if (!fs::is_regular_file(s.template_path))
+    if (s.engine == ShearEngine::yade && !fs::is_regular_file(s.template_path))
         throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");
 }
 
@@ -259,10 +295,8 @@ void ShearCampaignRunner::recover_stale_runs() {
 ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, const ProgressCallback& progress) {
     validate_shear_spec(spec_in);
     const ShearCampaignSpec spec = resolved(spec_in);
-    find_yade(options_.yade);
-    const std::string template_text = read_text_file(spec.template_path);
-    const std::string wrapper_text = read_text_file(default_shear_template().parent_path() / kWrapperName);
-    const auto plan = plan_runs(spec, template_text, dir_);
+    const EngineSetup engine = engine_setup(spec, options_);
+    const auto plan = plan_runs(spec, engine.identity_text, dir_);
 
     ShearCampaignOutcome out;
     out.campaign = store_->ensure_campaign(campaign_name(spec), "shear", spec.to_json());
@@ -272,7 +306,10 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     for (const auto& r : plan) {
         if (!seen.insert(r.hash).second) continue;  // the same run twice in a plan (repeated stress) runs once
         by_hash[r.hash] = &r;
-        write_run_directory(r, template_text, wrapper_text);
+        if (spec.engine == ShearEngine::kernel)
+            write_kernel_run_directory(r, engine);
+        else
+            write_run_directory(r, engine.identity_text, engine.wrapper_text);
         RunRecord rec = store_->ensure_run(out.campaign.id, r.hash, r.params, r.dir, r.label);
         if (options_.force && rec.state != RunState::pending) {
             store_->reset_to_pending(r.hash, "forced recomputation");
@@ -376,10 +413,9 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         const PlannedRun& r = *by_hash.at(h);
         fs::remove(r.dir / "result.json");  // a result must come from this attempt
         keep_previous_attempt_logs(r.dir, store_->run(h)->attempts);
-        return Job{h, r.dir,
-                   {find_yade(options_.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py", "params.json",
-                    "result.json"},
-                   options_.timeout_s};
+        std::vector<std::string> argv = engine.command;
+        argv.insert(argv.end(), {"params.json", "result.json"});
+        return Job{h, r.dir, std::move(argv), options_.timeout_s};
     };
 
     {

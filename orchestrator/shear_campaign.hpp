@@ -18,6 +18,14 @@
 
 namespace demcal::orchestrator {
 
+// Which engine runs a campaign's shear boxes: YADE (yade_scripts/shear_box.py) or the native kernel (the same
+// procedure with YADE's laws, kernel/cases/shear_box.hpp, run as `demcal shear-run` subprocesses). Part of each run's
+// identity: the two engines' runs of one material never share a cache entry.
+enum class ShearEngine { yade, kernel };
+std::string to_string(ShearEngine e);
+// Throws std::invalid_argument naming the field 'engine' and the value.
+ShearEngine parse_shear_engine(const std::string& name);
+
 struct ShearCampaignSpec {
     nlohmann::json material;                 // as given; validated by plan_runs
     std::vector<double> normal_stresses;     // [Pa]
@@ -25,7 +33,7 @@ struct ShearCampaignSpec {
     long base_seed = 1;
     std::filesystem::path template_path;     // empty: the installed yade_scripts/shear_box.py
     std::string label;                       // optional human name, e.g. "sensitivity density level 2"
-    std::string engine = "yade";             // the shear-box simulator, one of shear_engines()
+    ShearEngine engine = ShearEngine::yade;  // template_path applies to yade only
 
     nlohmann::json to_json() const;
     static ShearCampaignSpec from_json(const nlohmann::json& j);
@@ -40,6 +48,11 @@ struct ExecutionOptions {
     std::string yade = "yade";    // the YADE launcher (path or name on PATH)
     std::string slurm_partition;  // SLURM only; empty = the default partition
     long max_runs = 10000;        // most simulations one command may plan (a typo in --levels started millions)
+    // The kernel engine, as the program that embeds it says (the orchestrator knows nothing of the kernel): the
+    // command of one run, to which "params.json result.json" is appended (demcal: {its own path, "shear-run"}), and
+    // the engine's name and version, which stands in a kernel run's identity where a YADE run has its script.
+    std::vector<std::string> kernel_command;
+    std::string kernel_engine;
 };
 
 // Refuses a plan of more than `max_runs` simulations before anything is planned or written; `breakdown` says how
@@ -68,9 +81,6 @@ struct ShearCampaignOutcome {
     std::string infrastructure_failure;
     bool complete() const { return !interrupted && failed == 0 && infrastructure_failure.empty(); }
 };
-
-// The shear-box simulators a campaign can run; a new engine is one more name here (and its runner).
-const std::vector<std::string>& shear_engines();
 
 std::filesystem::path default_shear_template();
 // Throws std::invalid_argument when the YADE launcher cannot be found (naming it and how to install it).

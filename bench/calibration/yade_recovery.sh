@@ -10,6 +10,7 @@ set -euo pipefail
 demcal=${1:-build-cal/app/demcal}
 dir=${2:-campaigns/calibration-bench}
 template=(${3:+--template "$3"})
+engine=(${ENGINE:+--engine "$ENGINE"})               # ENGINE=kernel: the same box on demcal's kernel engine
 stresses=${STRESSES:-2e3,3e3,4e3,5e3}
 hidden=${HIDDEN:-examples/calibration/hidden-tiny.json}
 start=${START:-examples/materials/sand-tiny.json}
@@ -22,7 +23,7 @@ strict=(${STRICT---strict})                         # STRICT= : also stop when t
 #   bench/calibration/yade_recovery.sh build/app/demcal campaigns/recovery-sand
 mkdir -p "$dir"
 $demcal shear "$hidden" --normal-stress $stresses --replicates "$replicates" --jobs 2 --campaign "$dir/target" \
-  "${template[@]}" | tee "$dir/target.log"
+  "${template[@]}" "${engine[@]}" | tee "$dir/target.log"
 target=$(python3 -c "
 import json,glob
 j=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['peak_failure_line']
@@ -38,7 +39,7 @@ runs=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['runs']
 print(','.join('%.9g:%.9g' % (r['label']['normal_stress'], r['peak_shear_stress']) for r in runs if r['state']=='done'))")")
 fi
 common=("${target_option[@]}" --start "$start" "${strict[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
-        "${template[@]}" --params "$params" --levels "$levels" --campaign "$dir/loop")
+        "${template[@]}" "${engine[@]}" --params "$params" --levels "$levels" --campaign "$dir/loop")
 $demcal calibrate "${common[@]}" --max-evaluations 7 | tee "$dir/surrogate.log" || true
 # The baselines cost tens of failure lines: run them with COORDINATE=1 and/or GRID=1 (GRID_POINTS per parameter over
 # the same bounds; 5 puts the grid on the study's levels, so the study's lines are reused but still counted).

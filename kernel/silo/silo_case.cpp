@@ -618,6 +618,7 @@ private:
     }
 
     void open() {
+        if (s_.at_opening) s_.at_opening(opened_bed());
         sim_.set_wall_enabled(plate_, false);
         t_open_ = sim_.time();
         if (bin_motion_) bin_motion_->open_at(t_open_);
@@ -625,6 +626,27 @@ private:
         next_frame_ = sim_.steps_done();
         r_.discharge.push_back({0.0, 0.0, 0});
         phase_ = Phase::discharge;
+    }
+
+    // The bed as it stands at the opening: every grain's rigid-body state and its spheres' centres.
+    OpenedBed opened_bed() const {
+        OpenedBed bed;
+        bed.time = sim_.time();
+        bed.time_step = r_.time_step;
+        bed.wall_top = wall_top_;
+        bed.grain = tmpl_;
+        bed.grains.resize(sim_.num_bodies());
+        for (size_t i = 0; i < sim_.num_bodies(); ++i) {
+            const BodyState b = sim_.body(i);
+            // BodyState's orientation is of the template frame; the principal frame is the one a rigid-body code uses
+            bed.grains[i] = {b.position, (b.orientation * tmpl_.principal).normalized(), b.velocity, b.angular_velocity,
+                             {}};
+        }
+        for (size_t k = 0; k < sim_.num_spheres(); ++k) {
+            const SphereState sphere = sim_.sphere(k);
+            bed.grains.at(sphere.body).spheres.push_back(sphere.position);
+        }
+        return bed;
     }
 
     // False: stopped at the session's wall limit.

@@ -9,6 +9,7 @@
 #include "kernel/silo/silo_geometry.hpp"
 #include "kernel/silo/silo_output.hpp"
 #include "kernel/silo/wheat.hpp"
+#include "kernel/clump.hpp"
 
 #include <functional>
 #include <memory>
@@ -17,6 +18,26 @@
 #include <vector>
 
 namespace demcal::kernel::silo {
+
+// One grain of the filled bed as the kernel holds it: the clump's centre of mass and the orientation of its
+// principal frame (the frame of ClumpTemplate::offsets and ::inertia), on-step velocities, world frame.
+struct BedGrain {
+    Eigen::Vector3d position;          // centre of mass [m]
+    Eigen::Quaterniond orientation;    // principal frame -> world
+    Eigen::Vector3d velocity;          // [m/s]
+    Eigen::Vector3d angular_velocity;  // [rad/s]
+    std::vector<Eigen::Vector3d> spheres;  // the centres of its spheres as the kernel placed them [m] (any order)
+};
+
+// The bed at the moment the outlet opens, before the first discharge step: what another code needs to start the
+// same discharge (demcal silo --export-bed).
+struct OpenedBed {
+    double time = 0;       // simulated time of the opening [s]
+    double time_step = 0;  // [s]
+    double wall_top = 0;   // the body wall's top [m]: above the silo's top when the generation column was taller
+    ClumpTemplate grain;   // mass, principal inertia, member offsets (principal frame) and radii
+    std::vector<BedGrain> grains;
+};
 
 struct SiloCaseSettings {
     SiloGeometry geometry;
@@ -66,10 +87,13 @@ struct SiloCaseSettings {
     // suspends the run the same way (checkpoint written, result marked suspended). The caller's way to stop a run
     // cleanly from outside (demcal silo: SIGTERM and SIGINT). Only with a checkpoint file. Not stored.
     std::function<std::string()> stop_request;
+    // Called once with the filled bed when the outlet opens (demcal silo --export-bed). Not stored: a run resumed
+    // from a checkpoint written after the opening does not call it again.
+    std::function<void(const OpenedBed&)> at_opening;
 };
 // A new setting that changes the run must also be listed in for_each_setting (silo_case.cpp): the checkpoint stores
-// the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit and stop_request are not
-// stored: a resumed run takes them from its caller.
+// the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit, stop_request and at_opening are
+// not stored: a resumed run takes them from its caller.
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions, the vibration).
 void validate(const SiloCaseSettings& s);

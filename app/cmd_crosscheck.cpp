@@ -1,0 +1,279 @@
+// demcal crosscheck shear MATERIAL: the same shear campaign (material, stresses, seeds) on YADE and on the kernel
+// engine, in one store; the two failure lines side by side with their intervals and a test of their difference, the
+// shear curves of both on one plot, and each engine's time per run. JSON + Markdown + PNG in the campaign directory.
+#include "analytics/failure_line_comparison.hpp"
+#include "app/cli_support.hpp"
+#include "app/commands.hpp"
+#include "app/execution_options.hpp"
+#include "app/gnuplot.hpp"
+#include "app/shear_report.hpp"
+#include "calibration/failure_line_evaluation.hpp"
+#include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_params.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+namespace demcal {
+
+namespace fs = std::filesystem;
+using namespace orchestrator;
+
+namespace {
+
+struct CrosscheckOptions {
+    std::string material_file;
+    std::vector<double> normal_stresses;
+    int replicates = 3;
+    long seed = 1;
+    std::string campaign_dir;
+    std::string plot_format = "png";
+    ExecutionOptions exec;
+};
+
+const ShearEngine kEngines[] = {ShearEngine::yade, ShearEngine::kernel};
+
+// Mean wall and CPU seconds per finished run.
+struct RunCost {
+    int runs = 0;
+    double wall_s = 0, cpu_s = 0;
+};
+RunCost cost_of(const ShearCampaignOutcome& o) {
+    RunCost c;
+    for (const auto& r : o.runs)
+        if (r.state == RunState::done) {
+            ++c.runs;
+            c.wall_s += r.wall_s;
+            c.cpu_s += r.cpu_s;
+        }
+    if (c.runs > 0) {
+        c.wall_s /= c.runs;
+        c.cpu_s /= c.runs;
+    }
+    return c;
+}
+
+std::string fixed(double v, int digits) {
+    std::ostringstream o;
+    o << std::fixed << std::setprecision(digits) << v;
+    return o.str();
+}
+
+std::string markdown_table(const std::map<ShearEngine, calibration::FailureLineEvaluation>& ev,
+                           const std::map<ShearEngine, RunCost>& cost,
+                           const std::optional<analytics::FailureLineComparison>& peak,
+                           const std::optional<analytics::FailureLineComparison>& residual) {
+    std::ostringstream md;
+    md << "| engine | runs | peak mu_b (95 % CI) | peak tau_c [Pa] (95 % CI) | residual mu_b | residual tau_c [Pa] | "
+          "wall s/run | CPU s/run |\n|---|---|---|---|---|---|---|---|\n";
+    for (ShearEngine e : kEngines) {
+        const auto& f = ev.at(e);
+        md << "| " << to_string(e) << " | " << cost.at(e).runs << " | ";
+        if (f.peak)
+            md << fixed(f.peak->mu_b, 3) << " (" << fixed(f.peak->mu_b_low, 3) << " .. " << fixed(f.peak->mu_b_high, 3)
+               << ") | " << fixed(f.peak->tau_c, 0) << " (" << fixed(f.peak->tau_c_low, 0) << " .. "
+               << fixed(f.peak->tau_c_high, 0) << ") | ";
+        else
+            md << "- | - | ";
+        if (f.residual)
+            md << fixed(f.residual->mu_b, 3) << " | " << fixed(f.residual->tau_c, 0) << " | ";
+        else
+            md << "- | - | ";
+        md << fixed(cost.at(e).wall_s, 1) << " | " << fixed(cost.at(e).cpu_s, 1) << " |\n";
+    }
+    auto row = [&](const char* what, const analytics::ParameterComparison& c, int digits) {
+        md << "| " << what << " | " << fixed(c.difference, digits) << " | " << fixed(c.standard_error, digits) << " | "
+           << fixed(c.combined_half_width, digits) << " | " << fixed(c.p_value, 3) << " | "
+           << (c.within_combined_intervals() ? "yes" : "**no**") << " |\n";
+    };
+    md << "\n| difference yade - kernel | value | standard error | combined 95 % half-width | p (Welch t) | within |\n"
+          "|---|---|---|---|---|---|\n";
+    if (peak) {
+        row("peak mu_b", peak->mu_b, 3);
+        row("peak tau_c [Pa]", peak->tau_c, 0);
+    }
+    if (residual) {
+        row("residual mu_b", residual->mu_b, 3);
+        row("residual tau_c [Pa]", residual->tau_c, 0);
+    }
+    const RunCost& y = cost.at(ShearEngine::yade);
+    const RunCost& k = cost.at(ShearEngine::kernel);
+    if (y.runs > 0 && k.runs > 0 && k.wall_s > 0 && k.cpu_s > 0)
+        md << "\nYADE / kernel per run: wall " << fixed(y.wall_s / k.wall_s, 1) << "x, CPU " << fixed(y.cpu_s / k.cpu_s, 1)
+           << "x\n";
+    return md.str();
+}
+
+// Failure lines of both engines with their points, and the shear curves of both (YADE solid, kernel dashed).
+void write_plots(const fs::path& dir, const std::map<ShearEngine, calibration::FailureLineEvaluation>& ev,
+                 const std::string& format) {
+    std::ostringstream g;
+    g << "set title 'Failure lines: YADE and the kernel engine'\nset xlabel 'normal stress [kPa]'\n"
+      << "set ylabel 'peak shear stress [kPa]'\nset key top left\nset grid\nset xrange [0:*]\nset yrange [0:*]\nplot ";
+    std::ostringstream c;
+    c << "set title 'Shear curves: YADE (solid) and the kernel (dashed)'\nset xlabel 'shear displacement [mm]'\n"
+      << "set ylabel 'shear stress [kPa]'\nset key outside right\nset grid\nplot ";
+    bool first_line = true, first_curve = true;
+    for (ShearEngine e : kEngines) {
+        const auto& f = ev.at(e);
+        const std::string name = to_string(e);
+        const fs::path points = dir / ("crosscheck_points_" + name + ".dat");
+        std::ofstream p(points);
+        double smax = 0;
+        for (const auto& r : f.outcome.runs) {
+            if (r.state != RunState::done) continue;
+            const double s = r.label["normal_stress"].get<double>();
+            smax = std::max(smax, s);
+            p << s << " " << r.result["peak_shear_stress"].get<double>() << "\n";
+            if (!r.result.contains("curve")) continue;
+            const fs::path curve = dir / ("crosscheck_curve_" + name + "_" + r.hash.substr(0, 12) + ".dat");
+            std::ofstream cf(curve);
+            const auto& cv = r.result["curve"];
+            for (std::size_t i = 0; i < cv["displacement"].size(); ++i)
+                cf << cv["displacement"][i].get<double>() << " " << cv["shear_stress"][i].get<double>() << "\n";
+            c << (first_curve ? "" : ", \\\n  ") << gnuplot_quote(curve) << " using ($1*1e3):($2/1e3) with lines dt "
+              << (e == ShearEngine::yade ? 1 : 2) << " lc " << (e == ShearEngine::yade ? 1 : 2) << " title '" << name
+              << " " << s / 1e3 << " kPa #" << r.label["replicate"].get<int>() << "'";
+            first_curve = false;
+        }
+        if (!f.peak) continue;
+        g << (first_line ? "" : ", \\\n  ") << gnuplot_quote(points) << " using ($1/1e3):($2/1e3) with points pt "
+          << (e == ShearEngine::yade ? 7 : 6) << " lc " << (e == ShearEngine::yade ? 1 : 2) << " title '" << name
+          << " runs', \\\n  [0:" << 1.1 * smax / 1e3 << "] " << f.peak->mu_b << " * x + " << f.peak->tau_c / 1e3
+          << " with lines lw 2 lc " << (e == ShearEngine::yade ? 1 : 2) << " title '" << name
+          << ": mu_b = " << fixed(f.peak->mu_b, 3) << ", tau_c = " << fixed(f.peak->tau_c, 0) << " Pa'";
+        first_line = false;
+    }
+    if (!first_line) render_gnuplot(dir / ("crosscheck_failure_lines." + format), g.str());
+    if (!first_curve) render_gnuplot(dir / ("crosscheck_curves." + format), c.str(), 1100, 650);
+}
+
+int run_crosscheck(const CrosscheckOptions& opt) {
+    ShearCampaignSpec base;
+    base.material = read_json_file(opt.material_file, "material");
+    try {
+        validate_material(base.material, opt.material_file);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+    check_run_count(2.0 * static_cast<double>(opt.normal_stresses.size()) * opt.replicates, opt.exec.max_runs,
+                    "crosscheck: 2 engines x " + std::to_string(opt.normal_stresses.size()) + " normal stresses x " +
+                        std::to_string(opt.replicates) + " replicates");
+    base.normal_stresses = opt.normal_stresses;
+    base.replicates = opt.replicates;
+    base.base_seed = opt.seed;
+    std::map<ShearEngine, ShearCampaignSpec> specs;
+    for (ShearEngine e : kEngines) {
+        specs[e] = base;
+        specs[e].engine = e;
+        specs[e].label = "crosscheck " + to_string(e);
+        try {
+            validate_shear_spec(specs[e]);
+        } catch (const std::invalid_argument& err) {
+            throw UserError(err.what());
+        }
+    }
+    try {
+        find_yade(opt.exec.yade);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+    const fs::path dir = opt.campaign_dir.empty()
+                             ? fs::path("campaigns") / ("crosscheck-" + fs::path(opt.material_file).stem().string())
+                             : fs::path(opt.campaign_dir);
+    const fs::path report = dir / "crosscheck.json";
+    if (fs::exists(dir) && !fs::is_directory(dir))
+        throw UserError("campaign = '" + dir.string() + "' exists and is not a folder");
+    ShearCampaignRunner runner(dir, opt.exec);
+    std::cout << "crosscheck in " << runner.dir().string() << ": " << opt.normal_stresses.size() << " normal stresses x "
+              << opt.replicates << " replicates on yade and on the kernel engine\n";
+    std::map<ShearEngine, calibration::FailureLineEvaluation> ev;
+    std::map<ShearEngine, RunCost> cost;
+    bool interrupted = false, failed = false, infra = false;
+    for (ShearEngine e : kEngines) {
+        std::cout << "\n--- " << to_string(e) << " ---\n";
+        ev[e] = calibration::evaluate_failure_line(runner, specs[e], print_progress);
+        cost[e] = cost_of(ev[e].outcome);
+        interrupted = interrupted || ev[e].outcome.interrupted;
+        failed = failed || ev[e].outcome.failed > 0;
+        infra = infra || !ev[e].outcome.infrastructure_failure.empty();
+        if (interrupted) break;
+    }
+    if (interrupted) {
+        std::cout << "interrupted: run the same command again to continue\n";
+        return 130;
+    }
+    std::optional<analytics::FailureLineComparison> peak, residual;
+    const auto& y = ev[ShearEngine::yade];
+    const auto& k = ev[ShearEngine::kernel];
+    if (y.peak && k.peak) peak = analytics::compare_failure_lines(*y.peak, *k.peak);
+    if (y.residual && k.residual) residual = analytics::compare_failure_lines(*y.residual, *k.residual);
+    for (ShearEngine e : kEngines) {
+        std::cout << "\n";
+        if (ev[e].peak) print_line(("Peak failure line, " + to_string(e)).c_str(), *ev[e].peak);
+    }
+    const std::string md = markdown_table(ev, cost, peak, residual);
+    std::cout << "\n" << md;
+    if (peak)
+        std::cout << "\nthe two engines' peak failure lines " << (peak->agree() ? "agree" : "DIFFER")
+                  << " within their combined 95 % intervals\n";
+    nlohmann::json j = {{"material", base.material},
+                        {"normal_stresses", opt.normal_stresses},
+                        {"replicates", opt.replicates},
+                        {"base_seed", opt.seed}};
+    for (ShearEngine e : kEngines) {
+        const std::string n = to_string(e);
+        j[n] = {{"campaign", ev[e].outcome.campaign.name},
+                {"peak_failure_line", ev[e].peak ? ev[e].peak->to_json() : nlohmann::json(nullptr)},
+                {"residual_failure_line", ev[e].residual ? ev[e].residual->to_json() : nlohmann::json(nullptr)},
+                {"runs_done", cost[e].runs},
+                {"runs_failed", ev[e].outcome.failed},
+                {"wall_s_per_run", cost[e].wall_s},
+                {"cpu_s_per_run", cost[e].cpu_s}};
+    }
+    j["peak_comparison"] = peak ? peak->to_json() : nlohmann::json(nullptr);
+    j["residual_comparison"] = residual ? residual->to_json() : nlohmann::json(nullptr);
+    write_text_file_atomically(report, j.dump(2) + "\n");
+    write_text_file_atomically(dir / "crosscheck.md", md);
+    try {
+        write_plots(runner.dir(), ev, opt.plot_format);
+    } catch (const std::exception& e) {
+        std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
+    }
+    std::cout << "\nresults: " << report.string() << ", " << (dir / "crosscheck.md").string() << "\n";
+    if (infra) return kExitResumeLater;
+    return failed ? 1 : 0;
+}
+
+}  // namespace
+
+void add_crosscheck_command(CLI::App& app) {
+    auto* crosscheck = app.add_subcommand("crosscheck", "run one case on YADE and on the kernel, compare the results");
+    crosscheck->require_subcommand(1);
+    auto opt = std::make_shared<CrosscheckOptions>();
+    auto* shear = crosscheck->add_subcommand(
+        "shear", "the same shear campaign on both engines: failure lines, their difference, time per run");
+    shear->add_option("material", opt->material_file, "material JSON (micromechanical parameters)")->required();
+    shear->add_option("--normal-stress,-s", opt->normal_stresses, "normal stresses [Pa], e.g. 5e3,10e3,15e3")
+        ->required()
+        ->delimiter(',')
+        ->check(positive_number());
+    shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress, the same seeds on both")
+        ->check(integer_in(1, 1000))
+        ->capture_default_str();
+    shear->add_option("--seed", opt->seed, "first packing seed")
+        ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));
+    shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/crosscheck-<material>)");
+    shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    add_execution_options(shear, opt->exec);
+    shear->callback([opt] {
+        const int code = run_crosscheck(*opt);
+        if (code != 0) throw CLI::RuntimeError(code);
+    });
+}
+
+}  // namespace demcal

@@ -1,0 +1,76 @@
+// Shear campaigns on the kernel engine (`demcal shear --engine kernel`): the same store, cache and run directories
+// as YADE's, the engine part of each run's identity, the kernel runs started as `demcal shear-run` subprocesses.
+#include <catch2/catch.hpp>
+
+#include "campaign_test_support.hpp"
+#include "orchestrator/run_identity.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <set>
+
+namespace fs = std::filesystem;
+using namespace demcal;
+using orchestrator::RunState;
+
+namespace {
+const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+}
+
+TEST_CASE("a kernel-engine campaign fits a failure line, stores its runs beside YADE's and never repeats one",
+          "[kernel_engine]") {
+    const fs::path dir = test::fresh_test_dir("kernel-campaign");
+    const std::vector<std::string> args{"shear", tiny,         "--normal-stress", "3e3,5e3,7e3", "--engine",
+                                        "kernel", "--jobs", "2", "--campaign",    dir.string()};
+    REQUIRE(test::run_demcal(args, dir / "first.log") == 0);
+    const std::string first = test::read_file(dir / "first.log");
+    INFO(first);
+    CHECK(first.find("kernel engine") != std::string::npos);
+    CHECK(first.find("Peak failure line") != std::string::npos);
+    const auto runs = test::stored_runs(dir);
+    REQUIRE(runs.size() == 3);
+    std::set<std::string> hashes;
+    for (const auto& r : runs) {
+        CHECK(r.state == RunState::done);
+        CHECK(r.result.at("engine").get<std::string>().rfind("demcal-kernel-shear-box/", 0) == 0);
+        CHECK(r.result.at("peak_shear_stress").get<double>() > 0);
+        CHECK(std::abs(r.result.at("normal_stress_held").get<double>() / r.label.at("normal_stress").get<double>() -
+                       1) < 0.1);
+        // the directory says how to repeat the run, and its identity is not a YADE run's with the same parameters
+        CHECK(test::read_file(r.run_dir / "ENGINE").find("shear-run params.json result.json") != std::string::npos);
+        CHECK_FALSE(fs::exists(r.run_dir / "shear_box.py"));
+        const std::string yade_identity = orchestrator::run_identity(
+            test::read_file(test::source_path("yade_scripts/shear_box.py")), r.params);
+        CHECK(r.hash != yade_identity);
+        hashes.insert(r.hash);
+    }
+    CHECK(hashes.size() == 3);
+    // the second time everything is reused
+    REQUIRE(test::run_demcal(args, dir / "second.log") == 0);
+    CHECK(test::read_file(dir / "second.log").find("0 computed now, 3 reused") != std::string::npos);
+    CHECK(test::stored_runs(dir).size() == 3);
+}
+
+TEST_CASE("the kernel engine refuses a YADE template and bad run parameters, naming them", "[kernel_engine]") {
+    const fs::path dir = test::fresh_test_dir("kernel-refusals");
+    CHECK(test::run_demcal({"shear", tiny, "-s", "2e3,4e3", "--engine", "kernel", "--template", tiny, "-c",
+                            (dir / "c").string()},
+                           dir / "template.log") == 2);
+    CHECK(test::read_file(dir / "template.log").find("--engine yade only") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "c"));
+    // shear-run itself speaks the YADE script's protocol: exit 2 and a DEMCAL_FAILURE params line naming the field
+    nlohmann::json p = nlohmann::json::parse(test::read_file(tiny));
+    p.erase("name");
+    p.erase("description");
+    p["normal_stress"] = 4e3;
+    p["seed"] = 1;
+    p["box_width"] = 0.005;
+    orchestrator::write_text_file_atomically(dir / "params.json", p.dump());
+    CHECK(test::run_demcal({"shear-run", (dir / "params.json").string(), (dir / "result.json").string()},
+                           dir / "run.log") == 2);
+    const std::string log = test::read_file(dir / "run.log");
+    CHECK(log.find("DEMCAL_FAILURE params:") != std::string::npos);
+    CHECK(log.find("box_width") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "result.json"));
+}
