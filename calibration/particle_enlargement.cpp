@@ -373,11 +373,15 @@ void check_enlargement(const nlohmann::json& base, const EnlargementOptions& o) 
     if (!(o.trend.alpha > 0 && o.trend.alpha < 1))
         throw std::invalid_argument("alpha = " + num(o.trend.alpha) + " must be in (0, 1)");
     check_calibration_options(o.calibration);
-    for (const auto& [name, range] : o.bounds)
-        if (std::find(enlargement_controls().begin(), enlargement_controls().end(), name) ==
-            enlargement_controls().end())
-            throw std::invalid_argument("bounds: '" + name + "' is not a control of the study (young_modulus, "
-                                        "poisson_ratio)");
+    const auto is_control = [](const std::string& name) {
+        const auto& c = enlargement_controls();
+        return std::find(c.begin(), c.end(), name) != c.end();
+    };
+    for (const auto& [option, ranges] : {std::pair{"bounds", &o.bounds}, std::pair{"range", &o.study.ranges}})
+        for (const auto& [name, range] : *ranges)
+            if (!is_control(name))  // a range of another parameter would be ignored without a word
+                throw std::invalid_argument(std::string(option) + ": '" + name +
+                                            "' is not a control of the study (young_modulus, poisson_ratio)");
     for (double r : o.radii) {
         const auto material = material_at_radius(base, r);
         if (r == o.radii.front()) continue;  // the reference is not calibrated

@@ -173,6 +173,10 @@ TEST_CASE("bad radii are refused before any evaluation, naming the field and the
     refused({1e-3, 2e-3}, "radii: 2 given, need at least 3");
     // 6 mm spheres (13.2 mm long with the spread): 4 of them are more than the 5 cm box height
     refused({1e-3, 2e-3, 6e-3}, "radii = 0.006 m: field 'box_height'");
+    auto other_range = seed_radii_options();
+    other_range.study.ranges = {{"friction_coefficient", {0.2, 0.8}}};
+    CHECK_THROWS_WITH(run_enlargement_study(base_material(), counting, other_range),
+                      Catch::Contains("range: 'friction_coefficient' is not a control"));
     CHECK(evaluations == 0);
 }
 
