@@ -184,7 +184,11 @@ ResponseShapeResult classify_response(std::span<const double> x, std::span<const
     r.alpha = options.alpha;
     r.x_ref = x_ref;
     r.n = static_cast<int>(n);
-    const int max_degree = n >= 4 ? 2 : 1;  // a parabola through 3 points leaves nothing to test it with
+    if (options.max_degree < 1 || options.max_degree > 2)
+        throw std::invalid_argument("response shape: max_degree = " + std::to_string(options.max_degree) +
+                                    " is not 1 (linear) or 2 (parabolic)");
+    // a parabola through 3 points leaves nothing to test it with
+    const int max_degree = n >= 4 ? options.max_degree : 1;
     for (int d = 0; d <= max_degree; ++d) r.fits.push_back(fit_polynomial(u, y, w, d, scale));
     double weighted_total = 0;
     for (std::size_t i = 0; i < n; ++i) weighted_total += w[i] * y[i] * y[i];

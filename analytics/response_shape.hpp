@@ -33,6 +33,7 @@ ShapeCriterion shape_criterion_from_string(const std::string& text);
 struct ResponseShapeOptions {
     ShapeCriterion criterion = ShapeCriterion::f_test;
     double alpha = 0.05;  // significance level of each F test
+    int max_degree = 2;   // highest shape considered: 2 = parabolic, 1 = linear (a trend that is a line or nothing)
 };
 
 struct Coefficient {

@@ -4,7 +4,9 @@
 
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_fit.h>
+#include <gsl/gsl_multifit.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -60,6 +62,66 @@ LawParameter parameter(const char* name, double value, double variance, double t
     return {name, value, se, value - t * se, value + t * se};
 }
 
+std::string number(double v) {
+    std::ostringstream o;
+    o.precision(4);
+    o << v;
+    return o.str();
+}
+
+// Two-sided p-value of the quadratic term of log y = a + b log r + c (log r)^2, weights w y^2 (the variance of log y
+// is about that of y over y^2), scale from the residuals. Needs 4 points or more; 1 (no evidence) otherwise.
+double log_log_curvature_p_value(std::span<const double> r, std::span<const double> y, const std::vector<double>& w) {
+    const std::size_t n = r.size();
+    if (n < 4) return 1;
+    gsl_matrix* x = gsl_matrix_alloc(n, 3);
+    gsl_vector *ly = gsl_vector_alloc(n), *wl = gsl_vector_alloc(n), *c = gsl_vector_alloc(3);
+    gsl_matrix* cov = gsl_matrix_alloc(3, 3);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double lr = std::log(r[i]);
+        gsl_matrix_set(x, i, 0, 1);
+        gsl_matrix_set(x, i, 1, lr);
+        gsl_matrix_set(x, i, 2, lr * lr);
+        gsl_vector_set(ly, i, std::log(y[i]));
+        gsl_vector_set(wl, i, w[i] * y[i] * y[i]);
+    }
+    double chisq = 0, weighted_total = 0;
+    for (std::size_t i = 0; i < n; ++i) weighted_total += gsl_vector_get(wl, i) * std::pow(gsl_vector_get(ly, i), 2);
+    gsl_multifit_linear_workspace* work = gsl_multifit_linear_alloc(n, 3);
+    gsl_multifit_wlinear(x, wl, ly, c, cov, &chisq, work);
+    const int dof = static_cast<int>(n) - 3;
+    const double se = std::sqrt(gsl_matrix_get(cov, 2, 2) * chisq / dof);
+    const double t = std::fabs(gsl_vector_get(c, 2)) / se;
+    gsl_multifit_linear_free(work);
+    gsl_matrix_free(x);
+    gsl_matrix_free(cov);
+    gsl_vector_free(ly);
+    gsl_vector_free(wl);
+    gsl_vector_free(c);
+    // points on the curve to rounding (exact data): the t ratio would compare rounding errors
+    if (!(se > 0) || chisq <= 1e-20 * weighted_total) return 1;
+    return 2 * gsl_cdf_tdist_Q(t, dof);
+}
+
+// Why the points cannot determine the power law, or empty.
+std::string power_law_undetermined(const ScalingLawFit& fit, std::span<const double> y, double curvature_p) {
+    const auto& d = fit.params[1];
+    if (std::all_of(y.begin(), y.end(), [&](double v) { return v == y[0]; }))
+        return "the same value at every radius: a constant, with no exponent to estimate";
+    if (!fit.converged) return "the nonlinear fit did not converge";
+    if (!std::isfinite(fit.params[0].std_error) || !std::isfinite(d.std_error))
+        return "the covariance is singular: C and D cannot be separated";
+    const std::string percent = number(100 * fit.confidence) + " %";
+    if (d.low <= 0 && 0 <= d.high)
+        return "D = " + number(d.value) + " +/- " + number(d.std_error) + ": its " + percent + " interval [" +
+               number(d.low) + ", " + number(d.high) + "] holds 0, so the points show no power law (a constant fits "
+               "as well)";
+    if (curvature_p < 1 - fit.confidence)
+        return "the points bend away from a power law: a quadratic term in log y over log r is significant (p = " +
+               number(curvature_p) + ")";
+    return {};
+}
+
 }  // namespace
 
 double ScalingLawFit::operator()(double r) const {
@@ -82,7 +144,8 @@ std::string ScalingLawFit::formula() const {
 nlohmann::json ScalingLawFit::to_json() const {
     nlohmann::json j = {{"law", law},   {"formula", formula()},       {"n", n},
                         {"dof", dof},   {"confidence", confidence},   {"r_squared", r_squared},
-                        {"residual_sd", residual_sd}, {"converged", converged}, {"params", nlohmann::json::object()}};
+                        {"residual_sd", residual_sd}, {"converged", converged}, {"determined", determined()},
+                        {"undetermined_because", undetermined}, {"params", nlohmann::json::object()}};
     for (const auto& p : params)
         j["params"][p.name] = {{"value", p.value}, {"std_error", p.std_error}, {"low", p.low}, {"high", p.high}};
     return j;
@@ -104,6 +167,8 @@ ScalingLawFit fit_linear_law(std::span<const double> r, std::span<const double> 
     fit.params = {parameter("A", c1, cov11 * s2, t), parameter("B", c0, cov00 * s2, t)};
     fit.residual_sd = std::sqrt(s2);
     fit.r_squared = weighted_r_squared(y, w, chisq);
+    if (!std::isfinite(fit.params[0].std_error) || !std::isfinite(fit.params[1].std_error))
+        fit.undetermined = "the covariance is singular: A and B cannot be separated";
     return fit;
 }
 
@@ -130,6 +195,7 @@ ScalingLawFit fit_power_law(std::span<const double> r, std::span<const double> y
     fit.params = {parameter("C", ls.params[0], ls.covariance[0], t), parameter("D", ls.params[1], ls.covariance[3], t)};
     fit.residual_sd = std::sqrt(ls.sse / fit.dof);
     fit.r_squared = weighted_r_squared(y, w, ls.sse);
+    fit.undetermined = power_law_undetermined(fit, y, log_log_curvature_p_value(r, y, w));
     return fit;
 }
 

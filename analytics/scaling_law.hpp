@@ -26,6 +26,10 @@ struct ScalingLawFit {
     double r_squared = 0;
     double residual_sd = 0;           // sqrt(weighted SSE / dof), in y units when unweighted
     bool converged = true;            // the nonlinear fit met GSL's tolerances
+    // Why these points cannot determine the law (empty: they can): a fit that did not converge, a singular covariance,
+    // or for the power law an exponent indistinguishable from 0 or points that bend away from it in log-log.
+    std::string undetermined;
+    bool determined() const { return undetermined.empty(); }
     double operator()(double r) const;
     std::string formula() const;      // e.g. "E(r) = 91.52 r + 148.9"
     nlohmann::json to_json() const;
@@ -37,6 +41,8 @@ ScalingLawFit fit_linear_law(std::span<const double> r, std::span<const double> 
                              double confidence = 0.95);
 
 // y = C r^-D by nonlinear least squares (gsl_multifit_nlinear, started from the log-log line). r and y must be > 0.
+// `undetermined` says so when D's interval holds 0 (no power law: a constant does as well) or, with 4 points or more,
+// when a quadratic term in log y over log r is significant at 1 - confidence (the points are not on a power law).
 ScalingLawFit fit_power_law(std::span<const double> r, std::span<const double> y, std::span<const double> sigma = {},
                             double confidence = 0.95);
 

@@ -2,10 +2,12 @@
 // and the particle-enlargement laws (seed eqs. 3.1-3.2). Every simulation is a stored, cached, resumable campaign run.
 #include "analytics/number_text.hpp"
 #include "analytics/scaling_law.hpp"
+#include "app/campaign_cli.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
+#include "app/scaling_plots.hpp"
 #include "calibration/calibration_loop.hpp"
 #include "calibration/campaign_evaluator.hpp"
 #include "orchestrator/run_identity.hpp"
@@ -25,107 +27,6 @@ using namespace calibration;
 using orchestrator::check_run_count;
 
 namespace {
-
-// Options shared by the commands that run campaigns.
-struct CampaignCli {
-    std::vector<double> normal_stresses{2e3, 4e3, 6e3};
-    int replicates = 1;
-    long seed = 1;
-    std::string campaign_dir = "campaigns/calibration";
-    std::string template_path;
-    std::string line = "peak";
-    std::string plot_format = "png";
-    std::string engine = "yade";
-    orchestrator::ExecutionOptions exec;
-};
-
-void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
-    cmd->add_option("--normal-stress,-s", c.normal_stresses, "normal stresses of every failure line [Pa]")
-        ->delimiter(',')
-        ->check(positive_number())
-        ->capture_default_str();
-    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(positive_number());
-    cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)")
-        ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
-    cmd->add_option("--campaign,-c", c.campaign_dir, "campaign directory (store, runs, results)")->capture_default_str();
-    cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
-    cmd->add_option("--engine", c.engine, "yade or kernel (the same shear box on demcal's kernel with YADE's laws)")
-        ->check(CLI::IsMember({"yade", "kernel"}))
-        ->capture_default_str();
-    cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
-    cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
-    add_execution_options(cmd, c.exec);
-}
-
-// "name=low:high" items (repeatable option) -> map; throws naming the item.
-std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<std::string>& items,
-                                                              const std::string& option) {
-    std::map<std::string, std::pair<double, double>> out;
-    for (const auto& item : items) {
-        const auto eq = item.find('='), colon = item.find(':');
-        double lo = NAN, hi = NAN;
-        bool ok = eq != std::string::npos && colon != std::string::npos && colon > eq;
-        if (ok) {
-            try {
-                std::size_t a = 0, b = 0;
-                const std::string l = item.substr(eq + 1, colon - eq - 1), h = item.substr(colon + 1);
-                lo = std::stod(l, &a);
-                hi = std::stod(h, &b);
-                ok = a == l.size() && b == h.size();
-            } catch (const std::exception&) {
-                ok = false;
-            }
-        }
-        if (!ok) throw UserError(option + " '" + item + "' is not of the form NAME=LOW:HIGH");
-        const std::string name = item.substr(0, eq);
-        if (!orchestrator::find_shear_param(name)) throw UserError(option + " '" + item + "': unknown parameter '" + name + "'");
-        out[name] = {lo, hi};
-    }
-    return out;
-}
-
-CampaignSettings settings_of(const CampaignCli& c, const std::string& label) {
-    return {c.normal_stresses, c.replicates, c.seed, c.template_path, label, orchestrator::parse_shear_engine(c.engine)};
-}
-
-// The campaign every failure line will run (stresses, replicates, seeds, template), checked on `material` before the
-// campaign directory exists.
-void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
-    if (c.normal_stresses.size() < 2)
-        throw UserError("normal-stress: a failure line needs at least 2 normal stresses, got " +
-                        std::to_string(c.normal_stresses.size()));
-    if (c.engine == "kernel" && !c.template_path.empty())
-        throw UserError("template = '" + c.template_path + "' is a YADE script: it applies to --engine yade only");
-    orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));
-}
-
-std::string duration(double s) {
-    std::ostringstream o;
-    if (s >= 3600)
-        o << std::fixed << std::setprecision(1) << s / 3600 << " h";
-    else if (s >= 60)
-        o << std::fixed << std::setprecision(1) << s / 60 << " min";
-    else
-        o << std::fixed << std::setprecision(0) << s << " s";
-    return o.str();
-}
-
-// Runs in a campaign directory with one runner for all the evaluations of a command.
-struct CampaignSession {
-    std::unique_ptr<orchestrator::ShearCampaignRunner> runner;
-    FailureLineEvaluator evaluate;
-    CampaignSession(const CampaignCli& c, const std::string& label) {
-        if (c.engine == "yade") orchestrator::find_yade(c.exec.yade);
-        runner = std::make_unique<orchestrator::ShearCampaignRunner>(c.campaign_dir, c.exec);
-        const CampaignSettings settings = settings_of(c, label);
-        auto progress = [](const orchestrator::CampaignProgress& p) {
-            if (p.event != "failed" && p.event != "retry") return;  // the study prints one line per failure line
-            std::cout << "    run " << p.event << " (sigma = " << (p.run ? p.run->label.value("normal_stress", 0.0) : 0)
-                      << " Pa): " << (p.run ? p.run->cause + ": " + p.run->message : "") << std::endl;
-        };
-        evaluate = campaign_evaluator(*runner, settings, progress);
-    }
-};
 
 // ---- sensitivity ----
 
@@ -244,7 +145,7 @@ void add_sensitivity(CLI::App& app) {
         const auto study = run_study(base, *o, session.evaluate);
         write_study(o->campaign.campaign_dir, study, o->campaign.plot_format);
         std::cout << "\n" << study.table() << "\n" << study.evaluations << " failure lines, " << study.simulations_run
-                  << " simulations run now, " << study.simulations_reused << " reused; CPU " << duration(study.cpu_s)
+                  << " simulations run now, " << study.simulations_reused << " reused; CPU " << cpu_duration(study.cpu_s)
                   << "\nresults: " << (fs::path(o->campaign.campaign_dir) / "sensitivity.json").string()
                   << ", sensitivity_table.txt, sensitivity_<param>." << o->campaign.plot_format << std::endl;
     });
@@ -426,7 +327,7 @@ void add_calibrate(CLI::App& app) {
                   << "final: mu_b = " << best.mu_b << " +/- " << best.mu_b_half_width << ", tau_c = " << best.tau_c
                   << " +/- " << best.tau_c_half_width << " Pa (95 % intervals)\n"
                   << "calibration: " << result.evaluations << " failure lines, " << result.simulations_run
-                  << " simulations run, " << result.simulations_reused << " reused, CPU " << duration(result.cpu_s)
+                  << " simulations run, " << result.simulations_reused << " reused, CPU " << cpu_duration(result.cpu_s)
                   << "; sensitivity study: " << study.evaluations << " failure lines, " << study.simulations_run
                   << " simulations run now\nmaterial: " << out.string() << "\n";
         if (result.status == CalibrationStatus::unreachable) throw UserError("calibration stopped: " + result.message);
@@ -443,28 +344,6 @@ struct EnlargeCli {
     bool no_plot = false;
     bool allow_unconverged = false;
 };
-
-// The points and both fitted laws, side by side: OUTPUT with the plot's extension, its data in OUTPUT.dat.
-void plot_enlargement(const fs::path& output, const std::vector<double>& r, const std::vector<double>& e,
-                      const std::vector<double>& nu, const analytics::ScalingLawFit& e_law,
-                      const analytics::ScalingLawFit& nu_law, const std::string& format) {
-    fs::path data = output, picture = output;
-    data.replace_extension(".dat");
-    picture.replace_extension("." + format);
-    std::ostringstream d;
-    d << "# particle_radius_m young_modulus_Pa poisson_ratio\n" << std::setprecision(10);
-    for (std::size_t i = 0; i < r.size(); ++i) d << r[i] << " " << e[i] << " " << nu[i] << "\n";
-    orchestrator::write_text_file_atomically(data, d.str());
-    std::ostringstream g;
-    g << std::setprecision(10) << "set multiplot layout 1,2\nset xlabel 'particle radius r_p [mm]'\nunset key\n"
-      << "set ylabel 'E [MPa]'\nset title 'E(r_p) = A r_p + B'\n"
-      << "plot " << gnuplot_quote(data) << " using ($1*1e3):($2/1e6) with points pt 7, (" << e_law.params[0].value
-      << " * x / 1e3 + " << e_law.params[1].value << ") / 1e6 with lines lw 2\n"
-      << "set ylabel 'nu (YADE ks/kn)'\nset title 'nu(r_p) = C r_p^{-D}'\n"
-      << "plot " << gnuplot_quote(data) << " using ($1*1e3):3 with points pt 7, " << nu_law.params[0].value
-      << " * (x / 1e3)**(-" << nu_law.params[1].value << ") with lines lw 2\nunset multiplot\n";
-    render_gnuplot(picture, g.str(), 1000, 450);
-}
 
 void add_enlarge(CLI::App& app) {
     auto o = std::make_shared<EnlargeCli>();
@@ -491,10 +370,11 @@ void add_enlarge(CLI::App& app) {
         if (r.size() < 3) throw UserError("materials: " + std::to_string(r.size()) + " given, need at least 3 radii");
         const auto e_law = analytics::fit_linear_law(r, e);
         const auto nu_law = analytics::fit_power_law(r, nu);
-        if (!nu_law.converged && !o->allow_unconverged)  // e.g. nu equal at every radius: D is not identifiable
-            throw std::runtime_error("enlarge: the power law nu(r) = C r^-D did not converge (" + nu_law.formula() +
-                                     "): D is not identifiable from these " + std::to_string(r.size()) +
-                                     " points; nothing written (--allow-unconverged writes it anyway)");
+        for (const auto* law : {&e_law, &nu_law})  // e.g. nu equal at every radius: D is not identifiable
+            if (!law->determined() && !o->allow_unconverged)
+                throw std::runtime_error("enlarge: " + law->formula() + " is not determined by these " +
+                                         std::to_string(r.size()) + " points: " + law->undetermined +
+                                         "; nothing written (--allow-unconverged writes it anyway)");
         nlohmann::json j = {{"young_modulus", e_law.to_json()},
                             {"poisson_ratio", nu_law.to_json()},
                             {"note", "r in m; poisson_ratio is YADE's ks/kn stiffness ratio, so nu(r) is a law for it"},

@@ -25,5 +25,6 @@ void add_cutoff_command(CLI::App& app);        // cutoff                        
 void add_vibration_command(CLI::App& app);     // vibration                         (cmd_vibration.cpp)
 void add_discharge_commands(CLI::App& app);    // predict, diagnose                 (cmd_diagnose.cpp)
 void add_calibration_commands(CLI::App& app);  // sensitivity, calibrate, enlarge   (cmd_calibrate.cpp)
+void add_scale_command(CLI::App& app);         // scale                             (cmd_scale.cpp)
 
 }  // namespace demcal

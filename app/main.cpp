@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
     demcal::add_vibration_command(app);
     demcal::add_discharge_commands(app);
     demcal::add_calibration_commands(app);
+    demcal::add_scale_command(app);
     demcal::refuse_empty_values(app);
     try {
         app.parse(argc, argv);

@@ -118,3 +118,19 @@ TEST_CASE("bad input is refused with the problem named", "[response_shape]") {
     CHECK_THROWS_WITH(classify_response(x, y, std::vector<double>{1, 0, 1}, 2), Catch::Contains("uncertainty of level 1"));
     CHECK_THROWS_WITH(shape_criterion_from_string("bic"), Catch::Contains("'bic'"));
 }
+
+TEST_CASE("a trend limited to degree 1 is a line or a constant, never a parabola", "[response_shape]") {
+    const std::vector<double> x{1, 1.5, 2, 3, 5, 7};
+    std::vector<double> bent, rising;
+    for (double v : x) bent.push_back(1 + (v - 4) * (v - 4)), rising.push_back(0.5 + 0.05 * v + 1e-3 * std::sin(7 * v));
+    ResponseShapeOptions linear_at_most;
+    linear_at_most.max_degree = 1;
+    CHECK(classify_response(x, bent, {}, 1, {}).shape == ResponseShape::parabolic);  // the default sees the bend
+    const auto limited = classify_response(x, bent, {}, 1, linear_at_most);
+    CHECK(limited.shape != ResponseShape::parabolic);
+    CHECK(limited.fits.size() == 2);
+    CHECK_FALSE(limited.parabolic_vs_linear);
+    CHECK(classify_response(x, rising, {}, 1, linear_at_most).shape == ResponseShape::linear);
+    linear_at_most.max_degree = 3;
+    CHECK_THROWS_WITH(classify_response(x, rising, {}, 1, linear_at_most), Catch::Contains("max_degree = 3"));
+}

@@ -221,7 +221,7 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
     fs::remove_all(dir);
 }
 
-TEST_CASE("demcal enlarge says when the power law did not converge and writes nothing unless asked", "[cli]") {
+TEST_CASE("demcal enlarge says when the points do not determine the power law and writes nothing unless asked", "[cli]") {
     const fs::path dir = test::fresh_test_dir("cli-enlarge-unconverged");
     auto material = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand.json")));
     std::vector<std::string> args{"enlarge", "--no-plot", "-o", (dir / "e.json").string()};
@@ -233,7 +233,7 @@ TEST_CASE("demcal enlarge says when the power law did not converge and writes no
         std::ofstream(args.back()) << material.dump();
     }
     CHECK(test::run_demcal(args, dir / "out.log") == 1);
-    CHECK_THAT(test::read_file(dir / "out.log"), Contains("did not converge") && Contains("not identifiable"));
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("not determined") && Contains("the same value at every radius"));
     CHECK_FALSE(fs::exists(dir / "e.json"));
     args.push_back("--allow-unconverged");
     CHECK(test::run_demcal(args, dir / "out.log") == 0);

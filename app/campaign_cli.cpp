@@ -1,0 +1,95 @@
+#include "app/campaign_cli.hpp"
+
+#include "app/cli_support.hpp"
+#include "app/commands.hpp"
+#include "orchestrator/shear_params.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace demcal {
+
+void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
+    cmd->add_option("--normal-stress,-s", c.normal_stresses, "normal stresses of every failure line [Pa]")
+        ->delimiter(',')
+        ->check(positive_number())
+        ->capture_default_str();
+    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(positive_number());
+    cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)")
+        ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
+    cmd->add_option("--engine", c.engine, "yade or kernel (the same shear box on demcal's kernel with YADE's laws)")
+        ->check(CLI::IsMember({"yade", "kernel"}))
+        ->capture_default_str();
+    cmd->add_option("--campaign,--dir,-c", c.campaign_dir, "campaign directory (store, runs, results)")
+        ->capture_default_str();
+    cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
+    cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
+    cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    add_execution_options(cmd, c.exec);
+}
+
+std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<std::string>& items,
+                                                              const std::string& option) {
+    std::map<std::string, std::pair<double, double>> out;
+    for (const auto& item : items) {
+        const auto eq = item.find('='), colon = item.find(':');
+        double lo = NAN, hi = NAN;
+        bool ok = eq != std::string::npos && colon != std::string::npos && colon > eq;
+        if (ok) {
+            try {
+                std::size_t a = 0, b = 0;
+                const std::string l = item.substr(eq + 1, colon - eq - 1), h = item.substr(colon + 1);
+                lo = std::stod(l, &a);
+                hi = std::stod(h, &b);
+                ok = a == l.size() && b == h.size();
+            } catch (const std::exception&) {
+                ok = false;
+            }
+        }
+        if (!ok) throw UserError(option + " '" + item + "' is not of the form NAME=LOW:HIGH");
+        const std::string name = item.substr(0, eq);
+        if (!orchestrator::find_shear_param(name)) throw UserError(option + " '" + item + "': unknown parameter '" + name + "'");
+        out[name] = {lo, hi};
+    }
+    return out;
+}
+
+calibration::CampaignSettings settings_of(const CampaignCli& c, const std::string& label) {
+    return {c.normal_stresses, c.replicates, c.seed, c.template_path, label, orchestrator::parse_shear_engine(c.engine)};
+}
+
+void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
+    if (c.normal_stresses.size() < 2)
+        throw UserError("normal-stress: a failure line needs at least 2 normal stresses, got " +
+                        std::to_string(c.normal_stresses.size()));
+    if (c.engine == "kernel" && !c.template_path.empty())
+        throw UserError("template = '" + c.template_path + "' is a YADE script: it applies to --engine yade only");
+    orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));
+}
+
+std::string cpu_duration(double s) {
+    std::ostringstream o;
+    if (s >= 3600)
+        o << std::fixed << std::setprecision(1) << s / 3600 << " h";
+    else if (s >= 60)
+        o << std::fixed << std::setprecision(1) << s / 60 << " min";
+    else
+        o << std::fixed << std::setprecision(0) << s << " s";
+    return o.str();
+}
+
+CampaignSession::CampaignSession(const CampaignCli& c, const std::string& label) {
+    if (c.engine == "yade") orchestrator::find_yade(c.exec.yade);
+    runner = std::make_unique<orchestrator::ShearCampaignRunner>(c.campaign_dir, c.exec);
+    const calibration::CampaignSettings settings = settings_of(c, label);
+    auto progress = [](const orchestrator::CampaignProgress& p) {
+        if (p.event != "failed" && p.event != "retry") return;  // the commands print one line per failure line
+        std::cout << "    run " << p.event << " (sigma = " << (p.run ? p.run->label.value("normal_stress", 0.0) : 0)
+                  << " Pa): " << (p.run ? p.run->cause + ": " + p.run->message : "") << std::endl;
+    };
+    evaluate = calibration::campaign_evaluator(*runner, settings, progress);
+}
+
+}  // namespace demcal
