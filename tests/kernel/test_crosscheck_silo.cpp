@@ -1,6 +1,7 @@
 // demcal crosscheck silo end to end with real YADE: the kernel fills and discharges a tiny reduced silo, YADE
 // discharges the same bed; the report holds both rates (within 25 % of each other on 300 grains), the curve gap, the
-// costs; the same command again reuses both runs (nothing started); a bad angle is refused before anything runs.
+// costs; the same command again reuses both runs (nothing started); a deliberate mismatch of the grains' friction is
+// flagged; a bad angle is refused before anything runs.
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -11,6 +12,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -47,6 +49,21 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     // the same command again: both runs reused
     REQUIRE(run_demcal(args, dir / "second.log") == 0);
     CHECK(read_file(dir / "second.log").find("started") == std::string::npos);
+    CHECK(report["rates_agree"] == true);
+    // a deliberate mismatch (YADE's grains far more frictional) on the same bed: flagged
+    auto material = nlohmann::json::parse(
+        read_file(fs::path(DEMCAL_SOURCE_DIR) / "examples/materials/silo_wheat_table21.json"));
+    material["grain_grain"]["friction"] = 1.0;
+    {
+        std::ofstream f(dir / "mismatch.json");
+        f << material.dump();
+    }
+    REQUIRE(run_demcal(args + " --yade-material '" + (dir / "mismatch.json").string() + "'", dir / "third.log") == 0);
+    const auto mismatch = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
+    CHECK(mismatch["rates_agree"] == false);
+    CHECK(mismatch["angles"][0]["rates_agree"] == false);
+    CHECK(mismatch["angles"][0]["yade_material_as_bed"] == false);
+    CHECK(read_file(dir / "third.log").find("DIFFER") != std::string::npos);
     // a bad angle: exit 2, named, nothing run
     CHECK(run_demcal("crosscheck silo --theta 95 -c '" + (dir / "bad").string() + "'", dir / "bad.log") == 2);
     CHECK(read_file(dir / "bad.log").find("theta") != std::string::npos);
