@@ -5,6 +5,7 @@
 #include "app/commands.hpp"
 #include "app/silo_settings.hpp"
 #include "kernel/cases/cohesive_hopper.hpp"
+#include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
@@ -120,9 +121,11 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     }
     if (!base.materials.cohesive())
         std::printf("note: the material has no cohesion (surface_energy_J_m2 = 0): a cohesionless bed rarely arches\n");
-    std::printf("cut-off search in the silo: %s, %ld grains, stiffness scale %g; %s; A = %g m along x; bracket "
+    const std::string amount = base.fill_mass > 0 ? ks::setting_text(base.fill_mass) + " kg of grain"
+                                                   : std::to_string(base.particles) + " grains";
+    std::printf("cut-off search in the silo: %s, %s, stiffness scale %g; %s; A = %g m along x; bracket "
                 "[%g, %g] Hz to %g Hz, %zu seed(s); flows = half the mass out within %g s of the opening\n",
-                base.geometry.describe().c_str(), base.particles, base.materials.stiffness_scale,
+                base.geometry.describe().c_str(), amount.c_str(), base.materials.stiffness_scale,
                 ks::contact_law_name(base.materials).c_str(), o.base.amplitude, search.lo, search.hi, search.tol,
                 search.seeds.size(), o.base.window);
     std::fflush(stdout);
