@@ -44,9 +44,13 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
          "the folder /no/such/folder does not exist"},
         // limits, named with the flag that lifts them (an absurd level count started millions of runs)
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", "2000000000"},
-         "levels x 2 normal stresses x 1 replicates = 3.2e+10 simulations, more than the limit --max-runs = 10000"},
-        {{"shear", tiny, "-s", "5e3,1e4", "-r", "6000"}, "shear: 2 normal stresses x 6000 replicates = 12000"},
-        {{"shear", tiny, "-s", "5e3,1e4", "-r", "6000", "--max-runs", "1e9"}, "--max-runs: '1e9' is not an integer"},
+         "--levels: '2000000000' is not an integer between 3 and 101"},
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", "101", "-r", "1000", "--params", "friction_coefficient"},
+         "1 parameters x 101 levels x 2 normal stresses x 1000 replicates = 202000 simulations, more than the limit "
+         "--max-runs = 10000"},
+        {{"shear", tiny, "-s", "5e3,1e4", "-r", "600", "--max-runs", "1000"},
+         "shear: 2 normal stresses x 600 replicates = 1200"},
+        {{"shear", tiny, "-s", "5e3,1e4", "-r", "600", "--max-runs", "1e9"}, "--max-runs: '1e9' is not an integer"},
         // a negative cohesion target or negative measured stresses were calibrated against
         {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800 must be >= 0"},
         {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
