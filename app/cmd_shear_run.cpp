@@ -146,7 +146,7 @@ void add_shear_run_command(CLI::App& app) {
     cmd->add_option("params", opt->params, "params.json of the run (the YADE script's fields)");
     cmd->add_option("result", opt->result, "result.json to write");
     cmd->add_option("--threads", opt->threads, "OpenMP threads (the result does not depend on them)")
-        ->check(CLI::Range(1, 256));
+        ->check(integer_in(1, 256));
     cmd->callback([opt] { run(opt->params, opt->result, opt->threads); });
 }
 

@@ -123,6 +123,7 @@ run_case shear-kernel/campaign-readonly 2 "campaign" "$ro" -- shear "$tiny" --en
 run_case shear-kernel/campaign-file  2 "campaign"       -- shear "$tiny" --engine kernel -s 5e3,1e4 --campaign "$tiny"
 run_case shear-kernel/timeout-subnormal 2 "--timeout"   -- "${K[@]}" -s 5e3,1e4 --timeout 1e-320
 run_case shear-kernel/retries-huge   2 "--retries"      -- "${K[@]}" -s 5e3,1e4 --retries 1e9
+run_case shear-kernel/retries-many   2 "--retries"      -- "${K[@]}" -s 5e3,1e4 --retries 1000000000
 run_case shear-kernel/jobs-huge      2 "--jobs"         -- "${K[@]}" -s 5e3,1e4 --jobs 1e9
 run_case shear-kernel/engine-bad     2 "--engine"       -- shear "$tiny" --engine "$hugestr" -s 5e3,1e4 --campaign camp
 

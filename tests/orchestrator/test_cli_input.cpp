@@ -204,9 +204,11 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
     const fs::path campaign = dir / "campaign";
     // executable, but its interpreter does not exist: execvp fails, as for a launcher of a broken installation
     std::ofstream(dir / "broken-yade") << "#!/nonexistent/interpreter\n";
-    // a stand-in simulator: writes the result file named by its last argument
+    // a stand-in simulator: writes the result file named by its last argument (schema /1: a template older than the
+    // result's seal, still read)
     std::ofstream(dir / "stand-in-yade") << "#!/bin/sh\nfor last; do :; done\n"
-                                            "echo '{\"peak_shear_stress\": 1000, \"residual_shear_stress\": 800}' > "
+                                            "echo '{\"schema\": \"demcal.shear_result/1\", \"peak_shear_stress\": 1000, "
+                                            "\"residual_shear_stress\": 800}' > "
                                             "\"$last\"\n";
     fs::permissions(dir / "broken-yade", fs::perms::owner_all);
     fs::permissions(dir / "stand-in-yade", fs::perms::owner_all);

@@ -114,8 +114,29 @@ TEST_CASE("output paths are tried for real before any work: a folder nobody can 
               {"--vtk = '/proc/vtk'", "not writable"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", params}, {"--out", "is a file, not a folder"}},
              {{"silo", "--resume", "/proc"}, {"resume"}},
+             // a campaign folder that cannot be made was a filesystem error with exit 1
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4",
+               "--engine", "kernel", "--campaign", "/proc/campaign"},
+              {"campaign = '/proc/campaign': cannot create the campaign folder"}},
              {{"crosscheck", "silo", "--theta", "30", "--campaign", "/proc/xsilo"},
               {"--campaign = '/proc/xsilo'", "not writable"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("silo: a time step that never lets the run end, or a snapshot every step, is refused before it starts",
+          "[cli]") {
+    // --dt-fraction 1e-300 passed every range and filled at t = 0.000 s for ever
+    const fs::path root = test::fresh_test_dir("hostile-silo-size"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string out = (dir / "o").string();
+    refused({{{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt-fraction", "1e-300"},
+              {"--dt-fraction 1e-300", "time steps, more than 1e+09; the run would not end"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt", "1e-300"},
+              {"--dt 1e-300 s over --fill-time 2.1 s + --max-time 20 s"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--vtk", (dir / "v").string(), "--vtk-every",
+               "1e-300"},
+              {"--vtk-every 1e-300 s", "snapshots, more than 100000"}}},
             dir);
     fs::remove_all(root);
 }
@@ -170,7 +191,23 @@ TEST_CASE("levels and replicates have their own caps, named, below the total --m
              {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--levels", "1000", "--campaign", camp},
               {"--levels: '1000' is not an integer between 3 and 101"}},
              {{"scale", tiny, "--radii", "1e-3,1.5e-3,2e-3", "-s", "5e3,1e4", "--levels", "500", "--dir", camp},
-              {"--levels: '500' is not an integer between 3 and 101"}}},
+              {"--levels: '500' is not an integer between 3 and 101"}},
+             // a deterministic crash was retried as often as asked (1e9)
+             {{"shear", tiny, "-s", "5e3,1e4", "--retries", "1000000000", "--campaign", camp},
+              {"--retries: '1000000000' is not an integer between 0 and 100"}},
+             // a design whose line cannot be fitted ran its runs first (crosscheck shear with one stress)
+             {{"crosscheck", "shear", tiny, "-s", "5e3,5e3", "-r", "3", "--campaign", camp},
+              {"normal-stress: a failure line needs at least 2 distinct normal stresses, got 1"}},
+             {{"crosscheck", "shear", tiny, "-s", "5e3,1e4", "-r", "1", "--campaign", camp},
+              {"replicates = 1 at 2 normal stresses: a failure line needs at least 3 points"}},
+             // 2e9 evaluations overflowed scale's int count of failure lines, which then passed --max-runs
+             {{"scale", tiny, "--radii", "1e-3,1.5e-3,2e-3", "-s", "5e3,1e4,2e4", "--max-evaluations", "2000000000",
+               "--dir", camp},
+              {"scale: at most", "failure lines", "more than the limit --max-runs = 10000"}},
+             // a grid evaluates points^controls, whatever --max-evaluations says
+             {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--method", "grid", "--grid-points",
+               "1000", "-s", "5e3,1e4,2e4", "--campaign", camp},
+              {"calibration: 1000000 evaluations", "--max-runs = 10000"}}},
             dir);
     CHECK(orchestrator::kMaxReplicates == 1000);
     fs::remove_all(root);
