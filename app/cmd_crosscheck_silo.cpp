@@ -6,6 +6,7 @@
 // is reused from its folder (IDENTITY beside its result), so the same command continues an interrupted check.
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "app/silo_material.hpp"
 #include "app/gnuplot.hpp"
 #include "analytics/user_input.hpp"
 #include "orchestrator/executor.hpp"
@@ -209,7 +210,12 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     std::error_code ec;
     const std::string self = fs::read_symlink("/proc/self/exe", ec).string();
     if (ec) throw std::runtime_error("cannot find this program's own path (/proc/self/exe)");
-    if (!o.material.empty()) analytics::read_json_input(o.material, "material");  // refused early, named
+    // refused early, named; YADE's Hertz-Mindlin has no JKR cohesion, so a cohesive material has no YADE twin
+    for (const auto& [option, file] : {std::pair<std::string, std::string>{"--material", o.material},
+                                       {"--yade-material", o.yade_material}})
+        if (!file.empty() && read_silo_material(file).cohesive())
+            throw UserError(option + " = " + file + ": a cohesive material (surface_energy_J_m2 > 0): yade_scripts/silo.py "
+                            "has no JKR cohesion to match the kernel's; cross-check cohesionless materials");
     if (!o.geometry.empty()) analytics::read_json_input(o.geometry, "geometry");
     const json yade_material = o.yade_material.empty() ? json() : analytics::read_json_input(o.yade_material, "yade-material");
     for (double theta : o.thetas) check_kernel_run(kernel_argv(o, theta, "out", "bed.json", self), theta);

@@ -1,9 +1,13 @@
-// demcal cutoff: the lowest vibration frequency at which a cohesive bed arched over a hopper's outlet flows
-// (kernel/cases/cohesive_hopper.hpp; measured cases in examples/cohesive_arch/README.md).
+// demcal cutoff: the lowest vibration frequency at which a cohesive bed arched over a hopper's outlet flows, in a
+// small hopper of JKR spheres (kernel/cases/cohesive_hopper.hpp) or, with silo options after --, in the silo case
+// with a cohesive material (kernel/silo/silo_case.hpp); measured cases in examples/cohesive_arch/README.md.
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "app/silo_settings.hpp"
 #include "kernel/cases/cohesive_hopper.hpp"
 #include "analytics/number_text.hpp"
+#include "kernel/silo/input_error.hpp"  // setting_text
+#include "kernel/silo/silo_case.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 #include "orchestrator/shear_campaign.hpp"  // check_run_count
 
@@ -32,7 +36,18 @@ struct CutoffCli {
     std::vector<long long> seeds{1};
     std::string json;
     long max_runs = 10000;
+    std::vector<std::string> silo_args;  // after --: the silo case (demcal silo's options) instead of the small hopper
 };
+
+// The silo options a cut-off search sets for every run itself.
+constexpr const char* kOwnedSiloOptions[] = {"--seed", "--vibration-frequency", "--vibration-amplitude",
+                                             "--vibration-direction", "--vibration-start", "--stop-fraction",
+                                             "--max-time"};
+// The small hopper's own options, which a silo search does not use (the silo options after -- say the case).
+constexpr const char* kHopperOptions[] = {"--bond-number", "--theta", "--grains"};
+
+// The stated criterion, as for the small hopper: the bed flows when half of its mass leaves within the window.
+constexpr double kFlowingFraction = 0.5;
 
 std::pair<double, double> parse_bracket(const std::string& text) {
     const auto comma = text.find(',');
@@ -68,8 +83,7 @@ void check_search_size(const kc::CutoffSearch& s, long max_runs) {
                                       std::to_string(s.seeds.size()) + " seeds");
 }
 
-int run(const CutoffCli& o) {
-    if (!o.json.empty()) check_output_file(o.json, "--json");
+kc::CutoffSearch search_from(const CutoffCli& o) {
     kc::CutoffSearch search;
     std::tie(search.lo, search.hi) = parse_bracket(o.bracket);
     search.tol = o.tol;
@@ -79,6 +93,103 @@ int run(const CutoffCli& o) {
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
+    return search;
+}
+
+// The search's result, printed and added to the JSON report; the exit status.
+int conclude(const kc::CutoffResult& res, nlohmann::json out, const std::string& json_file) {
+    if (res.found) {
+        out["cutoff_hz"] = {res.lo, res.hi};
+        std::printf("cut-off frequency in [%g, %g] Hz\n", res.lo, res.hi);
+    } else {
+        out["cutoff_hz"] = nullptr;
+        out["reason"] = res.reason;
+        std::printf("no cut-off found: %s\n", res.reason);
+    }
+    if (!json_file.empty()) orchestrator::write_text_file_atomically(json_file, out.dump(1) + "\n");
+    return res.found ? 0 : 1;
+}
+
+// One silo run of the search: the base settings with this seed and frequency, stopped once half the mass is out or
+// at the window's end.
+kernel::silo::SiloCaseSettings silo_run_settings(kernel::silo::SiloCaseSettings s, double frequency, unsigned seed,
+                                                 double amplitude, double window) {
+    s.seed = seed;
+    s.stop_fraction = kFlowingFraction;
+    s.max_time = window;
+    s.vibration = {};
+    if (frequency > 0 && amplitude > 0) {
+        s.vibration.frequency = frequency;
+        s.vibration.amplitude = amplitude;  // horizontal (x), the whole bin, from the opening: as the small hopper
+    }
+    return s;
+}
+
+int run_silo_search(const CutoffCli& o, CLI::App& sub) {
+    namespace ks = kernel::silo;
+    for (const char* option : kHopperOptions)
+        if (sub.count(option))
+            throw UserError(std::string(option) + " applies to the small hopper; with silo options after -- the silo "
+                            "case and its material say it (--theta and --material there)");
+    for (const std::string& a : o.silo_args)
+        for (const char* owned : kOwnedSiloOptions)
+            if (a == owned || a.rfind(std::string(owned) + "=", 0) == 0)
+                throw UserError("silo option " + a + " after --: demcal cutoff sets it for every run (--seeds, "
+                                "--amplitude, --window; the criterion's half of the mass)");
+    if (!o.json.empty()) check_output_file(o.json, "--json");
+    const ks::SiloCaseSettings base = silo_case_settings(o.silo_args, "demcal cutoff");
+    const kc::CutoffSearch search = search_from(o);
+    try {
+        kc::validate(search);
+        for (double f : {search.lo, search.hi})  // every frequency of the search lies in the bracket
+            ks::validate(silo_run_settings(base, f, search.seeds.front(), o.base.amplitude, o.base.window));
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+    if (!base.materials.cohesive())
+        std::printf("note: the material has no cohesion (surface_energy_J_m2 = 0): a cohesionless bed rarely arches\n");
+    const std::string amount = base.fill_mass > 0 ? ks::setting_text(base.fill_mass) + " kg of grain"
+                                                   : std::to_string(base.particles) + " grains";
+    std::printf("cut-off search in the silo: %s, %s, stiffness scale %g; %s; A = %g m along x; bracket "
+                "[%g, %g] Hz to %g Hz, %zu seed(s); flows = half the mass out within %g s of the opening\n",
+                base.geometry.describe().c_str(), amount.c_str(), base.materials.stiffness_scale,
+                ks::contact_law_name(base.materials).c_str(), o.base.amplitude, search.lo, search.hi, search.tol,
+                search.seeds.size(), o.base.window);
+    std::fflush(stdout);
+    nlohmann::json runs = nlohmann::json::array();
+    const kc::CutoffResult res = kc::find_cutoff(search, [&](double f, unsigned seed) {
+        const ks::SiloCaseSettings s = silo_run_settings(base, f, seed, o.base.amplitude, o.base.window);
+        const ks::SiloCaseResult r = ks::run_silo_case(s);
+        const double fraction = r.filled_mass > 0 ? r.discharge.back().mass / r.filled_mass : 0;
+        const bool flows = fraction >= kFlowingFraction * (1 - 1e-12);
+        const double peak_g = s.vibration.peak_acceleration() / s.gravity;
+        std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% of %.1f g out in %.2f s -> %s  [%s; %.1f s CPU]\n",
+                    f, peak_g, seed, 100 * fraction, 1e3 * r.filled_mass, r.discharge_time,
+                    flows ? "flows" : "arched", r.stop_reason.c_str(), r.cpu_s);
+        std::fflush(stdout);
+        runs.push_back({{"frequency_hz", f}, {"seed", seed}, {"peak_acceleration_g", peak_g},
+                        {"discharged_fraction", fraction}, {"filled_mass_kg", r.filled_mass},
+                        {"bulk_density_kg_m3", r.bulk_density}, {"discharge_time_s", r.discharge_time},
+                        {"stop_reason", r.stop_reason}, {"flows", flows}, {"cpu_s", r.cpu_s}, {"wall_s", r.wall_s}});
+        return flows;
+    });
+    nlohmann::json out = {{"case", "silo"},
+                          {"geometry", base.geometry.describe()},
+                          {"silo_options", o.silo_args},
+                          {"contact_law", ks::contact_law_name(base.materials)},
+                          {"amplitude_m", o.base.amplitude},
+                          {"direction", "x"},
+                          {"window_s", o.base.window},
+                          {"criterion", "flows: at least half of the filled mass out within window_s of the opening, "
+                                        "in at least half of the seeds"},
+                          {"runs", runs}};
+    return conclude(res, std::move(out), o.json);
+}
+
+int run(const CutoffCli& o, CLI::App& sub) {
+    if (!o.silo_args.empty()) return run_silo_search(o, sub);
+    if (!o.json.empty()) check_output_file(o.json, "--json");
+    const kc::CutoffSearch search = search_from(o);
     nlohmann::json runs = nlohmann::json::array();
     auto report = [&](const kc::CohesiveHopperCase& c, const kc::CohesiveHopperOutcome& r) {
         std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% out in %.2f s -> %s  [%.1f s]\n", c.frequency,
@@ -99,21 +210,12 @@ int run(const CutoffCli& o) {
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
-    nlohmann::json out = {{"bond_number", o.base.bond_number}, {"theta_deg", o.base.theta_deg},
+    nlohmann::json out = {{"case", "small hopper"}, {"bond_number", o.base.bond_number}, {"theta_deg", o.base.theta_deg},
                           {"amplitude_m", o.base.amplitude}, {"grains", o.base.grains}, {"window_s", o.base.window},
                           {"criterion", "flows: at least half of the mass out within window_s of the opening, "
                                         "in at least half of the seeds"},
                           {"runs", runs}};
-    if (res.found) {
-        out["cutoff_hz"] = {res.lo, res.hi};
-        std::printf("cut-off frequency in [%g, %g] Hz\n", res.lo, res.hi);
-    } else {
-        out["cutoff_hz"] = nullptr;
-        out["reason"] = res.reason;
-        std::printf("no cut-off found: %s\n", res.reason);
-    }
-    if (!o.json.empty()) orchestrator::write_text_file_atomically(o.json, out.dump(1) + "\n");
-    return res.found ? 0 : 1;
+    return conclude(res, std::move(out), o.json);
 }
 
 }  // namespace
@@ -121,7 +223,8 @@ int run(const CutoffCli& o) {
 void add_cutoff_command(CLI::App& app) {
     auto o = std::make_shared<CutoffCli>();
     CLI::App* sub = app.add_subcommand(
-        "cutoff", "lowest vibration frequency at which a cohesive (JKR) bed arched over a small hopper's outlet flows");
+        "cutoff", "lowest vibration frequency at which a cohesive (JKR) bed arched over the outlet flows: a small hopper of "
+                  "spheres, or the silo case with the silo options after --");
     sub->add_option("--bond-number", o->base.bond_number, "cohesion as F_pulloff / (m g) of two equal grains")
         ->check(number_in(0, 1e4))
         ->capture_default_str();
@@ -144,8 +247,13 @@ void add_cutoff_command(CLI::App& app) {
     sub->add_option("--max-runs", o->max_runs, "most runs the search may make (a guard against typos)")
         ->check(integer_in(1, 1000000000))
         ->capture_default_str();
-    sub->callback([o] {
-        const int status = run(*o);
+    sub->add_option("silo_args", o->silo_args,
+                    "after --: search in the silo case instead, with these demcal silo options (a cohesive --material, "
+                    "--theta, --geometry, --particles, --stiffness-scale, ...)");
+    sub->footer("Silo: demcal cutoff --amplitude 1.1e-4 --bracket 0,400 --tol 25 --seeds 1,2 -- --material "
+                "examples/materials/silo_meal.json --theta 30 --particles 3000 --stiffness-scale 0.001 --fill-time 0.5");
+    sub->callback([o, sub] {
+        const int status = run(*o, *sub);
         if (status != 0) throw CLI::RuntimeError(status);
     });
 }

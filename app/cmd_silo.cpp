@@ -5,6 +5,7 @@
 #include "app/gnuplot.hpp"
 #include "app/silo_bed_export.hpp"
 #include "app/silo_material.hpp"
+#include "app/silo_settings.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
 #include "kernel/silo/wheat.hpp"  // the Rayleigh step of the run size
@@ -512,7 +513,8 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     }
     s.wall_limit = o.wall_limit;
     std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
-              << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string();
+              << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string() << "\n  contact law: "
+              << ks::contact_law_name(s.materials);
     if (s.vibration.vibrates()) std::cout << "\n  vibration: " << vibration_text(s);
     if (!s.checkpoint_file.empty())
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
@@ -659,17 +661,9 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"stop_fraction", s.stop_fraction},
                      {"skin_m", s.skin},
                      {"removal_depth_m", s.removal_depth},
-                     {"materials",
-                      {{"wheat", {{"G_Pa", s.materials.wheat.shear_modulus}, {"nu", s.materials.wheat.poisson},
-                                  {"rho_kg_m3", s.materials.wheat.density}}},
-                       {"steel", {{"G_Pa", s.materials.steel.shear_modulus}, {"nu", s.materials.steel.poisson},
-                                  {"rho_kg_m3", s.materials.steel.density}}},
-                       {"wheat_wheat", {{"restitution", s.materials.wheat_wheat.restitution},
-                                        {"friction", s.materials.wheat_wheat.friction},
-                                        {"rolling_friction", s.materials.wheat_wheat.rolling_friction}}},
-                       {"wheat_steel", {{"restitution", s.materials.wheat_steel.restitution},
-                                        {"friction", s.materials.wheat_steel.friction},
-                                        {"rolling_friction", s.materials.wheat_steel.rolling_friction}}}}}};
+                     // as a --material file gives it (silo_material.cpp), unscaled: demcal silo --material reads it back
+                     {"material", silo_material_json(s.materials)},
+                     {"contact_law", r.contact_law}};
     if (!s.vtk_dir.empty()) j["vtk"] = {{"dir", s.vtk_dir}, {"files", r.vtk_files}};
     try {
         ks::write_discharge_csv(dir / "discharge.csv", r.discharge);
@@ -711,7 +705,99 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
               << (dir / "discharge.csv").string() << (no_plots ? "" : ", section.png, discharge.png") << "\n";
 }
 
+// Every option of `demcal silo`, into `o`.
+void add_silo_options(CLI::App* sub, SiloCli& o) {
+    sub->add_option("--theta", o.theta, "hopper half angle from the vertical [deg], 0 < theta < 90 (required unless "
+                                         "--geometry gives theta_deg)");
+    sub->add_option("--material", o.material_file,
+                    "material file (grain, wall, grain-grain and grain-wall pairs; default: the seed's Table 2.1, "
+                    "examples/materials/silo_wheat_table21.json)");
+    sub->add_option("--geometry", o.geometry_file,
+                    "geometry JSON (shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m; see "
+                    "examples/silo/); options given on the command line win");
+    sub->add_option("--outlet", o.outlet, "outlet diameter d [m] (conical, default 0.035) or slot width a (--rect)");
+    sub->add_option("--diameter", o.diameter, "silo diameter D [m]")->capture_default_str();
+    sub->add_option("--body-height", o.body_height, "height of the vertical body above the hopper [m]")
+        ->capture_default_str();
+    sub->add_flag("--rect", o.rect, "rectangular silo with a wedge hopper and a slot outlet spanning the depth");
+    sub->add_option("--a", o.a, "rectangular: outlet (slot) width a [m], default 0.03");
+    sub->add_option("--b", o.b, "rectangular: silo depth b [m] (the slot's length)")->capture_default_str();
+    sub->add_option("--c", o.c, "rectangular: silo width c [m]")->capture_default_str();
+    sub->add_option("--particles", o.particles, "number of grains")->capture_default_str();
+    sub->add_option("--fill-mass", o.fill_mass, "mass of grain [kg] (instead of --particles)");
+    sub->add_option("--threads", o.threads, "OpenMP threads (default: every core)");
+    sub->add_option("--seed", o.seed, "random seed of the generation")->capture_default_str();
+    sub->add_option("--out", o.out, "output directory (default silo_theta<DEG>)");
+    sub->add_option("--vtk", o.vtk, "write VTK snapshots of the spheres into this directory");
+    sub->add_option("--vtk-every", o.vtk_every, "simulated seconds between VTK snapshots")->capture_default_str();
+    sub->add_option("--max-time", o.max_time, "discharge time limit after the opening [s]")->capture_default_str();
+    sub->add_option("--fill-time", o.fill_time, "filling time limit [s] (ends earlier once the grains are at rest)")
+        ->capture_default_str();
+    sub->add_option("--dt", o.dt, "time step [s] (default: --dt-fraction x the Rayleigh time step)");
+    sub->add_option("--dt-fraction", o.dt_fraction, "time step as a fraction of the Rayleigh time step")
+        ->capture_default_str();
+    sub->add_option("--stiffness-scale", o.stiffness_scale,
+                    "scales the shear moduli of Table 2.1 (softer contacts allow a larger time step)")
+        ->capture_default_str();
+    sub->add_option("--stop-fraction", o.stop_fraction,
+                    "stop once this fraction of the filled mass has left (1: until empty)")
+        ->capture_default_str();
+    sub->add_option("--skin", o.skin, "Verlet skin of the neighbour list [m] (0: 40 dt x 1 m/s within 0.2-1 mm)")
+        ->capture_default_str();
+    sub->add_option("--vibration-frequency", o.vibration_frequency,
+                    "the whole bin (hopper, body, outlet plate) vibrates at this frequency [Hz], 0-1000, from the "
+                    "opening (the seed's eccentric vibrator; needs --vibration-amplitude)");
+    sub->add_option("--vibration-amplitude", o.vibration_amplitude,
+                    "displacement amplitude A of the bin's vibration [m], 0-0.01 (the seed: up to 1.1e-4); "
+                    "d(t) = A sin(2 pi f t)");
+    sub->add_option("--vibration-direction", o.vibration_direction,
+                    "x: horizontal, perpendicular to the silo axis (as the seed's vibrator); z: along the axis")
+        ->capture_default_str();
+    sub->add_option("--vibration-start", o.vibration_start,
+                    "the vibration starts this many simulated seconds after the outlet opens; the bin is still "
+                    "while it fills")
+        ->capture_default_str();
+    sub->add_option("--export-bed", o.export_bed,
+                    "write the filled bed at the opening (every grain's centre, orientation, velocities; the clump, "
+                    "materials, geometry) to this JSON file, for yade_scripts/silo.py");
+    sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
+    sub->add_option("--checkpoint-every", o.checkpoint_every,
+                    "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "
+                    "the outputs are written)")
+        ->capture_default_str();
+    sub->add_flag("--no-checkpoint", o.no_checkpoint, "write no checkpoint");
+    sub->add_flag("--check", o.check_only, "check the settings and exit (0: valid, 2: refused); nothing is written");
+    sub->add_option("--wall-limit", o.wall_limit,
+                    "stop after this many wall-clock seconds of this session (0: none), at the end of a record "
+                    "interval, with a checkpoint written; exit status 75: not finished, continue with --resume "
+                    "(a batch system's time limit); SIGTERM or Ctrl-C does the same at any time")
+        ->capture_default_str();
+    sub->add_option("--resume", o.resume,
+                    "continue the interrupted run whose output directory (and checkpoint.bin) is DIR, bit for bit, "
+                    "with the settings stored in its checkpoint");
+}
+
 }  // namespace
+
+ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options, const std::string& owner) {
+    CLI::App parser("the silo options of " + owner, "silo");
+    SiloCli o;
+    add_silo_options(&parser, o);
+    refuse_empty_values(parser);  // the number rule, as on demcal silo's own command line
+    std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
+    try {
+        parser.parse(reversed);
+    } catch (const CLI::ParseError& e) {
+        throw UserError("silo options of " + owner + ": " + e.what());
+    }
+    // what only a `demcal silo` run of its own has: its outputs, its sessions
+    for (const char* own : {"--out", "--vtk", "--vtk-every", "--export-bed", "--no-plots", "--checkpoint-every",
+                            "--no-checkpoint", "--check", "--wall-limit", "--resume"})
+        if (parser.count(own))
+            throw UserError(std::string("silo option ") + own + " does not apply to " + owner +
+                            " (it runs the silo case itself and writes its own outputs)");
+    return settings_from(o, parser);
+}
 
 void add_silo_command(CLI::App& app) {
     auto o = std::make_shared<SiloCli>();
@@ -719,74 +805,7 @@ void add_silo_command(CLI::App& app) {
         "silo",
         "The seed's silo case on the native DEM kernel: wheat grains generated in the silo, filled against a closed "
         "outlet, then discharged; writes discharge.csv, summary.json (rate, flow pattern), section.png");
-    sub->add_option("--theta", o->theta, "hopper half angle from the vertical [deg], 0 < theta < 90 (required unless "
-                                         "--geometry gives theta_deg)");
-    sub->add_option("--material", o->material_file,
-                    "material file (grain, wall, grain-grain and grain-wall pairs; default: the seed's Table 2.1, "
-                    "examples/materials/silo_wheat_table21.json)");
-    sub->add_option("--geometry", o->geometry_file,
-                    "geometry JSON (shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m; see "
-                    "examples/silo/); options given on the command line win");
-    sub->add_option("--outlet", o->outlet, "outlet diameter d [m] (conical, default 0.035) or slot width a (--rect)");
-    sub->add_option("--diameter", o->diameter, "silo diameter D [m]")->capture_default_str();
-    sub->add_option("--body-height", o->body_height, "height of the vertical body above the hopper [m]")
-        ->capture_default_str();
-    sub->add_flag("--rect", o->rect, "rectangular silo with a wedge hopper and a slot outlet spanning the depth");
-    sub->add_option("--a", o->a, "rectangular: outlet (slot) width a [m], default 0.03");
-    sub->add_option("--b", o->b, "rectangular: silo depth b [m] (the slot's length)")->capture_default_str();
-    sub->add_option("--c", o->c, "rectangular: silo width c [m]")->capture_default_str();
-    sub->add_option("--particles", o->particles, "number of grains")->capture_default_str();
-    sub->add_option("--fill-mass", o->fill_mass, "mass of grain [kg] (instead of --particles)");
-    sub->add_option("--threads", o->threads, "OpenMP threads (default: every core)");
-    sub->add_option("--seed", o->seed, "random seed of the generation")->capture_default_str();
-    sub->add_option("--out", o->out, "output directory (default silo_theta<DEG>)");
-    sub->add_option("--vtk", o->vtk, "write VTK snapshots of the spheres into this directory");
-    sub->add_option("--vtk-every", o->vtk_every, "simulated seconds between VTK snapshots")->capture_default_str();
-    sub->add_option("--max-time", o->max_time, "discharge time limit after the opening [s]")->capture_default_str();
-    sub->add_option("--fill-time", o->fill_time, "filling time limit [s] (ends earlier once the grains are at rest)")
-        ->capture_default_str();
-    sub->add_option("--dt", o->dt, "time step [s] (default: --dt-fraction x the Rayleigh time step)");
-    sub->add_option("--dt-fraction", o->dt_fraction, "time step as a fraction of the Rayleigh time step")
-        ->capture_default_str();
-    sub->add_option("--stiffness-scale", o->stiffness_scale,
-                    "scales the shear moduli of Table 2.1 (softer contacts allow a larger time step)")
-        ->capture_default_str();
-    sub->add_option("--stop-fraction", o->stop_fraction,
-                    "stop once this fraction of the filled mass has left (1: until empty)")
-        ->capture_default_str();
-    sub->add_option("--skin", o->skin, "Verlet skin of the neighbour list [m] (0: 40 dt x 1 m/s within 0.2-1 mm)")
-        ->capture_default_str();
-    sub->add_option("--vibration-frequency", o->vibration_frequency,
-                    "the whole bin (hopper, body, outlet plate) vibrates at this frequency [Hz], 0-1000, from the "
-                    "opening (the seed's eccentric vibrator; needs --vibration-amplitude)");
-    sub->add_option("--vibration-amplitude", o->vibration_amplitude,
-                    "displacement amplitude A of the bin's vibration [m], 0-0.01 (the seed: up to 1.1e-4); "
-                    "d(t) = A sin(2 pi f t)");
-    sub->add_option("--vibration-direction", o->vibration_direction,
-                    "x: horizontal, perpendicular to the silo axis (as the seed's vibrator); z: along the axis")
-        ->capture_default_str();
-    sub->add_option("--vibration-start", o->vibration_start,
-                    "the vibration starts this many simulated seconds after the outlet opens; the bin is still "
-                    "while it fills")
-        ->capture_default_str();
-    sub->add_option("--export-bed", o->export_bed,
-                    "write the filled bed at the opening (every grain's centre, orientation, velocities; the clump, "
-                    "materials, geometry) to this JSON file, for yade_scripts/silo.py");
-    sub->add_flag("--no-plots", o->no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
-    sub->add_option("--checkpoint-every", o->checkpoint_every,
-                    "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "
-                    "the outputs are written)")
-        ->capture_default_str();
-    sub->add_flag("--no-checkpoint", o->no_checkpoint, "write no checkpoint");
-    sub->add_flag("--check", o->check_only, "check the settings and exit (0: valid, 2: refused); nothing is written");
-    sub->add_option("--wall-limit", o->wall_limit,
-                    "stop after this many wall-clock seconds of this session (0: none), at the end of a record "
-                    "interval, with a checkpoint written; exit status 75: not finished, continue with --resume "
-                    "(a batch system's time limit); SIGTERM or Ctrl-C does the same at any time")
-        ->capture_default_str();
-    sub->add_option("--resume", o->resume,
-                    "continue the interrupted run whose output directory (and checkpoint.bin) is DIR, bit for bit, "
-                    "with the settings stored in its checkpoint");
+    add_silo_options(sub, *o);
     sub->callback([o, sub] {
         if (sub->count("--resume")) resume_silo(*o, *sub);
         else run_silo(*o, *sub);

@@ -58,9 +58,13 @@ ks::Material solid(const json& root, const std::string& file, const std::string&
 
 ks::PairCoefficients pair(const json& root, const std::string& file, const std::string& field) {
     if (!root.contains(field)) throw UserError(file + ": " + field + " is missing");
-    const json& j = object_with(root.at(field), file, field, {"restitution", "friction", "rolling_friction"});
-    return {number(j, file, field, "restitution"), number(j, file, field, "friction"),
-            number(j, file, field, "rolling_friction")};
+    const json& j = object_with(root.at(field), file, field,
+                                {"restitution", "friction", "rolling_friction", "surface_energy_J_m2"});
+    ks::PairCoefficients p{number(j, file, field, "restitution"), number(j, file, field, "friction"),
+                           number(j, file, field, "rolling_friction")};
+    // optional: a cohesionless pair need not say so
+    if (j.contains("surface_energy_J_m2")) p.surface_energy = number(j, file, field, "surface_energy_J_m2");
+    return p;
 }
 
 }  // namespace
@@ -81,7 +85,10 @@ json silo_material_json(const ks::WheatMaterials& m) {
         return json{{"shear_modulus_Pa", s.shear_modulus}, {"poisson", s.poisson}, {"density_kg_m3", s.density}};
     };
     const auto pair = [](const ks::PairCoefficients& p) {
-        return json{{"restitution", p.restitution}, {"friction", p.friction}, {"rolling_friction", p.rolling_friction}};
+        json j{{"restitution", p.restitution}, {"friction", p.friction}, {"rolling_friction", p.rolling_friction}};
+        // only when cohesive: a cohesionless material's JSON (and the identities built on it) stays as it was
+        if (p.surface_energy > 0) j["surface_energy_J_m2"] = p.surface_energy;
+        return j;
     };
     json grain = solid(m.wheat);
     grain["shape"] = "wheat-clump";

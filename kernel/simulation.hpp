@@ -238,6 +238,7 @@ class BasicSimulation {
   std::vector<typename Law::Coeffs> coeffs_;  // nm * nm, ordered (row: sphere i's material; built in prepare)
   int nm_coeffs_ = 0;
   double law_reach_ = 0;  // how far beyond touching the law can act for the radii present [m] (prepare)
+  bool list_from_state_ = false;  // the neighbour list was loaded (load_state) and not yet prepared for
   std::vector<Wall> walls_;
   std::vector<Vec3> wall_disp_built_;  // each wall's displacement at the last neighbour build
   bool walls_move_ = false;            // some wall has a motion law or a velocity

@@ -277,8 +277,11 @@ void BasicSimulation<Law>::prepare() {
     for (int a = 0; a < nm; ++a)
       for (int b = 0; b < nm; ++b)
         if (pair_set_[a * nm + b]) reach = std::max(reach, Law::reach(coeffs_[a * nm + b], r_max));
-    if (reach > law_reach_) nl_.invalidate();  // pairs may now act beyond the list's reach
+    // pairs may now act beyond the list's reach; not so for a list just loaded from a state: it was built with the
+    // reach of these materials and radii (the configuration matched), as the uninterrupted run's list was
+    if (reach > law_reach_ && !list_from_state_) nl_.invalidate();
     law_reach_ = reach;
+    list_from_state_ = false;
   }
   if (skin_ <= 0) {
     double rs = 0;
@@ -1188,6 +1191,7 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   if (!sizes_ok) r.fail("state", "inconsistent array sizes or indices");
   rebuild_body_index();
   prepared_ = false;  // pair coefficients are derived from the configuration again
+  list_from_state_ = true;  // and the law's reach (prepare), which must not discard the list loaded here
 }
 
 template <class Law>

@@ -89,12 +89,7 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
 }
 
 void validate(const CohesiveHopperCase& base, const CutoffSearch& s) {
-  if (!(s.lo >= 0 && s.lo < s.hi && s.hi <= 1000))
-    throw std::invalid_argument("bracket = [" + silo::setting_text(s.lo) + ", " + silo::setting_text(s.hi) +
-                                "]: needs 0 <= LO < HI <= 1000 Hz");
-  if (!(s.tol > 0 && s.tol < s.hi - s.lo))
-    throw std::invalid_argument("tol = " + silo::setting_text(s.tol) + ": must be > 0 and below HI - LO");
-  if (s.seeds.empty()) throw std::invalid_argument("seeds: give at least one");
+  validate(s);
   CohesiveHopperCase c = base;
   for (double f : {s.lo, s.hi}) {  // every frequency of the search lies in the bracket: both ends checked
     c.frequency = f;
@@ -105,29 +100,13 @@ void validate(const CohesiveHopperCase& base, const CutoffSearch& s) {
 CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,
                          const std::function<void(const CohesiveHopperCase&, const CohesiveHopperOutcome&)>& report) {
   validate(c, s);
-  auto flows_at = [&](double f) {
+  return find_cutoff(s, [&](double f, unsigned seed) {
     c.frequency = f;
-    std::size_t flowing = 0;
-    for (unsigned seed : s.seeds) {
-      c.seed = seed;
-      const CohesiveHopperOutcome o = run_cohesive_hopper(c);
-      if (report) report(c, o);
-      flowing += o.flows();
-    }
-    return 2 * flowing >= s.seeds.size();
-  };
-  CutoffResult r;
-  double lo = s.lo, hi = s.hi;
-  if (flows_at(lo)) { r.reason = "flows at the low end of the bracket"; return r; }
-  if (!flows_at(hi)) { r.reason = "arched at the high end of the bracket"; return r; }
-  while (hi - lo > s.tol) {
-    const double mid = 0.5 * (lo + hi);
-    (flows_at(mid) ? hi : lo) = mid;
-  }
-  r.found = true;
-  r.lo = lo;
-  r.hi = hi;
-  return r;
+    c.seed = seed;
+    const CohesiveHopperOutcome o = run_cohesive_hopper(c);
+    if (report) report(c, o);
+    return o.flows();
+  });
 }
 
 }  // namespace demcal::kernel::cases

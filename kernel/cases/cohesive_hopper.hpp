@@ -5,6 +5,8 @@
 // F_pulloff = 3 pi gamma R*, R* = r/2. Measured results: examples/cohesive_arch/README.md.
 #pragma once
 #include <functional>
+
+#include "kernel/cases/cutoff_search.hpp"
 #include <vector>
 
 namespace demcal::kernel::cases {
@@ -36,17 +38,8 @@ struct CohesiveHopperOutcome {
 
 CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c);
 
-/// The lowest frequency at which the bed flows, by bracketing [lo, hi] and bisection down to `tol` Hz. At each
-/// frequency every seed runs once; the frequency flows when at least half of the seeds flow. `report` sees every run.
-struct CutoffSearch {
-  double lo = 0, hi = 400, tol = 25;
-  std::vector<unsigned> seeds{1};
-};
-struct CutoffResult {
-  bool found = false;
-  double lo = 0, hi = 0;  ///< the bracket: arched at lo, flows at hi [Hz]
-  const char* reason = "";  ///< when not found: which end failed
-};
+/// The lowest frequency at which this bed flows (cutoff_search.hpp), every seed at each frequency; `report` sees
+/// every run.
 /// Throws std::invalid_argument naming the setting when the search or the case at either end of the bracket is invalid.
 void validate(const CohesiveHopperCase& c, const CutoffSearch& s);
 CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,

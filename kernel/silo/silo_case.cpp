@@ -20,6 +20,7 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 #include <type_traits>
 #include <unordered_map>
 
@@ -135,17 +136,22 @@ kernel::Material to_kernel(const silo::Material& m, const char* name) {
     return k;
 }
 
-Simulation::PairParams to_kernel(const PairCoefficients& p) {
-    Simulation::PairParams k;
+// The pair's inputs of the law the run is on: the cohesion only where the law has it (a law without it runs only
+// cohesionless materials: SiloCaseLaw's choice).
+template <class Law>
+typename Law::Params to_kernel(const PairCoefficients& p) {
+    typename Law::Params k;
     k.restitution = p.restitution;
     k.friction = p.friction;
     k.rolling_friction = p.rolling_friction;
+    if constexpr (requires { k.surface_energy; }) k.surface_energy = p.surface_energy;
     return k;
 }
 
 // The silo's walls, all moving on `bin_motion` (null: still); returns the outlet plate's wall id. The body wall
 // reaches up to `wall_top`.
-int add_silo_walls(Simulation& sim, const SiloGeometry& g, int steel, double wall_top,
+template <class Sim>
+int add_silo_walls(Sim& sim, const SiloGeometry& g, int steel, double wall_top,
                    const std::shared_ptr<const WallMotion>& bin_motion) {
     const auto add = [&](const Wall& w) { return sim.add_wall(bin_motion ? w.moving(bin_motion) : w); };
     const double hh = g.hopper_height(), th = g.half_angle_deg * pi / 180;
@@ -187,6 +193,9 @@ void validate(const SiloCaseSettings& s) {
         if (!(p.friction >= 0 && p.friction <= 10)) reject_setting(name + ".friction", p.friction, "must lie in [0, 10]");
         if (!(p.rolling_friction >= 0 && p.rolling_friction <= 1))
             reject_setting(name + ".rolling_friction", p.rolling_friction, "must lie in [0, 1]");
+        // 100 J/m^2 gives the seed's grain a bond number 3 pi gamma R* / (m g) near 2000: far beyond any powder
+        if (!(p.surface_energy >= 0 && p.surface_energy <= 100))
+            reject_setting(name + ".surface_energy", p.surface_energy, "must lie in [0, 100] J/m^2 (0: no cohesion)");
     };
     pair(s.materials.wheat_wheat, "grain_grain");
     pair(s.materials.wheat_steel, "grain_wall");
@@ -254,11 +263,13 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
-// Version 4: each section (tag and settings; the case's state; the kernel's state) closed by a checksum, the kernel's
+// Version 5: the pairs' surface energies (JKR cohesion) at the end of the settings; version 4, the same without them
+// (no cohesion), is read too. Version 4: each section (tag and settings; the case's state; the kernel's state) closed by a checksum, the kernel's
 // state in its format 3 (contact histories of any size, moving walls); the settings include the bin's vibration
 // (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 4;
+constexpr int kCheckpointVersion = 5;
+constexpr int kCheckpointVersionWithoutCohesion = 4;
 
 // Every setting that shapes the run, named once: the checkpoint stores the settings through this list.
 template <class S, class F>
@@ -315,6 +326,9 @@ void for_each_setting(S& s, F&& f) {
     f("vtk_dir", s.vtk_dir);
     f("vtk_interval", s.vtk_interval);
     f("progress_interval", s.progress_interval);
+    // since version 5 (read_settings leaves them at 0 in a version 4 checkpoint)
+    f("surface_energy", s.materials.wheat_wheat.surface_energy);
+    f("surface_energy", s.materials.wheat_steel.surface_energy);
 }
 
 void write_settings(StateWriter& w, const SiloCaseSettings& s) {
@@ -324,9 +338,10 @@ void write_settings(StateWriter& w, const SiloCaseSettings& s) {
     });
 }
 
-SiloCaseSettings read_settings(StateReader& r) {
+SiloCaseSettings read_settings(StateReader& r, int version) {
     SiloCaseSettings s;
     for_each_setting(s, [&](const char* name, auto& v) {
+        if (version <= kCheckpointVersionWithoutCohesion && std::string_view(name) == "surface_energy") return;
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
         else r.value(v, name);
     });
@@ -335,6 +350,7 @@ SiloCaseSettings read_settings(StateReader& r) {
 
 // One run of the case: generation, filling, opening, discharge; every variable that carries over from one record
 // interval to the next is a member, so that a checkpoint can hold the whole run.
+template <class Law>
 class SiloRun {
 public:
     using Progress = std::function<void(const SiloProgress&)>;
@@ -346,8 +362,8 @@ public:
         sim_.set_gravity(Vec3(0, 0, -s_.gravity));
         wheat_ = sim_.add_material(to_kernel(s_.materials.wheat_scaled(), "wheat"));
         steel_ = sim_.add_material(to_kernel(s_.materials.steel_scaled(), "steel"));
-        sim_.set_pair(wheat_, wheat_, to_kernel(s_.materials.wheat_wheat));
-        sim_.set_pair(wheat_, steel_, to_kernel(s_.materials.wheat_steel));
+        sim_.set_pair(wheat_, wheat_, to_kernel<Law>(s_.materials.wheat_wheat));
+        sim_.set_pair(wheat_, steel_, to_kernel<Law>(s_.materials.wheat_steel));
         grain_ = sim_.add_clump_template(tmpl_);
         if (s_.vibration.vibrates()) bin_motion_ = std::make_shared<BinVibrationMotion>(s_.vibration);
         r_.grain_mass = tmpl_.mass;
@@ -748,7 +764,7 @@ private:
     SiloCaseSettings s_;
     Progress progress_;
     ClumpTemplate tmpl_;
-    Simulation sim_;
+    BasicSimulation<Law> sim_;
     int wheat_ = 0, steel_ = 0, grain_ = 0, plate_ = -1;
     std::shared_ptr<BinVibrationMotion> bin_motion_;  // every wall's law; null: the bin is still
     SiloCaseResult r_;
@@ -789,23 +805,46 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string current = prefix + std::to_string(kCheckpointVersion);
     if (tag == current) {
         version = kCheckpointVersion;
+    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutCohesion)) {
+        version = kCheckpointVersionWithoutCohesion;
     } else if (tag == prefix + "1" || tag == prefix + "2" || tag == prefix + "3") {
         r.fail("format tag", "written by an older demcal (" + tag + "; this one reads " + current +
                                  "): finish that run with the demcal that started it, or start it again");
     } else {
         r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + current + ")");
     }
-    SiloCaseSettings settings = read_settings(r);
+    SiloCaseSettings settings = read_settings(r, version);
     r.checksum();
     return settings;
 }
 
+// A new run or a resumed one (`resume` reads the state after the settings), on the law the materials ask for.
+template <class Law>
+SiloCaseResult run_on(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress,
+                      const std::function<void(SiloRun<Law>&)>& start) {
+    SiloRun<Law> run(s, progress);
+    start(run);
+    SiloCaseResult r = run.run();
+    r.contact_law = contact_law_name(s.materials);
+    return r;
+}
+
+template <class Start>
+SiloCaseResult run_on_its_law(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress,
+                              Start&& start) {
+    if (s.materials.cohesive()) return run_on<JkrMindlinEdem>(s, progress, start);
+    return run_on<HertzMindlinEdem>(s, progress, start);
+}
+
 }  // namespace
 
+std::string contact_law_name(const WheatMaterials& m) {
+    return m.cohesive() ? "Hertz-Mindlin with JKR cohesion, EDEM rolling friction"
+                        : "Hertz-Mindlin (no slip), EDEM rolling friction";
+}
+
 SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress) {
-    SiloRun run(s, progress);
-    run.generate();
-    return run.run();
+    return run_on_its_law(s, progress, [](auto& run) { run.generate(); });
 }
 
 SiloCaseSettings read_checkpoint_settings(const std::string& file) {
@@ -824,13 +863,13 @@ SiloCaseResult resume_silo_case(const std::string& file, const SiloSession& sess
     s.checkpoint_interval = session.checkpoint_interval;
     s.wall_limit = session.wall_limit;
     s.stop_request = session.stop_request;
-    SiloRun run(s, progress);
-    try {
-        run.load(is, "checkpoint '" + file + "'", version);
-    } catch (const std::runtime_error& e) {  // a damaged or foreign file is bad input, wherever the damage lies
-        throw std::invalid_argument(e.what());
-    }
-    return run.run();
+    return run_on_its_law(s, progress, [&](auto& run) {
+        try {
+            run.load(is, "checkpoint '" + file + "'", version);
+        } catch (const std::runtime_error& e) {  // a damaged or foreign file is bad input, wherever the damage lies
+            throw std::invalid_argument(e.what());
+        }
+    });
 }
 
 }  // namespace demcal::kernel::silo

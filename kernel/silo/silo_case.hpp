@@ -150,9 +150,14 @@ struct SiloCaseResult {
     int cpu_sessions = 0;
     bool suspended = false;  // stopped at SiloCaseSettings::wall_limit or stop_request (stop_reason says which):
                              // resume it from its checkpoint
+    std::string contact_law;             // the law the run was on (contact_law_name)
     long checkpoints = 0;                // written over the whole run
     long vtk_files = 0;
 };
+
+// The contact law a silo of these materials runs on: Hertz-Mindlin with EDEM's rolling friction, or, when a pair is
+// cohesive (WheatMaterials::cohesive), JKR with the same friction and rolling friction (kernel/contact/contact_law.hpp).
+std::string contact_law_name(const WheatMaterials& m);
 
 SiloCaseResult run_silo_case(const SiloCaseSettings& s,
                              const std::function<void(const SiloProgress&)>& progress = {});

@@ -37,6 +37,9 @@ struct PairCoefficients {
     double restitution;       // C_r [-]
     double friction;          // mu_0, static (sliding) friction [-]
     double rolling_friction;  // f [-], constant directional torque tau = -f Fn R omega/|omega| (EDEM)
+    // gamma [J/m^2] >= 0: JKR cohesion (EDEM's "Hertz-Mindlin with JKR cohesion", kernel/contact/jkr_normal.hpp),
+    // pull-off force 3 pi gamma R*. 0 (Table 2.1's wheat): no cohesion, the Hertz-Mindlin law.
+    double surface_energy = 0;
 };
 
 struct WheatMaterials {
@@ -49,6 +52,10 @@ struct WheatMaterials {
     double stiffness_scale = 1.0;
 
     Material wheat_scaled() const { return {wheat.shear_modulus * stiffness_scale, wheat.poisson, wheat.density}; }
+    // Whether either pair is cohesive: the silo then runs JKR (with gamma = 0 for a pair without cohesion, which is
+    // Hertz) instead of Hertz-Mindlin.
+    bool cohesive() const { return wheat_wheat.surface_energy > 0 || wheat_steel.surface_energy > 0; }
+
     Material steel_scaled() const { return {steel.shear_modulus * stiffness_scale, steel.poisson, steel.density}; }
 };
 

@@ -65,11 +65,21 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
   const std::pair<std::string, std::string> cases[] = {
       {"--bracket 400,0", "bracket"},     {"--bracket 0,x", "--bracket"}, {"--tol 1000", "tol"},
       {"--bond-number nan", "--bond-number"}, {"--seeds -1", "--seeds"},   {"--amplitude 1", "--amplitude"},
-      {"--json " + dir.string(), "--json"}};
+      {"--json " + dir.string(), "--json"},
+      // the silo case (options after --): its own options stay with demcal silo, the search's with cutoff
+      {"--bond-number 5 -- --theta 30", "--bond-number applies to the small hopper"},
+      {"-- --theta 30 --seed 3", "silo option --seed after --: demcal cutoff sets it"},
+      {"-- --theta 30 --vibration-frequency 50", "--vibration-frequency after --"},
+      {"-- --theta 30 --out " + dir.string(), "--out does not apply to demcal cutoff"},
+      {"-- --theta 30 --colour red", "silo options of demcal cutoff"},
+      {"-- --theta 95", "theta"},
+      {"--bracket 0,5000 -- --theta 30", "bracket"},
+      {"--bracket 0,900 -- --theta 30 --stiffness-scale 1e-6", "vibration_frequency"}};
   for (const auto& [args, expect] : cases) {
     INFO(args);
-    const std::string run = std::string("'") + DEMCAL_BINARY + "' cutoff " + args +
-                            (args.rfind("--json", 0) == 0 ? "" : " --json '" + json + "'") + " > '" +
+    // --json first: after -- every word is a silo option
+    const std::string run = std::string("'") + DEMCAL_BINARY + "' cutoff " +
+                            (args.rfind("--json", 0) == 0 ? "" : "--json '" + json + "' ") + args + " > '" +
                             (dir / "out.log").string() + "' 2>&1";
     const int status = std::system(run.c_str());
     CHECK((WIFEXITED(status) ? WEXITSTATUS(status) : -1) == 2);

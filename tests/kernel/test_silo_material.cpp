@@ -50,6 +50,23 @@ TEST_CASE("demcal silo --material: the Table 2.1 file is the default, bit for bi
     "grain_grain": {"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01},
     "grain_wall": {"restitution": 0.6, "friction": 0.6, "rolling_friction": 0.01}})";
   CHECK(tiny_run(dir, "rough", "--material '" + (dir / "rough.json").string() + "'") != builtin);
+  // a cohesion of 0 said aloud is no cohesion: the Hertz-Mindlin law, the same bits
+  std::ofstream(dir / "dry.json") << R"({"grain": {"shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430},
+    "wall": {"shear_modulus_Pa": 8e8, "poisson": 0.3, "density_kg_m3": 7500},
+    "grain_grain": {"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01, "surface_energy_J_m2": 0},
+    "grain_wall": {"restitution": 0.6, "friction": 0.25, "rolling_friction": 0.01, "surface_energy_J_m2": 0}})";
+  CHECK(tiny_run(dir, "dry", "--material '" + (dir / "dry.json").string() + "'") == builtin);
+  // a cohesive one runs on the JKR law, says so and writes its cohesion back
+  std::ofstream(dir / "meal.json") << R"({"grain": {"shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430},
+    "wall": {"shear_modulus_Pa": 8e8, "poisson": 0.3, "density_kg_m3": 7500},
+    "grain_grain": {"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01, "surface_energy_J_m2": 0.25},
+    "grain_wall": {"restitution": 0.6, "friction": 0.25, "rolling_friction": 0.01}})";
+  CHECK(tiny_run(dir, "meal", "--material '" + (dir / "meal.json").string() + "'") != builtin);
+  const std::string summary = demcal::test::read_file(dir / "meal" / "summary.json");
+  CHECK_THAT(summary, Catch::Matchers::Contains("JKR"));
+  CHECK_THAT(summary, Catch::Matchers::Contains("\"surface_energy_J_m2\": 0.25"));
+  CHECK_THAT(demcal::test::read_file(dir / "builtin" / "summary.json"),
+             !Catch::Matchers::Contains("surface_energy") && !Catch::Matchers::Contains("JKR"));
   fs::remove_all(dir);
 }
 
@@ -76,6 +93,10 @@ TEST_CASE("demcal silo --material: bad files name the file, the field and the va
       {file(R"({"shape": "sphere", "shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430})", good_pair),
        "grain.shape"},
       {file(good_solid, R"({"restitution": "high", "friction": 0.3, "rolling_friction": 0.01})"), "must be a number"},
+      {file(good_solid, R"({"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01,
+                             "surface_energy_J_m2": -0.5})"), "grain_grain.surface_energy = -0.5"},
+      {file(good_solid, R"({"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01,
+                             "surface_energy_J_m2": "sticky"})"), "surface_energy_J_m2 = \"sticky\": must be a number"},
       {"[1, 2]", "must be a JSON object"}};
   int k = 0;
   for (const auto& [text, expect] : cases) {

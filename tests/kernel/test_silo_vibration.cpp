@@ -5,6 +5,7 @@
 // Tiny case: 600 grains in a 30 deg cone (D = 70 mm, 30 mm outlet), shear moduli scaled by 1e-3 as the reduced silo
 // tests do; the bin shakes at 50 Hz, 1 mm along x (peak 10 g), strong enough to change a 0.2 s discharge.
 #include "kernel/silo/silo_case.hpp"
+#include "silo_resume_check.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -18,6 +19,7 @@
 #include <unistd.h>
 
 using namespace demcal::kernel::silo;
+using demcal::test::same_discharge;
 
 namespace {
 
@@ -38,17 +40,6 @@ SiloCaseSettings tiny_vibrating_case() {
     s.vibration.amplitude = 1e-3;
     return s;
 }
-
-bool same_discharge(const SiloCaseResult& a, const SiloCaseResult& b) {
-    if (a.discharge.size() != b.discharge.size()) return false;
-    for (size_t i = 0; i < a.discharge.size(); ++i)
-        if (a.discharge[i].time != b.discharge[i].time || a.discharge[i].mass != b.discharge[i].mass ||
-            a.discharge[i].grains != b.discharge[i].grains)
-            return false;
-    return true;
-}
-
-struct SimulatedCrash {};
 
 }  // namespace
 
@@ -143,35 +134,8 @@ TEST_CASE("silo case: a vibrating run killed at checkpoints resumes to the unint
           "[silo][vibration][checkpoint]") {
     SiloCaseSettings s = tiny_vibrating_case();
     s.vibration.start_after_opening = 0.02;
-    const SiloCaseResult whole = run_silo_case(s);
-
-    const auto dir = std::filesystem::temp_directory_path() / ("demcal-test-vibration-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    s.checkpoint_file = (dir / "checkpoint.bin").string();
-    s.checkpoint_interval = 0;  // after every record interval
-    long seen = 0;
-    // first session dies while filling (the law waits for the opening), the second 0.05 s after the opening (the
-    // bin vibrates since 0.02 s), the third finishes
-    CHECK_THROWS_AS(run_silo_case(s,
-                                  [&](const SiloProgress& p) {
-                                      if (p.phase == "checkpoint" && ++seen == 5) throw SimulatedCrash{};
-                                  }),
-                    SimulatedCrash);
-    CHECK(read_checkpoint_settings(s.checkpoint_file).vibration.frequency == 50);
-    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0},
-                                     [&](const SiloProgress& p) {
-                                         if (p.phase == "checkpoint" && p.discharge_time > 0.05) throw SimulatedCrash{};
-                                     }),
-                    SimulatedCrash);
-    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0});
-    CHECK(resumed.sessions == 3);
-    CHECK(resumed.fill_steps == whole.fill_steps);
-    CHECK(resumed.fill_kinetic_energy == whole.fill_kinetic_energy);
-    CHECK(same_discharge(resumed, whole));
-    CHECK(resumed.steps == whole.steps);
-    CHECK(resumed.fit.rate == whole.fit.rate);
-    CHECK(resumed.flow.ratio == whole.flow.ratio);
-    std::filesystem::remove_all(dir);
+    // killed while filling (the law waits for the opening), then 0.05 s after the opening (vibrating since 0.02 s)
+    CHECK(demcal::test::check_resumes_bit_for_bit(s, "vibration", 0.05).vibration.frequency == 50);
 }
 
 TEST_CASE("silo case: bad vibration settings name the field and the value", "[silo][vibration]") {

@@ -1,0 +1,28 @@
+// The cut-off frequency of vibration (the seed's section 3.6): the lowest frequency at which an arched bed flows,
+// found by bracketing [lo, hi] and bisection down to `tol` Hz. The case is the caller's (a small cohesive hopper,
+// the silo): it answers "does the bed flow at this frequency with this seed" by its own stated criterion.
+#pragma once
+#include <functional>
+#include <vector>
+
+namespace demcal::kernel::cases {
+
+struct CutoffSearch {
+  double lo = 0, hi = 400, tol = 25;  ///< the bracket and the final width [Hz]
+  std::vector<unsigned> seeds{1};     ///< repeats: each frequency runs once per seed
+};
+
+struct CutoffResult {
+  bool found = false;
+  double lo = 0, hi = 0;    ///< the bracket: arched at lo, flows at hi [Hz]
+  const char* reason = "";  ///< when not found: which end failed
+};
+
+/// Throws std::invalid_argument naming the setting: 0 <= lo < hi <= 1000 Hz, 0 < tol < hi - lo, a seed at least.
+void validate(const CutoffSearch& s);
+
+/// A frequency flows when at least half of the seeds flow there (a majority; a tie counts as flowing).
+/// `flows(frequency, seed)` runs the case once.
+CutoffResult find_cutoff(const CutoffSearch& s, const std::function<bool(double frequency, unsigned seed)>& flows);
+
+}  // namespace demcal::kernel::cases

@@ -1,0 +1,63 @@
+// Shared by the silo case's checkpoint tests: a run killed at checkpoints (first while it fills, then after the
+// opening) and resumed gives the uninterrupted run's result bit for bit, whatever the settings exercise (a still or
+// vibrating bin, a cohesive material).
+#pragma once
+#include "kernel/silo/silo_case.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <string>
+
+#include <unistd.h>
+
+namespace demcal::test {
+
+inline bool same_discharge(const kernel::silo::SiloCaseResult& a, const kernel::silo::SiloCaseResult& b) {
+    if (a.discharge.size() != b.discharge.size()) return false;
+    for (size_t i = 0; i < a.discharge.size(); ++i)
+        if (a.discharge[i].time != b.discharge[i].time || a.discharge[i].mass != b.discharge[i].mass ||
+            a.discharge[i].grains != b.discharge[i].grains)
+            return false;
+    return true;
+}
+
+// `s` runs whole, then again killed at its 5th checkpoint (while filling, with checkpoints after every record
+// interval) and, resumed on another thread count, killed once the discharge passed `second_kill_after` s; the third
+// session finishes. Returns the checkpoint's stored settings for the caller's own checks.
+inline kernel::silo::SiloCaseSettings check_resumes_bit_for_bit(kernel::silo::SiloCaseSettings s, const std::string& tag,
+                                                                double second_kill_after) {
+    using namespace kernel::silo;
+    struct SimulatedCrash {};
+    const SiloCaseResult whole = run_silo_case(s);
+    const auto dir = std::filesystem::temp_directory_path() / ("demcal-test-" + tag + "-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    s.checkpoint_file = (dir / "checkpoint.bin").string();
+    s.checkpoint_interval = 0;  // after every record interval
+    long seen = 0;
+    CHECK_THROWS_AS(run_silo_case(s,
+                                  [&](const SiloProgress& p) {
+                                      if (p.phase == "checkpoint" && ++seen == 5) throw SimulatedCrash{};
+                                  }),
+                    SimulatedCrash);
+    const SiloCaseSettings stored = read_checkpoint_settings(s.checkpoint_file);
+    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0},
+                                     [&](const SiloProgress& p) {
+                                         if (p.phase == "checkpoint" && p.discharge_time > second_kill_after)
+                                             throw SimulatedCrash{};
+                                     }),
+                    SimulatedCrash);
+    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0});
+    CHECK(resumed.sessions == 3);
+    CHECK(resumed.fill_steps == whole.fill_steps);
+    CHECK(resumed.fill_kinetic_energy == whole.fill_kinetic_energy);
+    CHECK(same_discharge(resumed, whole));
+    CHECK(resumed.steps == whole.steps);
+    CHECK(resumed.fit.rate == whole.fit.rate);
+    CHECK(resumed.flow.ratio == whole.flow.ratio);
+    CHECK(resumed.contact_law == whole.contact_law);
+    std::filesystem::remove_all(dir);
+    return stored;
+}
+
+}  // namespace demcal::test
