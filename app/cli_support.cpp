@@ -44,7 +44,7 @@ CLI::Validator number_check(const std::string& what, std::function<bool(double)>
             if (!n.is_number) return shown + " is not a number";
             if (n.defect) return shown + " " + *n.defect;
             const double v = n.value;
-            if (!ok(v)) return shown + " is not " + what;
+            if (!ok(v)) return analytics::shortened_text(text) + " is not " + what;
             return {};
         },
         what);
