@@ -168,9 +168,12 @@ TEST_CASE("crosscheck silo: repeated angles, too many angles and settings the ke
              {{"crosscheck", "silo", "--theta", "10,20,30", "--max-runs", "4", "--campaign", camp},
               {"crosscheck silo: 3 angles x 2 codes = 6 simulations", "--max-runs = 4"}},
              {{"crosscheck", "silo", "--theta", "1e-320", "--campaign", camp}, {"--theta", "subnormal"}},
-             // a shear material given as the silo's: found by the kernel run's own checks, not after the campaign began
+             // a setting only the silo run checks (its run size): found before the campaign began, not by its runs
+             {{"crosscheck", "silo", "--theta", "30", "--max-time", "1e99", "--campaign", camp},
+              {"theta = 30: the kernel run refuses its settings", "--max-time 1e+99 s", "the run would not end"}},
+             // a shear material given as the silo's
              {{"crosscheck", "silo", "--theta", "30", "--material", shear_material, "--campaign", camp},
-              {"theta = 30: the kernel run refuses its settings"}}},
+              {"unknown key 'bond_normal_strength'"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);
