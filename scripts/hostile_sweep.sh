@@ -204,6 +204,12 @@ run_case cutoff/window-nan           2 "--window"        -- cutoff --bond-number
 run_case cutoff/json-folder          2 "--json"          -- cutoff --bond-number 10 --json "$work/folder.json"
 run_case cutoff/json-readonly        2 "--json"  "$ro"   -- cutoff --bond-number 10 --json "$ro/c.json"
 run_case cutoff/json-no-folder       2 "--json"          -- cutoff --bond-number 10 --json /no/such/c.json
+meal="$here/examples/materials/silo_meal.json"
+run_case cutoff/silo-tol-tiny        2 "--tol"           -- cutoff --tol 1e-300 -- --material "$meal" --theta 30
+run_case cutoff/silo-dt-fraction     2 "--dt-fraction"   -- cutoff -- --material "$meal" --theta 30 --dt-fraction 1e-300
+run_case cutoff/silo-particles-nan   2 "--particles"     -- cutoff -- --material "$meal" --theta 30 --particles nan
+run_case cutoff/silo-stiffness-sub   2 "--stiffness-scale" -- cutoff -- --material "$meal" --theta 30 --stiffness-scale 1e-320
+run_case cutoff/silo-out             2 "--out"           -- cutoff -- --material "$meal" --theta 30 --out o
 
 # ---- demcal vibration -----------------------------------------------------------------------------------------------
 V=(vibration --campaign camp --theta 30 --frequency 0,50 --amplitude 1e-4)
