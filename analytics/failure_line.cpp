@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <map>
+#include <set>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,18 @@ namespace demcal::analytics {
 namespace {
 double t_quantile(double confidence, int dof) { return gsl_cdf_tdist_Pinv(0.5 + confidence / 2.0, dof); }
 }  // namespace
+
+void check_failure_line_design(std::span<const double> normal_stresses, int replicates) {
+    const std::set<double> distinct(normal_stresses.begin(), normal_stresses.end());
+    if (distinct.size() < 2)
+        throw std::invalid_argument("normal-stress: a failure line needs at least 2 distinct normal stresses, got " +
+                                    std::to_string(distinct.size()));
+    if (static_cast<double>(distinct.size()) * replicates < 3)
+        throw std::invalid_argument("replicates = " + std::to_string(replicates) + " at " +
+                                    std::to_string(distinct.size()) +
+                                    " normal stresses: a failure line needs at least 3 points (a line through 2 "
+                                    "leaves nothing to estimate its uncertainty)");
+}
 
 FailureLine fit_failure_line(std::span<const double> sigma, std::span<const double> tau, double confidence) {
     if (sigma.size() != tau.size())

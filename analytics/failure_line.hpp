@@ -39,4 +39,9 @@ struct FailureLine {
 // throws std::invalid_argument naming the problem otherwise (or on non-finite input).
 FailureLine fit_failure_line(std::span<const double> sigma, std::span<const double> tau, double confidence = 0.95);
 
+// The same requirement on a campaign before it runs (`replicates` points at each stress): at least 2 distinct normal
+// stresses and 3 points. Throws std::invalid_argument naming --normal-stress or --replicates and the values, so that
+// a campaign whose line cannot be fitted is refused before its runs, not after them.
+void check_failure_line_design(std::span<const double> normal_stresses, int replicates);
+
 }  // namespace demcal::analytics

@@ -1,5 +1,6 @@
 #include "app/campaign_cli.hpp"
 
+#include "analytics/failure_line.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "orchestrator/shear_params.hpp"
@@ -16,7 +17,7 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
         ->delimiter(',')
         ->check(positive_number())
         ->capture_default_str();
-    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(positive_number());
+    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(integer_in(1, orchestrator::kMaxReplicates));
     cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)")
         ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
     cmd->add_option("--engine", c.engine, "yade or kernel (the same shear box on demcal's kernel with YADE's laws)")
@@ -61,9 +62,11 @@ calibration::CampaignSettings settings_of(const CampaignCli& c, const std::strin
 }
 
 void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
-    if (c.normal_stresses.size() < 2)
-        throw UserError("normal-stress: a failure line needs at least 2 normal stresses, got " +
-                        std::to_string(c.normal_stresses.size()));
+    try {
+        analytics::check_failure_line_design(c.normal_stresses, c.replicates);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
     if (c.engine == "kernel" && !c.template_path.empty())
         throw UserError("template = '" + c.template_path + "' is a YADE script: it applies to --engine yade only");
     orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));

@@ -13,6 +13,8 @@
 #include <fstream>
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <string_view>
 
 #include <unistd.h>
 
@@ -42,7 +44,7 @@ CLI::Validator number_check(const std::string& what, std::function<bool(double)>
             if (!n.is_number) return shown + " is not a number";
             if (n.defect) return shown + " " + *n.defect;
             const double v = n.value;
-            if (!ok(v)) return text + " is not " + what;
+            if (!ok(v)) return analytics::shortened_text(text) + " is not " + what;
             return {};
         },
         what);
@@ -69,11 +71,34 @@ CLI::Validator integer_in(long long lo, long long hi) {
 }
 
 void refuse_empty_values(CLI::App& app) {
-    for (CLI::Option* opt : app.get_options())
-        if (opt->get_type_size_max() > 0)  // takes values (a flag takes none)
-            opt->check(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); },
-                                      ""));
+    // An option's type as CLI11 names it: every number option follows the number rule and every integer option the
+    // integer rule, whatever checks its command adds (one place: an option registered without a check was read by
+    // CLI11 alone, which lets NaN, subnormals and 1e308 through and echoes a 100 kB value in full).
+    const CLI::Validator any_number = number_check("a number", [](double) { return true; });
+    const CLI::Validator any_integer = integer_in(std::numeric_limits<long long>::min(),
+                                                  std::numeric_limits<long long>::max());
+    for (CLI::Option* opt : app.get_options()) {
+        if (opt->get_type_size_max() <= 0) continue;  // a flag takes no value
+        opt->check(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); }, ""));
+        const std::string type = opt->get_type_name();
+        if (type == "FLOAT") opt->check(any_number);
+        else if (type == "INT" || type == "UINT") opt->check(any_integer);
+    }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
+}
+
+void check_argument_lengths(int argc, const char* const* argv) {
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg(argv[i]);
+        if (arg.size() <= kMaxArgumentChars) continue;
+        std::string named = "argument " + std::to_string(i);
+        if (arg.rfind("--", 0) == 0 && arg.find('=') != std::string_view::npos)
+            named = std::string(arg.substr(0, std::min(arg.find('='), std::size_t(40))));
+        else if (i > 1 && argv[i - 1][0] == '-' && std::string_view(argv[i - 1]).size() <= 40)
+            named = argv[i - 1];
+        throw UserError(named + ": '" + analytics::shortened_text(arg) + "' is longer than " +
+                        std::to_string(kMaxArgumentChars) + " characters (no path, number or list of demcal is)");
+    }
 }
 
 CLI::Validator number_in(double lo, double hi) {
@@ -89,6 +114,21 @@ CLI::Validator non_negative_number() {
     return number_check("a number >= 0", [](double v) { return v >= 0; });
 }
 
+namespace {
+
+// Whether a file can be created in `folder`, tried for real: access(2) says yes to root in /proc or in a folder
+// mounted read-only by some file systems. The probe is removed at once.
+bool can_create_files_in(const std::filesystem::path& folder) {
+    std::string probe = (folder / ".demcal-write-probe-XXXXXX").string();
+    const int fd = ::mkstemp(probe.data());
+    if (fd < 0) return false;
+    ::close(fd);
+    ::unlink(probe.c_str());
+    return true;
+}
+
+}  // namespace
+
 void check_output_file(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
@@ -97,9 +137,27 @@ void check_output_file(const std::string& path, const std::string& option) {
     if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
     const fs::path folder = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
     if (!fs::is_directory(folder, ec)) throw UserError(named + ": the folder " + folder.string() + " does not exist");
-    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+    if (!can_create_files_in(folder))
         throw UserError(named + ": the folder " + folder.string() + " is not writable");
     if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) throw UserError(named + " is not writable");
+}
+
+void check_output_folder(const std::string& path, const std::string& option) {
+    namespace fs = std::filesystem;
+    const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
+    if (path.empty()) throw UserError(option + ": an empty path");
+    std::error_code ec;
+    fs::path folder = fs::absolute(fs::path(path), ec).lexically_normal();
+    if (ec) throw UserError(named + ": " + ec.message());
+    if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
+        throw UserError(named + " is a file, not a folder");
+    // the folder itself when it exists, else the nearest existing folder above it (where it will be created)
+    while (!fs::exists(folder, ec) && folder.has_parent_path() && folder.parent_path() != folder)
+        folder = folder.parent_path();
+    if (!fs::is_directory(folder, ec))
+        throw UserError(named + ": " + folder.string() + " is a file, so the folder cannot be created");
+    if (!can_create_files_in(folder))
+        throw UserError(named + ": " + folder.string() + " is not writable");
 }
 
 std::string duration_text(double seconds) {

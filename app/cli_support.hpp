@@ -20,12 +20,25 @@ CLI::Validator non_negative_number();            // x >= 0
 CLI::Validator integer_in(long long lo, long long hi);  // a whole integer, lo <= x <= hi (never clamped)
 
 // Adds to every option of `app` and its subcommands that takes a value a check refusing an empty one (CLI11 read
-// `--replicates ""` as 0). Call once every command is registered.
+// `--replicates ""` as 0), to every number option the number rule (analytics::number_defect) and to every integer
+// option the integer rule (integer_in, never clamped). Call once every command is registered.
 void refuse_empty_values(CLI::App& app);
+
+// The longest command-line argument demcal takes: a path (PATH_MAX) or a list of numbers.
+inline constexpr std::size_t kMaxArgumentChars = 4096;
+
+// Refuses, before CLI11 sees them, arguments longer than kMaxArgumentChars, naming the option and the value
+// shortened (CLI11 echoed a 100 kB value in full in its own messages).
+void check_argument_lengths(int argc, const char* const* argv);
 
 // Checks, before any work starts, that `path` can be written as an output file: not a folder, its folder exists and
 // is writable (and the file itself, when it exists). Throws UserError naming `option`, the path and the rule.
 void check_output_file(const std::string& path, const std::string& option);
+
+// Checks, before any work starts, that `path` can be used as an output folder: not a file, and files can be created
+// in it (when it exists) or in the nearest existing folder above it (where it will be created). The check creates
+// nothing (a probe file is removed at once). Throws UserError naming `option`, the path and the rule.
+void check_output_folder(const std::string& path, const std::string& option);
 
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);

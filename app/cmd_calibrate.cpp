@@ -10,6 +10,7 @@
 #include "app/scaling_plots.hpp"
 #include "calibration/calibration_loop.hpp"
 #include "calibration/campaign_evaluator.hpp"
+#include "calibration/sensitivity_study.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_params.hpp"
 
@@ -132,7 +133,9 @@ void add_sensitivity(CLI::App& app) {
                                                   "responses of mu_b and tau_c (seed Table 3.1)");
     cmd->add_option("base", o->base_file, "base material JSON")->required();
     cmd->add_option("--params", o->params, "parameters to vary (default: all micromechanical)")->delimiter(',');
-    cmd->add_option("--levels", o->levels, "values per parameter (>= 3; 5 lets a curvature be tested)")->capture_default_str();
+    cmd->add_option("--levels", o->levels, "values per parameter (>= 3; 5 lets a curvature be tested)")
+        ->check(integer_in(3, calibration::kMaxLevels))
+        ->capture_default_str();
     cmd->add_option("--span", o->span, "default range: base * (1 -+ span)")->capture_default_str();
     cmd->add_option("--range", o->ranges, "explicit range NAME=LOW:HIGH (repeatable)");
     cmd->add_option("--criterion", o->criterion, "shape selection: f-test or aicc")->capture_default_str();
@@ -217,7 +220,7 @@ void add_calibrate(CLI::App& app) {
     cmd->add_option("--grid-points", o->grid_points, "points per parameter (grid method)")->capture_default_str();
     cmd->add_option("--output,-o", o->output, "calibrated material JSON (default CAMPAIGN/calibrated_material.json; calibrated_material_<method>.json for the baselines)");
     cmd->add_option("--params", o->study.params, "study: parameters to vary")->delimiter(',');
-    cmd->add_option("--levels", o->study.levels, "study: values per parameter")->capture_default_str();
+    cmd->add_option("--levels", o->study.levels, "study: values per parameter")->check(integer_in(3, calibration::kMaxLevels))->capture_default_str();
     cmd->add_option("--span", o->study.span, "study: base * (1 -+ span)")->capture_default_str();
     cmd->add_option("--range", o->study.ranges, "study: explicit range NAME=LOW:HIGH");
     add_campaign_options(cmd, o->study.campaign);
@@ -245,9 +248,12 @@ void add_calibrate(CLI::App& app) {
             if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
             check_study(start, o->study);
         }
-        check_run_count(static_cast<double>(o->max_evaluations) * camp.normal_stresses.size() * camp.replicates,
-                        camp.exec.max_runs,
-                        "calibration: " + std::to_string(o->max_evaluations) + " evaluations x " +
+        // a grid evaluates all of itself: grid-points ^ controls, whatever --max-evaluations says
+        const double control_count = static_cast<double>(o->controls.empty() ? targets.size() : o->controls.size());
+        const double evaluations = options.method == SearchMethod::grid ? std::pow(double(o->grid_points), control_count)
+                                                                        : double(o->max_evaluations);
+        check_run_count(evaluations * camp.normal_stresses.size() * camp.replicates, camp.exec.max_runs,
+                        "calibration: " + analytics::number_text(evaluations, 10) + " evaluations x " +
                             std::to_string(camp.normal_stresses.size()) + " normal stresses x " +
                             std::to_string(camp.replicates) + " replicates");
         check_campaign(camp, start);

@@ -9,6 +9,7 @@
 #include "app/shear_report.hpp"
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_campaign.hpp"
 #include "orchestrator/shear_params.hpp"
 
 #include <cmath>
@@ -160,6 +161,11 @@ int run_crosscheck(const CrosscheckOptions& opt) {
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
+    try {  // both lines are the point: a design that cannot give them is refused before a run
+        analytics::check_failure_line_design(opt.normal_stresses, opt.replicates);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
     check_run_count(2.0 * static_cast<double>(opt.normal_stresses.size()) * opt.replicates, opt.exec.max_runs,
                     "crosscheck: 2 engines x " + std::to_string(opt.normal_stresses.size()) + " normal stresses x " +
                         std::to_string(opt.replicates) + " replicates");
@@ -264,7 +270,7 @@ void add_crosscheck_command(CLI::App& app) {
         ->delimiter(',')
         ->check(positive_number());
     shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress, the same seeds on both")
-        ->check(integer_in(1, 1000))
+        ->check(integer_in(1, orchestrator::kMaxReplicates))
         ->capture_default_str();
     shear->add_option("--seed", opt->seed, "first packing seed")
         ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));

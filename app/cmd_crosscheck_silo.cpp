@@ -45,6 +45,7 @@ struct SiloCrosscheckOptions {
     double timeout_s = 7200;
     std::string yade = "yade";
     std::string plot_format = "png";
+    long max_runs = 10000;
 };
 
 // The differences between the two codes' set-ups that YADE cannot remove (yade_scripts/README.md measures them).
@@ -161,10 +162,47 @@ void write_curve_plot(const fs::path& dir, double theta, const std::vector<Curve
     render_gnuplot(dir / ("mass_time." + format), s.str());
 }
 
+// The kernel run of one angle checked by `demcal silo --check` in this process (the very parser and checks the run
+// will meet), before the campaign folder exists: a setting the silo refuses (a material, a time limit, a particle
+// count) was found only once the runs had started. The output options are left out: their folders come later.
+void check_kernel_run(std::vector<std::string> argv, double theta) {
+    for (const char* option : {"--out", "--export-bed"}) {
+        const auto it = std::find(argv.begin(), argv.end(), option);
+        if (it != argv.end()) argv.erase(it, it + 2);
+    }
+    argv.erase(argv.begin());  // the program
+    argv.push_back("--check");
+    std::reverse(argv.begin(), argv.end());  // CLI11 takes the arguments last first
+    CLI::App app;
+    add_silo_command(app);
+    refuse_empty_values(app);
+    std::ostringstream quiet;  // "the settings are valid", once per angle: not news
+    auto* const previous = std::cout.rdbuf(quiet.rdbuf());
+    try {
+        app.parse(argv);
+        std::cout.rdbuf(previous);
+    } catch (const CLI::ParseError& e) {
+        std::cout.rdbuf(previous);
+        throw UserError("theta = " + g(theta) + ": the kernel run refuses its settings: " + e.what());
+    } catch (const std::exception& e) {
+        std::cout.rdbuf(previous);
+        throw UserError("theta = " + g(theta) + ": the kernel run refuses its settings: " + e.what());
+    }
+}
+
 int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
-    for (double t : o.thetas)
-        if (!(t > 0 && t < 90)) throw UserError("theta = " + g(t) + " deg must lie in (0, 90)");
     if (o.thetas.empty()) throw UserError("theta: give at least one cone half angle");
+    for (std::size_t i = 0; i < o.thetas.size(); ++i) {
+        const double t = o.thetas[i];
+        if (!(t > 0 && t < 90)) throw UserError("theta = " + g(t) + " deg must lie in (0, 90)");
+        // one folder per angle: a repeated angle would run twice into it
+        if (std::find(o.thetas.begin(), o.thetas.begin() + i, t) != o.thetas.begin() + i)
+            throw UserError("theta = " + g(t) + " deg is given twice");
+    }
+    orchestrator::check_run_count(2.0 * static_cast<double>(o.thetas.size()), o.max_runs,
+                                  "crosscheck silo: " + std::to_string(o.thetas.size()) + " angles x 2 codes");
+    if (!(o.tolerance > 0 && o.tolerance < 1)) throw UserError("tolerance = " + g(o.tolerance) + " must lie in (0, 1)");
+    check_output_folder(o.dir, "--campaign");
     const fs::path script = orchestrator::default_shear_template().parent_path() / "silo.py";
     const fs::path wrapper = orchestrator::default_shear_template().parent_path() / "run_clean.py";
     if (!fs::is_regular_file(script)) throw UserError("yade_scripts/silo.py not found at " + script.string());
@@ -180,7 +218,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
                             "has no JKR cohesion to match the kernel's; cross-check cohesionless materials");
     if (!o.geometry.empty()) analytics::read_json_input(o.geometry, "geometry");
     const json yade_material = o.yade_material.empty() ? json() : analytics::read_json_input(o.yade_material, "yade-material");
-    if (!(o.tolerance > 0 && o.tolerance < 1)) throw UserError("tolerance = " + g(o.tolerance) + " must lie in (0, 1)");
+    for (double theta : o.thetas) check_kernel_run(kernel_argv(o, theta, "out", "bed.json", self), theta);
     const fs::path root = fs::absolute(o.dir).lexically_normal();
     fs::create_directories(root);
     const std::string script_text = orchestrator::read_text_file(script);
@@ -359,6 +397,9 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
     silo->add_option("--timeout", o->timeout_s, "per-run wall-clock limit [s]")->check(positive_number());
     silo->add_option("--yade", o->yade, "YADE launcher");
     silo->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (a guard against typos)")
+        ->check(integer_in(1, 1000000000))
+        ->capture_default_str();
     silo->callback([o] {
         const int code = run_silo_crosscheck(*o);
         if (code != 0) throw CLI::RuntimeError(code);

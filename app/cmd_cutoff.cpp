@@ -5,12 +5,15 @@
 #include "app/commands.hpp"
 #include "app/silo_settings.hpp"
 #include "kernel/cases/cohesive_hopper.hpp"
+#include "analytics/number_text.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
+#include "orchestrator/shear_campaign.hpp"  // check_run_count
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -32,6 +35,7 @@ struct CutoffCli {
     double tol = 25;
     std::vector<long long> seeds{1};
     std::string json;
+    long max_runs = 10000;
     std::vector<std::string> silo_args;  // after --: the silo case (demcal silo's options) instead of the small hopper
 };
 
@@ -47,18 +51,36 @@ constexpr double kFlowingFraction = 0.5;
 
 std::pair<double, double> parse_bracket(const std::string& text) {
     const auto comma = text.find(',');
-    double lo = 0, hi = 0;
-    std::size_t used_lo = 0, used_hi = 0;
-    try {
-        if (comma == std::string::npos) throw std::invalid_argument("no comma");
-        lo = std::stod(text.substr(0, comma), &used_lo);
-        hi = std::stod(text.substr(comma + 1), &used_hi);
-    } catch (const std::exception&) {
-        used_lo = 0;
+    const std::string shown = "--bracket = '" + analytics::shortened_text(text, 40) + "'";
+    if (comma == std::string::npos) throw UserError(shown + ": give LO,HI in Hz, e.g. 0,400");
+    double ends[2];
+    const std::string parts[2] = {text.substr(0, comma), text.substr(comma + 1)};
+    for (int i = 0; i < 2; ++i) {  // the number rule of every option (a subnormal or NaN end was searched)
+        const auto n = analytics::read_typed_number(parts[i]);
+        if (!n.is_number) throw UserError(shown + ": give LO,HI in Hz, e.g. 0,400");
+        if (n.defect) throw UserError(shown + ": '" + analytics::shortened_text(parts[i], 40) + "' " + *n.defect);
+        ends[i] = n.value;
     }
-    if (used_lo == 0 || used_lo != comma || used_hi != text.size() - comma - 1)
-        throw UserError("--bracket = '" + text.substr(0, 40) + "': give LO,HI in Hz, e.g. 0,400");
-    return {lo, hi};
+    return {ends[0], ends[1]};
+}
+
+// Bisections that halve HI - LO down to the tolerance: below 2^-30 of the bracket the frequencies no longer differ
+// in any digit a run could resolve, and near 2^-52 the midpoint equals an end and the search never ends.
+constexpr int kMaxBisections = 30;
+
+// The runs the search may make (both ends, then every bisection, each with every seed), refused above --max-runs
+// before the first run; a tolerance finer than the bisection bound is refused by name.
+void check_search_size(const kc::CutoffSearch& s, long max_runs) {
+    const double width = s.hi - s.lo;
+    if (!(width > 0) || !(s.tol > 0) || s.tol >= width) return;  // kc::validate names these
+    if (s.tol < std::ldexp(width, -kMaxBisections))
+        throw UserError("--tol = " + analytics::number_text(s.tol) + " Hz: finer than 2^-" +
+                        std::to_string(kMaxBisections) + " of the bracket (" + analytics::number_text(width) +
+                        " Hz), more bisections than frequencies a run can tell apart");
+    const int bisections = static_cast<int>(std::ceil(std::log2(width / s.tol)));
+    orchestrator::check_run_count(static_cast<double>(2 + bisections) * s.seeds.size(), max_runs,
+                                  "cutoff: (2 ends + " + std::to_string(bisections) + " bisections) x " +
+                                      std::to_string(s.seeds.size()) + " seeds");
 }
 
 kc::CutoffSearch search_from(const CutoffCli& o) {
@@ -66,6 +88,11 @@ kc::CutoffSearch search_from(const CutoffCli& o) {
     std::tie(search.lo, search.hi) = parse_bracket(o.bracket);
     search.tol = o.tol;
     search.seeds.assign(o.seeds.begin(), o.seeds.end());
+    try {
+        check_search_size(search, o.max_runs);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
     return search;
 }
 
@@ -217,6 +244,9 @@ void add_cutoff_command(CLI::App& app) {
         ->check(number_in(0.05, 10))
         ->capture_default_str();
     sub->add_option("--json", o->json, "write the search and its runs to this JSON file");
+    sub->add_option("--max-runs", o->max_runs, "most runs the search may make (a guard against typos)")
+        ->check(integer_in(1, 1000000000))
+        ->capture_default_str();
     sub->add_option("silo_args", o->silo_args,
                     "after --: search in the silo case instead, with these demcal silo options (a cohesive --material, "
                     "--theta, --geometry, --particles, --stiffness-scale, ...)");

@@ -66,9 +66,9 @@ void check_scale(const nlohmann::json& base, const ScaleCli& o, const calibratio
     }
     calibration::check_enlargement(base, options);
     const auto& c = o.campaign;
-    const int lines = calibration::planned_failure_lines(options);
-    orchestrator::check_run_count(static_cast<double>(lines) * c.normal_stresses.size() * c.replicates, c.exec.max_runs,
-                                  "scale: at most " + std::to_string(lines) + " failure lines x " +
+    const double lines = calibration::planned_failure_lines(options);
+    orchestrator::check_run_count(lines * c.normal_stresses.size() * c.replicates, c.exec.max_runs,
+                                  "scale: at most " + analytics::number_text(lines, 10) + " failure lines x " +
                                       std::to_string(c.normal_stresses.size()) + " normal stresses x " +
                                       std::to_string(c.replicates) + " replicates");
     for (double r : o.radii) check_campaign(c, calibration::material_at_radius(base, r));
@@ -122,6 +122,7 @@ void add_scale_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--alpha", o->alpha, "significance of the F test of a trend's slope")->capture_default_str();
     cmd->add_option("--levels", o->levels, "study of E and nu at each radius: values per parameter")
+        ->check(integer_in(3, calibration::kMaxLevels))
         ->capture_default_str();
     cmd->add_option("--span", o->span, "study: base * (1 -+ span)")->capture_default_str();
     cmd->add_option("--range", o->ranges, "study: explicit range NAME=LOW:HIGH (young_modulus, poisson_ratio)");

@@ -158,7 +158,8 @@ void add_shear_commands(CLI::App& app) {
         ->required()
         ->delimiter(',')
         ->check(positive_number());
-    shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress (seeds seed, seed+1, ...)");
+    shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress (seeds seed, seed+1, ...)")
+        ->check(integer_in(1, orchestrator::kMaxReplicates));
     shear->add_option("--seed", opt->seed, "first packing seed")
         ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));
     shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<material name>)");

@@ -1,7 +1,9 @@
 // demcal shear-run PARAMS RESULT: one shear box on the kernel engine, as a campaign runs it (the orchestrator starts it
 // as a subprocess, so timeouts, kill -9, retries and SLURM hold exactly as for YADE). It speaks the YADE script's
-// protocol: params.json in, result.json (schema demcal.shear_result/1) written atomically, exit 2 with
+// protocol: params.json in, result.json (schema demcal.shear_result/2, sealed with its SHA-256 as
+// orchestrator/run_identity.hpp says) written atomically, exit 2 with
 // `DEMCAL_FAILURE params: ...` for bad parameters, exit 3 with `DEMCAL_FAILURE <cause>: ...` for a run that failed.
+#include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "analytics/user_input.hpp"
 #include "kernel/cases/shear_box.hpp"
@@ -68,7 +70,7 @@ ShearBoxParams to_kernel_params(const nlohmann::json& j) {
 }
 
 nlohmann::json to_json(const ShearBoxResult& r) {
-    return {{"schema", "demcal.shear_result/1"},
+    return {{"schema", orchestrator::kShearResultSchema},
             {"curve",
              {{"displacement", r.displacement},
               {"shear_stress", r.shear_stress},
@@ -111,6 +113,11 @@ void run(const std::string& params_path, const std::string& result_path, int thr
     } catch (const std::exception& e) {
         fail(2, "params", e.what());
     }
+    try {  // before the run, not after it: a result that cannot be written is a run wasted
+        check_output_file(result_path, "result");
+    } catch (const UserError& e) {
+        fail(2, "output", e.what());
+    }
     ShearBoxResult result;
     try {
         result = kernel::cases::run_shear_box(params, [](const std::string& line) { std::cout << line << std::endl; },
@@ -119,7 +126,8 @@ void run(const std::string& params_path, const std::string& result_path, int thr
         fail(e.cause == "params" ? 2 : 3, e.cause, e.what());
     }
     try {
-        orchestrator::write_text_file_atomically(result_path, to_json(result).dump(1) + "\n");
+        orchestrator::write_text_file_atomically(result_path,
+                                                 orchestrator::sealed_result_text(to_json(result).dump(1) + "\n"));
     } catch (const std::exception& e) {
         fail(3, "output", e.what());
     }
@@ -138,7 +146,7 @@ void add_shear_run_command(CLI::App& app) {
     cmd->add_option("params", opt->params, "params.json of the run (the YADE script's fields)");
     cmd->add_option("result", opt->result, "result.json to write");
     cmd->add_option("--threads", opt->threads, "OpenMP threads (the result does not depend on them)")
-        ->check(CLI::Range(1, 256));
+        ->check(integer_in(1, 256));
     cmd->callback([opt] { run(opt->params, opt->result, opt->threads); });
 }
 

@@ -8,6 +8,7 @@
 #include "app/silo_settings.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
+#include "kernel/silo/wheat.hpp"  // the Rayleigh step of the run size
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <nlohmann/json.hpp>
@@ -299,6 +300,34 @@ std::string vibration_text(const ks::SiloCaseSettings& s) {
            ks::setting_text(v.peak_acceleration() / s.gravity) + " g";
 }
 
+// Most time steps and VTK snapshots one run may take: 1e9 steps is about 300 times the seed's full 20 s discharge
+// (3.5e6 steps) and days of CPU even for a few hundred grains; 1e5 snapshots fill a disk. A smaller --dt or
+// --dt-fraction (1e-300 passed every range and the clock never visibly advanced) or --vtk-every is refused here, with
+// the count it would give, before anything is written.
+constexpr double kMaxSiloSteps = 1e9;
+constexpr double kMaxVtkSnapshots = 1e5;
+
+void check_run_size(const ks::SiloCaseSettings& s) {
+    double smallest_radius = 1;
+    for (const auto& sphere : ks::wheat_clump()) smallest_radius = std::min(smallest_radius, sphere.radius);
+    const double rayleigh = ks::rayleigh_time_step(s.materials.wheat_scaled(), smallest_radius);
+    const double dt = s.time_step > 0 ? s.time_step : s.time_step_fraction * rayleigh;
+    const double simulated = s.fill_time_max + s.max_time;
+    const double steps = simulated / dt;
+    if (!(steps <= kMaxSiloSteps)) {
+        const std::string given = s.time_step > 0 ? "--dt " + ks::setting_text(s.time_step) + " s"
+                                                  : "--dt-fraction " + ks::setting_text(s.time_step_fraction) +
+                                                        " (a time step of " + ks::setting_text(dt) + " s)";
+        throw UserError(given + " over --fill-time " + ks::setting_text(s.fill_time_max) + " s + --max-time " +
+                        ks::setting_text(s.max_time) + " s: " + ks::setting_text(steps) + " time steps, more than " +
+                        ks::setting_text(kMaxSiloSteps) + "; the run would not end");
+    }
+    if (!s.vtk_dir.empty() && !(simulated / s.vtk_interval <= kMaxVtkSnapshots))
+        throw UserError("--vtk-every " + ks::setting_text(s.vtk_interval) + " s: " +
+                        ks::setting_text(simulated / s.vtk_interval) + " snapshots, more than " +
+                        ks::setting_text(kMaxVtkSnapshots));
+}
+
 ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     check_session_options(o, sub);
     ks::SiloCaseSettings s;
@@ -329,6 +358,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
+    check_run_size(s);
     return s;
 }
 
@@ -451,6 +481,11 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
+    // every output place before the run (a run of hours into an unwritable folder failed at its end, and told the
+    // user to resume from a checkpoint it could never write): the output folder (results, plots, checkpoint), the
+    // VTK folder and the exported bed
+    check_output_folder(dir.string(), "--out");
+    if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk");
     if (!o.export_bed.empty()) {
         check_output_file(o.export_bed, "--export-bed");
         s.at_opening = [file = o.export_bed, settings = s](const ks::OpenedBed& bed) {
@@ -521,6 +556,9 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     } catch (const std::runtime_error& e) {
         throw UserError(e.what());
     }
+    // the results, the next checkpoints and the snapshots go where the run wrote before: still writable?
+    check_output_folder(dir.string(), "--resume");
+    if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "vtk (the run's snapshot folder, in its checkpoint)");
     s.threads = threads;
     s.checkpoint_file = file.string();  // removed once the outputs are written
     s.wall_limit = o.wall_limit;
@@ -745,6 +783,7 @@ ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options,
     CLI::App parser("the silo options of " + owner, "silo");
     SiloCli o;
     add_silo_options(&parser, o);
+    refuse_empty_values(parser);  // the number rule, as on demcal silo's own command line
     std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
     try {
         parser.parse(reversed);

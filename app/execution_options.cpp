@@ -16,7 +16,9 @@ void add_execution_options(CLI::App* cmd, orchestrator::ExecutionOptions& e) {
     e.kernel_engine = kernel::cases::kShearBoxEngine;
     cmd->add_option("--jobs,-j", e.jobs, "runs in parallel (0 = one per core)")->check(non_negative_number());
     cmd->add_option("--timeout", e.timeout_s, "per-run wall-clock limit [s]")->check(positive_number());
-    cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout")->check(non_negative_number());
+    // a crash that 100 attempts did not get past is the run's, not the machine's (1e9 retried one crash forever)
+    cmd->add_option("--retries", e.retries, "further attempts after a crash or timeout, at most 100")
+        ->check(integer_in(0, 100));
     cmd->add_option("--executor", e.executor, "local (process pool) or slurm (job arrays)")
         ->check(CLI::IsMember({"local", "slurm"}));
     cmd->add_option("--partition", e.slurm_partition, "SLURM partition (slurm executor)");

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     demcal::add_scale_command(app);
     demcal::refuse_empty_values(app);
     try {
+        demcal::check_argument_lengths(argc, argv);
         app.parse(argc, argv);
     } catch (const CLI::RuntimeError& e) {  // a command's own exit status (75: suspended, resume it)
         return app.exit(e);

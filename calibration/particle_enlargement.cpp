@@ -390,11 +390,11 @@ void check_enlargement(const nlohmann::json& base, const EnlargementOptions& o) 
     }
 }
 
-int planned_failure_lines(const EnlargementOptions& o) {
-    const int n = static_cast<int>(o.radii.size());
-    const int study = static_cast<int>(enlargement_controls().size()) * o.study.levels;
+double planned_failure_lines(const EnlargementOptions& o) {
+    const double n = static_cast<double>(o.radii.size());
+    const double study = static_cast<double>(enlargement_controls().size()) * o.study.levels;
     // base lines + per calibrated radius (study + search budget) + the verification at every radius
-    return n + (n - 1) * (study + o.calibration.max_evaluations) + n;
+    return n + (n - 1) * (study + static_cast<double>(o.calibration.max_evaluations)) + n;
 }
 
 EnlargementStudy run_enlargement_study(const nlohmann::json& base_in, const FailureLineEvaluator& evaluate_in,

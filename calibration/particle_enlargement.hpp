@@ -75,7 +75,7 @@ const std::vector<std::string>& enlargement_controls();
 // material, study levels and search bounds, the options. Throws std::invalid_argument naming the field and value.
 void check_enlargement(const nlohmann::json& base, const EnlargementOptions& options);
 // Most failure lines the study can evaluate (bases, studies, calibration budgets, verification), for --max-runs.
-int planned_failure_lines(const EnlargementOptions& options);
+double planned_failure_lines(const EnlargementOptions& options);  // a double: 2e9 evaluations overflowed an int
 
 struct RadiusBase {
     double radius = 0;

@@ -74,6 +74,9 @@ std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::st
     }
     if (options.levels < 3)
         throw std::invalid_argument("levels = " + std::to_string(options.levels) + " must be >= 3 to tell a shape");
+    if (options.levels > kMaxLevels)
+        throw std::invalid_argument("levels = " + std::to_string(options.levels) + " must be at most " +
+                                    std::to_string(kMaxLevels) + " (1 % of the span apart)");
     if (!(options.relative_span > 0 && options.relative_span < 1))
         throw std::invalid_argument("span = " + number_text(options.relative_span) + " must be in (0, 1)");
     const auto& spec = *orchestrator::find_shear_param(name);

@@ -13,6 +13,11 @@
 
 namespace demcal::calibration {
 
+// Most values per parameter a sensitivity study may take: the response shapes are at most quadratic (5 levels let a
+// curvature be tested), so 101 levels (1 % of the span apart) resolve any shape the fits can tell; more is a typo
+// (2e9 levels planned billions of runs). Refused by name (--levels) before any work.
+inline constexpr int kMaxLevels = 101;
+
 struct SensitivityOptions {
     std::vector<std::string> params;  // parameters to vary; empty = all micromechanical ones (orchestrator's list)
     int levels = 5;                   // values per parameter, base included when odd (>= 3)

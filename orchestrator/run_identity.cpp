@@ -29,6 +29,34 @@ std::string sha256_hex(const std::string& bytes) {
 }
 
 namespace {
+const std::string kSealHead = "{\"sha256\": \"";
+const std::string kSealTail = "\", ";
+constexpr std::size_t kHexDigits = 64;
+}  // namespace
+
+std::string sealed_result_text(const std::string& body) {
+    if (body.empty() || body.front() != '{') throw std::invalid_argument("a result to seal must be a JSON object");
+    return kSealHead + sha256_hex(body) + kSealTail + body.substr(1);
+}
+
+bool has_result_seal(const std::string& text) { return text.compare(0, kSealHead.size(), kSealHead) == 0; }
+
+std::string unsealed_result_text(const std::string& text) {
+    if (!has_result_seal(text)) return text;
+    const std::size_t after = kSealHead.size() + kHexDigits + kSealTail.size();
+    if (text.size() < after || text.compare(kSealHead.size() + kHexDigits, kSealTail.size(), kSealTail) != 0)
+        throw DamagedResult("its seal {\"sha256\": ...} is damaged");
+    const std::string recorded = text.substr(kSealHead.size(), kHexDigits);
+    std::string body(1, '{');
+    body.append(text, after, std::string::npos);
+    const std::string actual = sha256_hex(body);
+    if (actual != recorded)
+        throw DamagedResult("its text does not match its SHA-256 (sealed " + recorded.substr(0, 12) + "..., the text " +
+                            actual.substr(0, 12) + "...): damaged or truncated after it was written");
+    return body;
+}
+
+namespace {
 // The same number written 30000 in one material file and 30000.0 by a computed level (a double) is one run:
 // integral doubles become integers before hashing (measured: a sensitivity study re-ran its base failure line
 // for every parameter whose file value was an integer).

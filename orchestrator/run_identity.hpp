@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 namespace demcal::orchestrator {
@@ -13,6 +14,28 @@ std::string sha256_hex(const std::string& bytes);
 // Canonical form: nlohmann's dump sorts object keys, numbers print in shortest round-trip form, and an integral
 // double counts as the integer (30000.0 and 30000 are one run).
 std::string run_identity(const std::string& template_text, const nlohmann::json& params);
+
+// result.json of a shear run (schema demcal.shear_result/2) is sealed with the SHA-256 of its own text, so that a
+// file damaged after its atomic write (a flipped byte, a truncated copy) is found when the orchestrator reads it. The
+// rule, the same for every writer (yade_scripts/shear_box.py's write_result_atomically, demcal shear-run): BODY is the
+// result's JSON object as the writer serialises it, with its final newline; the file is
+//     {"sha256": "<64 lowercase hex digits of SHA-256(BODY)>", <BODY without its opening brace>
+// which is JSON again (one more key). A reader takes BODY back as "{" + everything after the seal and compares.
+inline constexpr const char* kShearResultSchema = "demcal.shear_result/2";
+
+// A result file whose seal is missing (where its schema needs one) or does not match its text.
+struct DamagedResult : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// BODY (a JSON object's text, from its '{') -> the sealed file text.
+std::string sealed_result_text(const std::string& body);
+
+// The sealed file text -> BODY, checked. A text without a seal is returned as it is (results of schema
+// demcal.shear_result/1, from templates older than the seal, had none); its schema is the caller's to check.
+// Throws DamagedResult when the seal does not match.
+std::string unsealed_result_text(const std::string& text);
+bool has_result_seal(const std::string& text);
 
 std::string read_text_file(const std::filesystem::path& p);
 // Writes via a temporary file and rename, so a reader (or a crash) never sees half a file.

@@ -240,8 +240,9 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
     for (double s : spec.normal_stresses)
         if (!(s > 0) || !std::isfinite(s))
             throw std::invalid_argument("normal_stress = " + std::to_string(s) + " Pa must be positive");
-    if (spec.replicates < 1)
-        throw std::invalid_argument("replicates = " + std::to_string(spec.replicates) + " must be at least 1");
+    if (spec.replicates < 1 || spec.replicates > kMaxReplicates)
+        throw std::invalid_argument("replicates = " + std::to_string(spec.replicates) + " must be between 1 and " +
+                                    std::to_string(kMaxReplicates));
     if (spec.base_seed < 0) throw std::invalid_argument("seed = " + std::to_string(spec.base_seed) + " must be >= 0");
     // every run's own fields in their ranges (each stress, the last replicate's seed), before anything is written
     const nlohmann::json material = validate_material(spec.material);
@@ -251,14 +252,29 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
         throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");
 }
 
+nlohmann::json read_shear_result(const fs::path& file) {
+    const std::string what = "result = '" + file.string() + "'";
+    const std::string text = analytics::read_input_file(file, what, analytics::kMaxJsonInputBytes);
+    const bool sealed = has_result_seal(text);
+    nlohmann::json result = analytics::parse_json_text(unsealed_result_text(text), what);
+    if (!result.is_object()) throw std::invalid_argument(what + ": not a JSON object");
+    const std::string schema = result.value("schema", std::string());
+    // a schema that needs the seal, without it: the seal itself was hit (or the file is not a demcal result)
+    if (!sealed && schema != "demcal.shear_result/1")
+        throw DamagedResult(what + ": schema " + analytics::shortened_text(schema.empty() ? "(none)" : schema) +
+                            " without its SHA-256 seal: damaged or not a demcal result");
+    if (!result.contains("peak_shear_stress") || !result["peak_shear_stress"].is_number())
+        throw std::invalid_argument(what + ": no number 'peak_shear_stress'");
+    return result;
+}
+
 namespace {
-// The result a run left in its directory, if it is a usable one.
+// The result a run left in its directory, if it is a usable one (a damaged one is not: the run is run again).
 std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
     const fs::path file = run_dir / "result.json";
     if (!fs::exists(file)) return std::nullopt;
     try {
-        auto result = analytics::read_json_input(file, "result");
-        if (result.contains("peak_shear_stress") && result["peak_shear_stress"].is_number()) return result;
+        return read_shear_result(file);
     } catch (const std::exception&) {
     }
     return std::nullopt;
@@ -267,7 +283,11 @@ std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
 
 ShearCampaignRunner::ShearCampaignRunner(const fs::path& dir, ExecutionOptions options)
     : dir_(fs::absolute(dir).lexically_normal()), options_(std::move(options)) {
-    fs::create_directories(dir_);
+    std::error_code ec;
+    fs::create_directories(dir_, ec);  // the first thing a campaign writes: a folder it cannot make is bad input
+    if (ec || !fs::is_directory(dir_))
+        throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +
+                                    "': cannot create the campaign folder" + (ec ? ": " + ec.message() : std::string()));
     const fs::path lock = dir_ / ".lock";
     // O_CLOEXEC: YADE children must not inherit the lock, or a resume right after kill -9 of the orchestrator finds
     // the directory "in use" until the last orphan has died.
@@ -383,9 +403,11 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         nlohmann::json result;
         if (o.succeeded()) {
             try {
-                result = analytics::read_json_input(job.dir / "result.json", "result");
-                if (!result.contains("peak_shear_stress") || !result["peak_shear_stress"].is_number())
-                    throw std::runtime_error("no number 'peak_shear_stress'");
+                result = read_shear_result(job.dir / "result.json");
+            } catch (const DamagedResult& e) {
+                // damaged between its write and this read (disk, copy): not the run's physics, so run it again
+                cause = kDamagedResult;
+                message = std::string("exit code 0 but result.json is damaged: ") + e.what();
             } catch (const std::exception& e) {
                 cause = "no_result";
                 message = std::string("exit code 0 but result.json is unusable: ") + e.what();

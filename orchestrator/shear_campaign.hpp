@@ -55,9 +55,22 @@ struct ExecutionOptions {
     std::string kernel_engine;
 };
 
+// Most packings per normal stress a campaign may ask for: the interval of a failure line narrows as 1/sqrt(n), so
+// 1000 replicates already put it at 3 % of one packing's scatter, below the box's own systematic error; more is a
+// typo (a replicate count of 2e9 planned millions of runs per stress). Refused by name (--replicates) before any work.
+inline constexpr int kMaxReplicates = 1000;
+
 // Refuses a plan of more than `max_runs` simulations before anything is planned or written; `breakdown` says how
 // the count came about ("3 normal stresses x 1000 replicates"). Counts as double: the product may overflow an int.
 void check_run_count(double runs, long max_runs, const std::string& breakdown);
+
+// The failure cause of a run whose result.json fails its SHA-256 seal: retried (up to --retries), never a result.
+inline constexpr const char* kDamagedResult = "damaged_result";
+
+// A run's result.json, read under the input rules and checked against its seal (run_identity.hpp: a file of schema
+// demcal.shear_result/2 must carry a matching one; /1, from older templates, has none) and for a number
+// peak_shear_stress. Throws DamagedResult for a damaged file, std::invalid_argument for one that is not a result.
+nlohmann::json read_shear_result(const std::filesystem::path& file);
 
 struct CampaignProgress {
     int total = 0, done = 0, failed = 0, running = 0, pending = 0, reused = 0;

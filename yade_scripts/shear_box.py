@@ -10,10 +10,11 @@ Sequence (the thesis' modified Jenike cell, seed section 2.2.1):
   4. the upper frame (four walls, its flange and the lid) is driven along x at shear_velocity up to
      shear_displacement while the lid keeps the normal stress; shear stress vs displacement is sampled.
 
-Output: result.json (schema demcal.shear_result/1), written atomically. Failures: exit 3 and one line
+Output: result.json (schema demcal.shear_result/2, sealed with its SHA-256), written atomically. Failures: exit 3 and one line
 `DEMCAL_FAILURE <cause>: <details>` on stderr; bad params: exit 2 with `DEMCAL_FAILURE params: ...`.
 Every parameter is documented in PARAM_SPECS below and in yade_scripts/README.md.
 """
+import hashlib
 import json
 import math
 import os
@@ -25,7 +26,7 @@ from yade import pack, utils
 
 WALL_CLOCK_START = time.time()
 
-SCHEMA = "demcal.shear_result/1"
+SCHEMA = "demcal.shear_result/2"
 
 # name: (unit, kind, lower bound, lower bound inclusive, upper bound, upper bound inclusive, meaning)
 PARAM_SPECS = {
@@ -177,11 +178,17 @@ def random_unit_vector(rng):
             return v / norm
 
 
+def sealed_result_text(result):
+    """The result's JSON with its SHA-256 seal, by the rule of orchestrator/run_identity.hpp (demcal shear-run follows
+    it too): BODY is the object's text with its final newline, the file {"sha256": "<hex of BODY>", + BODY[1:]."""
+    body = json.dumps(result, indent=1) + "\n"
+    return '{"sha256": "%s", ' % hashlib.sha256(body.encode("utf-8")).hexdigest() + body[1:]
+
+
 def write_result_atomically(path, result):
     tmp = path + ".tmp%d" % os.getpid()
     with open(tmp, "w") as f:
-        json.dump(result, f, indent=1)
-        f.write("\n")
+        f.write(sealed_result_text(result))
         f.flush()
         os.fsync(f.fileno())
     os.replace(tmp, path)

@@ -89,7 +89,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --rect --outlet -1", "a (outlet width) = -1"},
                           Case{"--theta 30 --seed -1", "seed = -1"},
                           Case{"--theta 30 --a 0.02", "--a = 0.02: applies to a rectangular hopper"},
-                          Case{"--theta 30 --checkpoint-every nan", "checkpoint-every = nan"},
+                          Case{"--theta 30 --checkpoint-every nan", "--checkpoint-every: 'nan' is not a number"},
                           Case{"--theta 30 --wall-limit -5", "wall-limit = -5"},
                           Case{"--theta 30 --vtk /dev/null/x", "vtk = '/dev/null/x'"},
                           Case{"--theta 30 --vtk-every 0.1", "--vtk-every applies to the VTK snapshots"},
@@ -108,13 +108,13 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --vibration-frequency -5 --vibration-amplitude 1e-4",
                                "vibration_frequency = -5"},
                           Case{"--theta 30 --vibration-frequency inf --vibration-amplitude 1e-4",
-                               "vibration_frequency = inf"},
+                               "--vibration-frequency: 'inf' is not finite"},
                           Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 0.05",
                                "vibration_amplitude = 0.05"},
                           Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude nan",
-                               "vibration_amplitude = nan"},
+                               "--vibration-amplitude: 'nan' is not a number"},
                           Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-310",
-                               "vibration_amplitude = 1e-310: a subnormal"},
+                               "--vibration-amplitude: '1e-310' is subnormal"},
                           Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-4 --vibration-direction y",
                                "vibration-direction = 'y'"},
                           Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-4 --vibration-start -1",
@@ -123,7 +123,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                                "--stiffness-scale 0.001",
                                "vibration_frequency = 1000: a period is only"},
                           // the command-line parser's own refusals exit 2 as well
-                          Case{"--theta abc", "--theta = abc"},
+                          Case{"--theta abc", "--theta: 'abc' is not a number"},
                           Case{"--theta 30 --thetaa 3", "not expected"}}) {
         INFO(c.args);
         const Run r = run_silo(c.args + " --out '" + out.string() + "'", dir);

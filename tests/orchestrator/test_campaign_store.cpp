@@ -65,15 +65,26 @@ TEST_CASE("a run that wrote its result just before the orchestrator died is kept
     {
         CampaignStore s(d / "campaign.sqlite");
         cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
-        for (const std::string h : {"finished", "unfinished", "garbled"}) {
+        for (const std::string h : {"finished", "unfinished", "garbled", "flipped", "unsealed", "legacy"}) {
             fs::create_directories(d / "runs" / h);
             s.ensure_run(cid, h, {{"normal_stress", 1e4}}, d / "runs" / h, {{"replicate", 0}});
             s.mark_running(h, 999999, 999999, "local");  // no such process group: the orchestrator died with it
         }
     }
-    demcal::orchestrator::write_text_file_atomically(d / "runs/finished/result.json",
-                                                     R"({"peak_shear_stress": 4321.0, "wall_time_s": 17.5})");
-    demcal::orchestrator::write_text_file_atomically(d / "runs/garbled/result.json", R"({"peak_shear_st)");
+    using demcal::orchestrator::sealed_result_text;
+    using demcal::orchestrator::write_text_file_atomically;
+    const std::string body =
+        R"({"schema": "demcal.shear_result/2", "peak_shear_stress": 4321.0, "wall_time_s": 17.5})" "\n";
+    write_text_file_atomically(d / "runs/finished/result.json", sealed_result_text(body));
+    write_text_file_atomically(d / "runs/garbled/result.json", R"({"peak_shear_st)");
+    // one digit changed after the write (4321.0 -> 4821.0): still JSON, still a number, caught by the seal
+    std::string flipped = sealed_result_text(body);
+    flipped[flipped.find("4321") + 1] = '8';
+    write_text_file_atomically(d / "runs/flipped/result.json", flipped);
+    write_text_file_atomically(d / "runs/unsealed/result.json", body);  // schema /2 without its seal
+    // a result of a template older than the seal (schema /1) is still read
+    write_text_file_atomically(d / "runs/legacy/result.json",
+                               R"({"schema": "demcal.shear_result/1", "peak_shear_stress": 1234.0})");
     { ShearCampaignRunner reopened(d, ExecutionOptions{}); }
     CampaignStore s(d / "campaign.sqlite");
     const auto finished = s.run("finished");
@@ -83,6 +94,9 @@ TEST_CASE("a run that wrote its result just before the orchestrator died is kept
     CHECK(finished->wall_s == 17.5);
     CHECK(s.run("unfinished")->state == RunState::pending);
     CHECK(s.run("garbled")->state == RunState::pending);  // a partial file is not a result
+    CHECK(s.run("flipped")->state == RunState::pending);  // nor a damaged one: it is run again
+    CHECK(s.run("unsealed")->state == RunState::pending);
+    CHECK(s.run("legacy")->state == RunState::done);
     fs::remove_all(d);
 }
 

@@ -44,9 +44,13 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
          "the folder /no/such/folder does not exist"},
         // limits, named with the flag that lifts them (an absurd level count started millions of runs)
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", "2000000000"},
-         "levels x 2 normal stresses x 1 replicates = 3.2e+10 simulations, more than the limit --max-runs = 10000"},
-        {{"shear", tiny, "-s", "5e3,1e4", "-r", "6000"}, "shear: 2 normal stresses x 6000 replicates = 12000"},
-        {{"shear", tiny, "-s", "5e3,1e4", "-r", "6000", "--max-runs", "1e9"}, "--max-runs: '1e9' is not an integer"},
+         "--levels: '2000000000' is not an integer between 3 and 101"},
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", "101", "-r", "1000", "--params", "friction_coefficient"},
+         "1 parameters x 101 levels x 2 normal stresses x 1000 replicates = 202000 simulations, more than the limit "
+         "--max-runs = 10000"},
+        {{"shear", tiny, "-s", "5e3,1e4", "-r", "600", "--max-runs", "1000"},
+         "shear: 2 normal stresses x 600 replicates = 1200"},
+        {{"shear", tiny, "-s", "5e3,1e4", "-r", "600", "--max-runs", "1e9"}, "--max-runs: '1e9' is not an integer"},
         // a negative cohesion target or negative measured stresses were calibrated against
         {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800 must be >= 0"},
         {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
@@ -200,9 +204,11 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
     const fs::path campaign = dir / "campaign";
     // executable, but its interpreter does not exist: execvp fails, as for a launcher of a broken installation
     std::ofstream(dir / "broken-yade") << "#!/nonexistent/interpreter\n";
-    // a stand-in simulator: writes the result file named by its last argument
+    // a stand-in simulator: writes the result file named by its last argument (schema /1: a template older than the
+    // result's seal, still read)
     std::ofstream(dir / "stand-in-yade") << "#!/bin/sh\nfor last; do :; done\n"
-                                            "echo '{\"peak_shear_stress\": 1000, \"residual_shear_stress\": 800}' > "
+                                            "echo '{\"schema\": \"demcal.shear_result/1\", \"peak_shear_stress\": 1000, "
+                                            "\"residual_shear_stress\": 800}' > "
                                             "\"$last\"\n";
     fs::permissions(dir / "broken-yade", fs::perms::owner_all);
     fs::permissions(dir / "stand-in-yade", fs::perms::owner_all);

@@ -1,8 +1,11 @@
-// Fuzz tests of the orchestrator's readers: material JSON and the campaign store file. Every seeded mutation of a
-// valid file is either read or refused with std::invalid_argument (exit code 2); anything else fails.
+// Fuzz tests of the orchestrator's readers: material JSON, the campaign store file and a run's result.json. Every
+// seeded mutation of a valid file is either read or refused with std::invalid_argument (exit code 2) or, for a result,
+// as damaged (the run is run again); anything else fails.
 #include "analytics/user_input.hpp"
 #include "fuzz_mutations.hpp"
 #include "orchestrator/campaign_store.hpp"
+#include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_campaign.hpp"
 #include "orchestrator/shear_params.hpp"
 #include "test_files.hpp"
 
@@ -78,4 +81,36 @@ TEST_CASE("fuzz: a damaged campaign store is refused or read, never crashes", "[
     INFO(opened << " opened (" << read_errors << " refused while reading), " << refused << " refused");
     CHECK(refused > 0);
     fs::remove_all(dir);
+}
+
+TEST_CASE("fuzz: a damaged shear result is refused or read whole, never taken for another result", "[fuzz][input]") {
+    // a sealed result as demcal shear-run and shear_box.py write it (schema demcal.shear_result/2)
+    nlohmann::json result = {{"schema", orchestrator::kShearResultSchema},
+                             {"curve", {{"displacement", {0.0, 1e-4, 2e-4}}, {"shear_stress", {0.0, 2100.5, 3300.25}}}},
+                             {"peak_shear_stress", 3300.25},
+                             {"residual_shear_stress", 2950.0},
+                             {"wall_time_s", 12.5}};
+    const std::string valid = orchestrator::sealed_result_text(result.dump(1) + "\n");
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-fuzz-result-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    int same = 0, refused = 0;
+    for (std::uint32_t seed = 1; seed <= 2000; ++seed) {
+        const std::string text = test::mutated(valid, seed);
+        orchestrator::write_text_file_atomically(dir / "result.json", text);
+        try {
+            const auto read = orchestrator::read_shear_result(dir / "result.json");
+            // read only when nothing that counts changed (a cut at the very end is no cut)
+            CHECK(read == result);
+            ++same;
+        } catch (const std::invalid_argument&) {
+            ++refused;
+        } catch (const orchestrator::DamagedResult&) {
+            ++refused;
+        } catch (const std::exception& e) {
+            FAIL("seed " << seed << ": " << e.what());
+        }
+    }
+    fs::remove_all(dir);
+    INFO(same << " read unchanged, " << refused << " refused");
+    CHECK(refused > 1900);
 }

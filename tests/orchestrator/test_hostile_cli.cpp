@@ -1,0 +1,265 @@
+// Regression tests of the hostile-input sweep (scripts/hostile_sweep.sh) over the commands added since the last
+// hardening pass: one case or more per defect class it found, each through the real demcal binary, each asserting
+// exit 2, the option or field and the value named, a short message, and no file written where the command writes.
+// None of them starts a simulation (each takes well under a second).
+#include "campaign_test_support.hpp"
+#include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_campaign.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace demcal;
+using Catch::Matchers::Contains;
+
+namespace {
+
+// Every file and folder below `dir`, with its size: the before/after listing of a refused command.
+std::vector<std::string> listing(const fs::path& dir) {
+    std::vector<std::string> out;
+    if (!fs::exists(dir)) return out;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        out.push_back(e.path().string() + (e.is_regular_file() ? " " + std::to_string(e.file_size()) : "/"));
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+struct Case {
+    std::vector<std::string> args;
+    std::vector<std::string> expect;  // every one must be in the message
+};
+
+void refused(const std::vector<Case>& cases, const fs::path& dir) {
+    for (const auto& c : cases) {
+        INFO(c.args[0] + " " + (c.args.size() > 1 ? c.args[1] : "") + " ... expecting " + c.expect.front());
+        const auto before = listing(dir);
+        const int rc = test::run_demcal(c.args, dir.parent_path() / "hostile.log");
+        const std::string log = test::read_file(dir.parent_path() / "hostile.log");
+        INFO(log.substr(0, 2000));
+        CHECK(rc == 2);
+        for (const auto& e : c.expect) CHECK_THAT(log, Contains(e));
+        CHECK(log.size() < 2000);  // one message, the value shortened
+        CHECK(listing(dir) == before);
+    }
+}
+
+}  // namespace
+
+TEST_CASE("every number and integer option follows the number rule, whatever its command checks", "[cli]") {
+    // options registered without a check of their own let NaN, subnormals and 1e308 through to the run
+    const fs::path root = test::fresh_test_dir("hostile-numbers"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "camp").string();
+    refused({{{"scale", tiny, "--dir", camp, "-s", "5e3,1e4", "--radii", "1e-3,1.5e-3,2e-3", "--alpha", "1e-320"},
+              {"--alpha", "'1e-320' is subnormal"}},
+             {{"scale", tiny, "--dir", camp, "-s", "5e3,1e4", "--radii", "1e-3,1.5e-3,2e-3", "--span", "1e308"},
+              {"--span", "'1e308' is implausibly large"}},
+             {{"sensitivity", tiny, "--campaign", camp, "-s", "5e3,1e4", "--span", "nan"}, {"--span", "'nan' is not a number"}},
+             {{"silo", "--theta", "30", "--out", camp, "--dt", "1e-320"}, {"--dt", "'1e-320' is subnormal"}},
+             {{"silo", "--theta", "30", "--out", camp, "--vibration-start", "nan", "--vibration-frequency", "50",
+               "--vibration-amplitude", "1e-4"},
+              {"--vibration-start", "'nan' is not a number"}},
+             {{"shear-run", "p.json", "r.json", "--threads", "nan"}, {"--threads", "'nan' is not an integer"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("an argument longer than any path or list is refused with the option named and the value shortened",
+          "[cli]") {
+    // CLI11 echoed a 100 kB value in full in its own conversion and membership messages
+    const fs::path root = test::fresh_test_dir("hostile-long"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string long_number(10000, '7'), long_word(10000, 'x');
+    refused({{{"cutoff", "--bond-number", long_number}, {"--bond-number", "longer than 4096 characters", "(10000 characters)"}},
+             {{"shear", tiny, "-s", "5e3,1e4", "--engine", long_word, "--campaign", (dir / "c").string()},
+              {"--engine", "longer than 4096"}},
+             {{"shear-run", long_word, "r.json"}, {"argument 2", "longer than 4096"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("output paths are tried for real before any work: a folder nobody can create files in is refused",
+          "[cli]") {
+    // access(2) told root that /proc is writable: the run went ahead and failed at its end
+    const fs::path root = test::fresh_test_dir("hostile-outputs"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string params = (dir / "params.json").string();
+    {
+        nlohmann::json p = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
+        for (auto it = p.begin(); it != p.end();) it = it.key().rfind('_', 0) == 0 ? p.erase(it) : std::next(it);
+        p["normal_stress"] = 5e3;
+        p["seed"] = 1;
+        std::ofstream(params) << p.dump();
+    }
+    refused({{{"cutoff", "--bond-number", "10", "--json", "/proc/cutoff.json"},
+              {"--json = '/proc/cutoff.json'", "the folder /proc is not writable"}},
+             // the kernel engine's run: the result's place is checked before the shear box runs (exit 2, not 3)
+             {{"shear-run", params, "/proc/result.json"}, {"DEMCAL_FAILURE output", "result = '/proc/result.json'"}},
+             {{"shear-run", params, dir.string()}, {"DEMCAL_FAILURE output", "is a folder"}},
+             // the silo's output folder, VTK folder and exported bed, before the filling starts
+             {{"silo", "--theta", "30", "--particles", "200", "--out", "/proc/silo-out"},
+              {"--out = '/proc/silo-out'", "/proc is not writable"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", (dir / "o").string(), "--vtk", "/proc/vtk"},
+              {"--vtk = '/proc/vtk'", "not writable"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", params}, {"--out", "is a file, not a folder"}},
+             {{"silo", "--resume", "/proc"}, {"resume"}},
+             // a campaign folder that cannot be made was a filesystem error with exit 1
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4",
+               "--engine", "kernel", "--campaign", "/proc/campaign"},
+              {"campaign = '/proc/campaign': cannot create the campaign folder"}},
+             {{"crosscheck", "silo", "--theta", "30", "--campaign", "/proc/xsilo"},
+              {"--campaign = '/proc/xsilo'", "not writable"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("silo: a time step that never lets the run end, or a snapshot every step, is refused before it starts",
+          "[cli]") {
+    // --dt-fraction 1e-300 passed every range and filled at t = 0.000 s for ever
+    const fs::path root = test::fresh_test_dir("hostile-silo-size"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string out = (dir / "o").string();
+    refused({{{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt-fraction", "1e-300"},
+              {"--dt-fraction 1e-300", "time steps, more than 1e+09; the run would not end"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt", "1e-300"},
+              {"--dt 1e-300 s over --fill-time 2.1 s + --max-time 20 s"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--vtk", (dir / "v").string(), "--vtk-every",
+               "1e-300"},
+              {"--vtk-every 1e-300 s", "snapshots, more than 100000"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("cutoff: a search that could not end or would start too many runs is refused before the first run",
+          "[cli]") {
+    // --tol 1e-300 bisected until the midpoint equalled an end, then forever; 20000 seeds started 120000 runs
+    const fs::path root = test::fresh_test_dir("hostile-cutoff"), dir = root / "work";
+    fs::create_directories(dir);
+    std::string seeds;
+    for (int i = 1; i <= 800; ++i) seeds += (i > 1 ? "," : "") + std::to_string(i);
+    refused({{{"cutoff", "--bond-number", "10", "--tol", "1e-300"}, {"--tol = 1e-300 Hz", "finer than 2^-30"}},
+             {{"cutoff", "--bond-number", "10", "--seeds", seeds, "--max-runs", "1000"},
+              {"cutoff: (2 ends + 4 bisections) x 800 seeds = 4800 simulations", "--max-runs = 1000"}},
+             {{"cutoff", "--bond-number", "10", "--bracket", "nan,400"}, {"--bracket = 'nan,400'", "'nan' is not a number"}},
+             {{"cutoff", "--bond-number", "10", "--bracket", "1e-320,400"}, {"--bracket", "'1e-320' is subnormal"}},
+             {{"cutoff", "--bond-number", "10", "--bracket", "0,1e308"}, {"--bracket", "'1e308' is implausibly large"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("crosscheck silo: repeated angles, too many angles and settings the kernel run refuses, before any folder",
+          "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-xsilo"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string camp = (dir / "camp").string();
+    const std::string shear_material = test::source_path("examples/materials/sand-tiny.json").string();
+    refused({{{"crosscheck", "silo", "--theta", "30,30", "--campaign", camp}, {"theta = 30 deg is given twice"}},
+             {{"crosscheck", "silo", "--theta", "10,20,30", "--max-runs", "4", "--campaign", camp},
+              {"crosscheck silo: 3 angles x 2 codes = 6 simulations", "--max-runs = 4"}},
+             {{"crosscheck", "silo", "--theta", "1e-320", "--campaign", camp}, {"--theta", "subnormal"}},
+             // a setting only the silo run checks (its run size): found before the campaign began, not by its runs
+             {{"crosscheck", "silo", "--theta", "30", "--max-time", "1e99", "--campaign", camp},
+              {"theta = 30: the kernel run refuses its settings", "--max-time 1e+99 s", "the run would not end"}},
+             // a shear material given as the silo's
+             {{"crosscheck", "silo", "--theta", "30", "--material", shear_material, "--campaign", camp},
+              {"unknown key 'bond_normal_strength'"}}},
+            dir);
+    CHECK_FALSE(fs::exists(camp));
+    fs::remove_all(root);
+}
+
+TEST_CASE("levels and replicates have their own caps, named, below the total --max-runs", "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-caps"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "camp").string();
+    // a run count within a raised --max-runs is still refused for its absurd level or replicate count
+    refused({{{"shear", tiny, "-s", "5e3,1e4", "-r", "1001", "--max-runs", "1000000", "--campaign", camp},
+              {"--replicates: '1001' is not an integer between 1 and 1000"}},
+             {{"crosscheck", "shear", tiny, "-s", "5e3,1e4", "-r", "5000", "--campaign", camp},
+              {"--replicates: '5000' is not an integer between 1 and 1000"}},
+             {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", "102", "--max-runs", "1000000", "--campaign", camp},
+              {"--levels: '102' is not an integer between 3 and 101"}},
+             {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--levels", "1000", "--campaign", camp},
+              {"--levels: '1000' is not an integer between 3 and 101"}},
+             {{"scale", tiny, "--radii", "1e-3,1.5e-3,2e-3", "-s", "5e3,1e4", "--levels", "500", "--dir", camp},
+              {"--levels: '500' is not an integer between 3 and 101"}},
+             // a deterministic crash was retried as often as asked (1e9)
+             {{"shear", tiny, "-s", "5e3,1e4", "--retries", "1000000000", "--campaign", camp},
+              {"--retries: '1000000000' is not an integer between 0 and 100"}},
+             // a design whose line cannot be fitted ran its runs first (crosscheck shear with one stress)
+             {{"crosscheck", "shear", tiny, "-s", "5e3,5e3", "-r", "3", "--campaign", camp},
+              {"normal-stress: a failure line needs at least 2 distinct normal stresses, got 1"}},
+             {{"crosscheck", "shear", tiny, "-s", "5e3,1e4", "-r", "1", "--campaign", camp},
+              {"replicates = 1 at 2 normal stresses: a failure line needs at least 3 points"}},
+             // 2e9 evaluations overflowed scale's int count of failure lines, which then passed --max-runs
+             {{"scale", tiny, "--radii", "1e-3,1.5e-3,2e-3", "-s", "5e3,1e4,2e4", "--max-evaluations", "2000000000",
+               "--dir", camp},
+              {"scale: at most", "failure lines", "more than the limit --max-runs = 10000"}},
+             // a grid evaluates points^controls, whatever --max-evaluations says
+             {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--method", "grid", "--grid-points",
+               "1000", "-s", "5e3,1e4,2e4", "--campaign", camp},
+              {"calibration: 1000000 evaluations", "--max-runs = 10000"}}},
+            dir);
+    CHECK(orchestrator::kMaxReplicates == 1000);
+    fs::remove_all(root);
+}
+
+TEST_CASE("a shear result's seal: both writers follow one rule, and a flipped byte or a cut is caught", "[cli]") {
+    using orchestrator::DamagedResult;
+    using orchestrator::sealed_result_text;
+    using orchestrator::unsealed_result_text;
+    const fs::path dir = test::fresh_test_dir("hostile-seal");
+    // the YADE template's own sealing function, run by python3 on a result, read back by the C++ reader
+    const fs::path script = dir / "seal.py";
+    std::ofstream(script) << "import hashlib, json, re, sys\n"
+                             "src = open(sys.argv[1]).read()\n"
+                             "fn = re.search(r'^def sealed_result_text\\(.*?(?=^def )', src, re.S | re.M).group(0)\n"
+                             "ns = {'json': json, 'hashlib': hashlib}\n"
+                             "exec(fn, ns)\n"
+                             "r = {'schema': 'demcal.shear_result/2', 'peak_shear_stress': 4321.5, 'curve': "
+                             "{'displacement': [0.0, 1e-05, 2e-05]}, 'yade_version': '2023.02a'}\n"
+                             "sys.stdout.write(ns['sealed_result_text'](r))\n";
+    const fs::path sealed_by_python = dir / "result.json";
+    const std::string cmd = "python3 " + script.string() + " " +
+                            test::source_path("yade_scripts/shear_box.py").string() + " > " + sealed_by_python.string();
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    const auto read = orchestrator::read_shear_result(sealed_by_python);
+    CHECK(read.at("peak_shear_stress").get<double>() == 4321.5);
+    CHECK_FALSE(read.contains("sha256"));
+    // the C++ writer (demcal shear-run) seals the same body to the same bytes
+    const std::string python_text = test::read_file(sealed_by_python);
+    CHECK(sealed_result_text(unsealed_result_text(python_text)) == python_text);
+    // every single flipped byte is caught by the seal, or the file no longer parses: never a result
+    int caught = 0;
+    for (std::size_t i = 0; i < python_text.size(); ++i) {
+        std::string damaged = python_text;
+        damaged[i] = static_cast<char>(damaged[i] ^ 0x04);
+        orchestrator::write_text_file_atomically(dir / "damaged.json", damaged);
+        CHECK_THROWS(orchestrator::read_shear_result(dir / "damaged.json"));
+        try {
+            orchestrator::read_shear_result(dir / "damaged.json");
+        } catch (const DamagedResult&) {
+            ++caught;
+        } catch (const std::exception&) {
+        }
+    }
+    CHECK(caught > 0);
+    // truncated at any point
+    for (std::size_t n : {python_text.size() - 1, python_text.size() / 2, std::size_t(80)}) {
+        orchestrator::write_text_file_atomically(dir / "cut.json", python_text.substr(0, n));
+        CHECK_THROWS(orchestrator::read_shear_result(dir / "cut.json"));
+    }
+    fs::remove_all(dir);
+}
