@@ -102,6 +102,21 @@ void check_output_file(const std::string& path, const std::string& option) {
     if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) throw UserError(named + " is not writable");
 }
 
+void check_output_file_in_new_folders(const std::string& path, const std::string& option) {
+    namespace fs = std::filesystem;
+    if (path.empty()) return;
+    std::error_code ec;
+    const fs::path parent = fs::path(path).parent_path();
+    if (parent.empty() || fs::exists(parent, ec)) return check_output_file(path, option);
+    fs::path existing = parent;
+    while (!existing.empty() && !fs::exists(existing, ec)) existing = existing.parent_path();
+    if (existing.empty()) existing = ".";
+    const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
+    if (!fs::is_directory(existing, ec)) throw UserError(named + ": " + existing.string() + " is not a folder");
+    if (::access(existing.c_str(), W_OK | X_OK) != 0)
+        throw UserError(named + ": the folder " + existing.string() + " is not writable");
+}
+
 std::string duration_text(double seconds) {
     if (!(seconds >= 0)) return "?";
     char buf[32];
