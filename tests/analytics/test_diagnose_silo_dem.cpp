@@ -177,12 +177,12 @@ TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value ins
     auto material = nlohmann::json::parse(read_file(kDeclared));
     material["grain_wall"]["friction"] = kTrueWallFriction;
     std::ofstream(dir / "rough_wall.json") << material.dump(1);
-    const int angles[] = {15, 30, 50, 70};
+    const int angles[] = {20, 30, 40, 50, 60};
     std::ofstream rough(dir / "rough.csv"), clean(dir / "clean.csv");
     rough << "theta_deg,rate_g_s,replicate\n";
     clean << "theta_deg,rate_g_s,replicate\n";
     for (int theta : angles)
-        for (int seed : {101, 102}) {
+        for (int seed : {101, 102, 103}) {
             for (const auto& [file, name, out] :
                  {std::tuple{(dir / "rough_wall.json").string(), std::string("rough"), &rough},
                   std::tuple{kDeclared, std::string("clean"), &clean}}) {
