@@ -9,6 +9,8 @@
 #include <gsl/gsl_multifit.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <set>
@@ -88,9 +90,11 @@ std::vector<double> candidate_grid(const DemEffectCandidate& c, int points) {
 }
 
 double run_value(double value) {
-    if (value == 0 || !std::isfinite(value)) return value;
-    const double magnitude = std::pow(10.0, std::floor(std::log10(std::fabs(value))) - 3);
-    return std::round(value / magnitude) * magnitude;
+    // through its 4-digit text, so that the value is the double nearest to what a report prints (0.1235, not
+    // 0.12350000000000001)
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", value);
+    return std::strtod(text, nullptr);
 }
 
 // --- measured data ------------------------------------------------------------------------------------------------

@@ -8,7 +8,6 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -126,8 +125,7 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
           "[diagnose][silo-dem]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-dem-bad-" + std::to_string(::getpid()));
     fs::remove_all(dir);
-    fs::create_directories(dir / "locked");
-    ::chmod((dir / "locked").c_str(), 0500);
+    fs::create_directories(dir / "folder");  // (tests run as root: a folder's permissions would not stop a write)
     std::ofstream(dir / "m.csv") << "theta_deg,rate_g_s\n30,160\n30,162\n50,120\n70,100\n";
     std::ofstream(dir / "few.csv") << "theta_deg,rate_g_s\n30,160\n30,162\n50,120\n";
     const std::string data = " --data '" + (dir / "m.csv").string() + "'";
@@ -137,12 +135,12 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
         std::string args, message;
     };
     const std::vector<Case> cases{
-        {"--model silo-dem" + data + campaign + material + " --json '" + (dir / "locked/r.json").string() + "' -- " +
+        {"--model silo-dem" + data + campaign + material + " --json '" + (dir / "folder").string() + "' -- " +
              kTinySilo,
-         "--json"},
-        {"--model silo-dem" + data + campaign + material + " --report '" + (dir / "locked/sub/r.md").string() +
+         "--json = '" + (dir / "folder").string() + "' is a folder"},
+        {"--model silo-dem" + data + campaign + material + " --report '" + (dir / "m.csv/sub/r.md").string() +
              "' -- " + kTinySilo,
-         "is not writable"},
+         "--report = '" + (dir / "m.csv/sub/r.md").string() + "': " + (dir / "m.csv").string() + " is not a folder"},
         {"--model silo-dem" + data + campaign + " -- " + kTinySilo, "--material"},
         {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --theta 30", "--theta"},
         {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --stop-fraction 7", "stop_fraction"},
@@ -152,8 +150,8 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
          "--material"},
         {"--model oldal" + data + material, "--material: only --model silo-dem"},
         {"--model oldal --data '" + std::string(DEMCAL_SOURCE_DIR) + "/examples/diagnose/oldal_clean.csv' --json '" +
-             (dir / "locked/r.json").string() + "'",
-         "--json"}};
+             (dir / "folder").string() + "'",
+         "--json = '" + (dir / "folder").string() + "' is a folder"}};
     for (const auto& c : cases) {
         INFO(c.args);
         CHECK(demcal_run("diagnose " + c.args, dir / "log") == 2);
@@ -161,7 +159,6 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
         CHECK_THAT(read_file(dir / "log"), Catch::Matchers::Contains(c.message));
         CHECK_FALSE(fs::exists(dir / "never"));
     }
-    ::chmod((dir / "locked").c_str(), 0700);
     fs::remove_all(dir);
 }
 
