@@ -406,12 +406,12 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
                 return sse;
             });
         };
-        for (int step = 0; step <= o.refine_steps; ++step) {
+        for (int step = 0; step < o.refine_steps; ++step) {
             const Surrogate g(c.spec, runs);
             const double proposal = run_value(g.value_of_unit(minimise_on_unit(sse_on(g, std::nullopt))));
             const bool known = runs.count(proposal) > 0;
-            run({proposal});  // the last step runs the final proposal, so the fitted value has real runs
-            if (known) break;
+            if (known) break;  // the surrogate's minimum has been run: converged
+            run({proposal});
         }
         const Surrogate g(c.spec, runs);
         const double u_fit = minimise_on_unit(sse_on(g, std::nullopt));

@@ -74,7 +74,7 @@ SiloMeasurements read_silo_measurements(const std::string& path);
 
 struct DemDiagnoseOptions {
     int grid_points = 5;        // coarse bracket: values evenly spaced over the bounds (search scale)
-    int refine_steps = 3;       // further proposals of the surrogate's minimiser, each one set of runs
+    int refine_steps = 3;       // proposals of the surrogate's minimiser, each one set of runs (then the fitted value)
     int prediction_seeds = 1;   // K: kernel runs (seeds) averaged per condition and value
     double alpha = 0.01;        // family-wise error of the candidates' F tests (Holm)
     double min_cv_gain = 0.05;  // least relative drop of the CV RMSE for an effect to be named

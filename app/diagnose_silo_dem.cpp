@@ -205,7 +205,7 @@ void plot_residuals(const an::SiloMeasurements& data, const an::DemDiagnosis& r,
                       : std::string("no effect named");
     for (int which = 0; which < 2; ++which) {
         std::ostringstream g;
-        g << "set grid\nset xlabel 'hopper half angle theta [deg]'\nset ylabel 'residual (measured - kernel) [%]'\n"
+        g << "set grid\nset xrange [0:90]\nset xlabel 'hopper half angle theta [deg]'\nset ylabel 'residual (measured - kernel) [%]'\n"
           << "set title '" << (which == 0 ? "silo-dem residuals, declared material" : "silo-dem residuals after: " + effect)
           << "' noenhanced\nset key top right\nplot " << gnuplot_quote(dat) << " using 2:" << (which == 0 ? 6 : 7)
           << " with points pt 7 ps 1 title 'measured runs', 0 lt -1 notitle\n";
