@@ -37,9 +37,11 @@ const std::vector<DemEffectCandidate>& dem_effect_candidates() {
          ParameterScale::linear,
          "particle-wall sliding friction (wall material, roughness, wear): it sets whether the hopper flows in mass "
          "flow, so it acts most at steep hoppers"},
+        // from 0.3: at 0.1 the reduced silo at 10 deg nearly jammed (1042 of its grains out after 4.5 s instead of
+        // all in under 1 s), a run of many minutes for a grain no wheat is
         {"restitution",
          {"grain_grain.restitution"},
-         0.1,
+         0.3,
          0.95,
          ParameterScale::linear,
          "grain-grain restitution (energy lost in collisions; grain-grain contacts dominate the flowing bed, the "

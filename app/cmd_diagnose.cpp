@@ -38,6 +38,9 @@ optional model constants (defaults in brackets):
   the flow pattern and each model says whether it applies))";
 
 void write_text(const std::string& path, const std::string& text) {
+    // the folders an output path names are created (checked creatable before any work)
+    if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
+        std::filesystem::create_directories(folder);
     std::ofstream out(path);
     if (!out) throw UserError("cannot write " + path);
     out << text;
