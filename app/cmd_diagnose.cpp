@@ -281,6 +281,10 @@ struct DiagnoseArgs {
 // Options that only the silo-dem model takes, refused (named) with an analytical model.
 const char* const kSiloDemOptions[] = {"--material", "--campaign", "--jobs", "--seeds", "--first-seed", "--grid-points",
                                        "--refine-steps"};
+// Options of the analytical search that silo-dem does not use (one effect from its table, no regimes or outliers yet):
+// refused rather than ignored.
+const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column", "--effective-friction-deg",
+                                              "--wall-friction-deg", "--outlier-alpha", "--drop-outliers"};
 
 void run_diagnose(const DiagnoseArgs& a) {
     // outputs first (issue 23): a path that cannot be written is refused before any work
@@ -413,6 +417,9 @@ void add_discharge_commands(CLI::App& app) {
     diagnose->footer(std::string(diagnose_help) + "\n\n" + silo_dem_help);
     diagnose->callback([args, diagnose] {
         if (args->model == "silo-dem") {
+            for (const char* option : kAnalyticalOnlyOptions)
+                if (diagnose->count(option))
+                    throw UserError(std::string(option) + ": the analytical models take it, not --model silo-dem");
             SiloDemArgs dem = args->silo_dem;
             dem.data = args->data;
             dem.json_out = args->json_out;

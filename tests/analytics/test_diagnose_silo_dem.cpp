@@ -149,6 +149,8 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
         {"--model silo-dem" + data + campaign + " --material '" + (dir / "m.csv").string() + "' -- " + kTinySilo,
          "--material"},
         {"--model oldal" + data + material, "--material: only --model silo-dem"},
+        {"--model silo-dem" + data + campaign + material + " --drop-outliers -- " + kTinySilo,
+         "--drop-outliers: the analytical models take it"},
         {"--model oldal --data '" + std::string(DEMCAL_SOURCE_DIR) + "/examples/diagnose/oldal_clean.csv' --json '" +
              (dir / "folder").string() + "'",
          "--json = '" + (dir / "folder").string() + "' is a folder"}};
