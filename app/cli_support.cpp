@@ -142,22 +142,39 @@ void check_output_file(const std::string& path, const std::string& option) {
     if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) throw UserError(named + " is not writable");
 }
 
+namespace {
+// Where files below `folder` will be created: `folder` itself when it exists, else the nearest existing folder above
+// it (the command creates the rest); it must be a folder in which files can be created. `named`: the option and
+// the path as given, for the message.
+void check_files_can_be_created_below(const std::filesystem::path& folder, const std::string& named) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path existing = fs::absolute(folder, ec).lexically_normal();
+    if (ec) throw UserError(named + ": " + ec.message());
+    while (!fs::exists(existing, ec) && existing.has_parent_path() && existing.parent_path() != existing)
+        existing = existing.parent_path();
+    if (!fs::is_directory(existing, ec))
+        throw UserError(named + ": " + existing.string() + " is a file, so the folder cannot be created");
+    if (!can_create_files_in(existing)) throw UserError(named + ": " + existing.string() + " is not writable");
+}
+}  // namespace
+
 void check_output_folder(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
     if (path.empty()) throw UserError(option + ": an empty path");
     std::error_code ec;
-    fs::path folder = fs::absolute(fs::path(path), ec).lexically_normal();
-    if (ec) throw UserError(named + ": " + ec.message());
-    if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
-        throw UserError(named + " is a file, not a folder");
-    // the folder itself when it exists, else the nearest existing folder above it (where it will be created)
-    while (!fs::exists(folder, ec) && folder.has_parent_path() && folder.parent_path() != folder)
-        folder = folder.parent_path();
-    if (!fs::is_directory(folder, ec))
-        throw UserError(named + ": " + folder.string() + " is a file, so the folder cannot be created");
-    if (!can_create_files_in(folder))
-        throw UserError(named + ": " + folder.string() + " is not writable");
+    if (fs::exists(path, ec) && !fs::is_directory(path, ec)) throw UserError(named + " is a file, not a folder");
+    check_files_can_be_created_below(path, named);
+}
+
+void check_output_file_in_new_folders(const std::string& path, const std::string& option) {
+    namespace fs = std::filesystem;
+    if (path.empty()) return;
+    std::error_code ec;
+    const fs::path parent = fs::path(path).parent_path();
+    if (parent.empty() || fs::exists(parent, ec)) return check_output_file(path, option);
+    check_files_can_be_created_below(parent, option + " = '" + analytics::shortened_text(path, 200) + "'");
 }
 
 std::string duration_text(double seconds) {

@@ -40,6 +40,11 @@ void check_output_file(const std::string& path, const std::string& option);
 // nothing (a probe file is removed at once). Throws UserError naming `option`, the path and the rule.
 void check_output_folder(const std::string& path, const std::string& option);
 
+// check_output_file for an output whose missing folders the command creates: the nearest existing folder above it
+// must allow files to be created (check_output_folder; the file, when it exists, as above). An empty path (output
+// not asked for) passes.
+void check_output_file_in_new_folders(const std::string& path, const std::string& option);
+
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);
 

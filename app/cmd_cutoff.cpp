@@ -3,6 +3,7 @@
 // with a cohesive material (kernel/silo/silo_case.hpp); measured cases in examples/cohesive_arch/README.md.
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "app/silo_campaign.hpp"  // refuse_owned_silo_options
 #include "app/silo_settings.hpp"
 #include "kernel/cases/cohesive_hopper.hpp"
 #include "analytics/number_text.hpp"
@@ -40,9 +41,9 @@ struct CutoffCli {
 };
 
 // The silo options a cut-off search sets for every run itself.
-constexpr const char* kOwnedSiloOptions[] = {"--seed", "--vibration-frequency", "--vibration-amplitude",
-                                             "--vibration-direction", "--vibration-start", "--stop-fraction",
-                                             "--max-time"};
+const std::vector<std::string> kOwnedSiloOptions{"--seed", "--vibration-frequency", "--vibration-amplitude",
+                                                 "--vibration-direction", "--vibration-start", "--stop-fraction",
+                                                 "--max-time"};
 // The small hopper's own options, which a silo search does not use (the silo options after -- say the case).
 constexpr const char* kHopperOptions[] = {"--bond-number", "--theta", "--grains"};
 
@@ -131,11 +132,7 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
         if (sub.count(option))
             throw UserError(std::string(option) + " applies to the small hopper; with silo options after -- the silo "
                             "case and its material say it (--theta and --material there)");
-    for (const std::string& a : o.silo_args)
-        for (const char* owned : kOwnedSiloOptions)
-            if (a == owned || a.rfind(std::string(owned) + "=", 0) == 0)
-                throw UserError("silo option " + a + " after --: demcal cutoff sets it for every run (--seeds, "
-                                "--amplitude, --window; the criterion's half of the mass)");
+    refuse_owned_silo_options(o.silo_args, kOwnedSiloOptions, "demcal cutoff");
     if (!o.json.empty()) check_output_file(o.json, "--json");
     const ks::SiloCaseSettings base = silo_case_settings(o.silo_args, "demcal cutoff");
     const kc::CutoffSearch search = search_from(o);

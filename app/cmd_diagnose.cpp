@@ -5,6 +5,7 @@
 #include "analytics/measured_data.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "app/diagnose_silo_dem.hpp"
 #include "app/gnuplot.hpp"
 
 #include <nlohmann/json.hpp>
@@ -37,6 +38,9 @@ optional model constants (defaults in brackets):
   the flow pattern and each model says whether it applies))";
 
 void write_text(const std::string& path, const std::string& text) {
+    // the folders an output path names are created (checked creatable before any work)
+    if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
+        std::filesystem::create_directories(folder);
     std::ofstream out(path);
     if (!out) throw UserError("cannot write " + path);
     out << text;
@@ -92,6 +96,12 @@ the angle by the seed's classes, mass < 30 <= mixed <= 40 < funnel deg, or by Je
 variable (x*z). Outliers: externally studentized residuals beyond a Bonferroni threshold (--outlier-alpha) are named
 by file line; the effect search never uses them; --drop-outliers also reports the fits without them.
 See examples/diagnose/README.md.)";
+
+constexpr const char* silo_dem_help = R"(--model silo-dem --material M.json [--campaign DIR] [--jobs N] [-- silo options]:
+  data: theta_deg, rate_g_s (g/s), optional outlet_m, D_m, body_height_m (conical), replicate; repeats as rows.
+  Every condition is predicted by demcal silo with the declared material (a resumable, cached campaign); the
+  residuals are traced to a DEM effect among rolling_friction, wall_friction, restitution, each fitted (coarse
+  bracket, refinement), tested (F against the repeat scatter, Holm) and cross-validated leaving one condition out.)";
 
 std::string sci(double v) {
     if (!std::isfinite(v)) return "n/a";
@@ -265,9 +275,21 @@ struct DiagnoseArgs {
     analytics::DiagnoseOptions options;
     double effective_friction_deg = std::nan(""), wall_friction_deg = std::nan("");  // NaN: not given
     bool no_plots = false;
+    SiloDemArgs silo_dem;  // --model silo-dem: the kernel's silo as the model
 };
 
+// Options that only the silo-dem model takes, refused (named) with an analytical model.
+const char* const kSiloDemOptions[] = {"--material", "--campaign", "--jobs", "--seeds", "--first-seed", "--grid-points",
+                                       "--refine-steps"};
+// Options of the analytical search that silo-dem does not use (one effect from its table, no regimes or outliers yet):
+// refused rather than ignored.
+const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column", "--effective-friction-deg",
+                                              "--wall-friction-deg", "--outlier-alpha", "--drop-outliers"};
+
 void run_diagnose(const DiagnoseArgs& a) {
+    // outputs first (issue 23): a path that cannot be written is refused before any work
+    check_output_file_in_new_folders(a.json_out, "--json");
+    check_output_file_in_new_folders(a.report_out, "--report");
     analytics::MeasuredData data;
     analytics::DiagnoseResult r;
     try {
@@ -337,6 +359,7 @@ void add_discharge_commands(CLI::App& app) {
     auto args = std::make_shared<DiagnoseArgs>();
     std::string models;
     for (const auto& m : analytics::diagnose_models()) models += (models.empty() ? "" : ", ") + m;
+    models += ", silo-dem (the kernel's silo with --material)";
     diagnose->add_option("--model", args->model, "the model: " + models)->required();
     diagnose->add_option("--data", args->data, "measured data, CSV (columns below)")->required();
     diagnose->add_option("--json", args->json_out, "write the result as JSON to this file");
@@ -369,8 +392,53 @@ void add_discharge_commands(CLI::App& app) {
         ->check(number_in(1e-6, 0.5));
     diagnose->add_flag("--drop-outliers", args->options.drop_outliers,
                        "report the fits without the rows flagged as outliers (the search never uses them)");
-    diagnose->footer(diagnose_help);
-    diagnose->callback([args] { run_diagnose(*args); });
+    SiloDemArgs& dem = args->silo_dem;
+    diagnose->add_option("--material", dem.material, "silo-dem: the declared silo material (JSON, as demcal silo's)");
+    diagnose->add_option("--campaign", dem.campaign,
+                         "silo-dem: campaign folder of the kernel runs (default silo_dem_<data stem>); the same "
+                         "command continues it and reruns nothing");
+    diagnose->add_option("--jobs", dem.jobs, "silo-dem: kernel runs at once")->capture_default_str()->check(
+        integer_in(1, 256));
+    diagnose->add_option("--seeds", dem.seeds, "silo-dem: kernel runs (seeds) averaged per condition and material")
+        ->capture_default_str()
+        ->check(integer_in(1, 20));
+    diagnose->add_option("--first-seed", dem.first_seed, "silo-dem: seed of the first prediction run")
+        ->capture_default_str()
+        ->check(integer_in(0, 1LL << 62));
+    diagnose->add_option("--grid-points", dem.grid_points, "silo-dem: coarse bracket per candidate (values run)")
+        ->capture_default_str()
+        ->check(integer_in(3, 30));
+    diagnose->add_option("--refine-steps", dem.refine_steps, "silo-dem: refinement proposals after the bracket")
+        ->capture_default_str()
+        ->check(integer_in(0, 20));
+    diagnose->add_option("silo_args", dem.silo_args,
+                         "silo-dem, after --: options of every demcal silo run (e.g. --geometry G --particles 2000 "
+                         "--stiffness-scale 0.001 --fill-time 0.5 --threads 1 --no-plots)");
+    diagnose->footer(std::string(diagnose_help) + "\n\n" + silo_dem_help);
+    diagnose->callback([args, diagnose] {
+        if (args->model == "silo-dem") {
+            for (const char* option : kAnalyticalOnlyOptions)
+                if (diagnose->count(option))
+                    throw UserError(std::string(option) + ": the analytical models take it, not --model silo-dem");
+            SiloDemArgs dem = args->silo_dem;
+            dem.data = args->data;
+            dem.json_out = args->json_out;
+            dem.report_out = args->report_out;
+            dem.no_plots = args->no_plots;
+            dem.alpha = args->options.family_alpha;
+            dem.min_cv_gain = args->options.min_cv_improvement;
+            const int status = run_silo_dem_diagnosis(dem);
+            if (status != 0) throw CLI::RuntimeError(status);
+            return;
+        }
+        for (const char* option : kSiloDemOptions)
+            if (diagnose->count(option))
+                throw UserError(std::string(option) + ": only --model silo-dem takes it (model '" + args->model + "')");
+        if (!args->silo_dem.silo_args.empty())
+            throw UserError("options after -- ('" + args->silo_dem.silo_args.front() +
+                            "'): only --model silo-dem runs demcal silo");
+        run_diagnose(*args);
+    });
 }
 
 }  // namespace demcal

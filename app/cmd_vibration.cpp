@@ -7,19 +7,14 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
+#include "app/silo_campaign.hpp"
+#include "orchestrator/shear_campaign.hpp"  // check_run_count
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
-
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
-#include <csignal>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -29,8 +24,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-extern char** environ;
 
 namespace demcal {
 
@@ -46,6 +39,7 @@ struct VibrationCli {
     int repeats = 3;
     long long first_seed = 1;
     std::string campaign;
+    long max_runs = 10000;
     std::vector<std::string> silo_args;  // after --: passed to every `demcal silo`
 };
 
@@ -60,66 +54,16 @@ struct RunSpec {
 };
 
 // Options this command sets for every run itself.
-const char* const kOwnedSiloOptions[] = {"--theta", "--seed", "--out", "--resume", "--vibration-frequency",
-                                         "--vibration-amplitude", "--vibration-direction", "--check"};
+const std::vector<std::string> kOwnedSiloOptions = {"--theta", "--seed", "--out", "--resume", "--vibration-frequency",
+                                                    "--vibration-amplitude", "--vibration-direction", "--check"};
 
-std::vector<std::string> silo_command(const VibrationCli& o, const RunSpec& r, const fs::path& out, bool check) {
-    auto num = [](double v) {
-        std::ostringstream s;
-        s << std::setprecision(17) << v;
-        return s.str();
-    };
-    std::vector<std::string> a{"silo", "--theta", num(r.theta), "--seed", std::to_string(r.seed), "--out", out.string()};
+SiloRunPlan silo_plan(const VibrationCli& o, const RunSpec& r) {
+    std::vector<std::string> a{"--theta", silo_number(r.theta), "--seed", std::to_string(r.seed)};
     if (r.frequency > 0)
-        a.insert(a.end(), {"--vibration-frequency", num(r.frequency), "--vibration-amplitude", num(o.amplitude),
-                           "--vibration-direction", o.direction});
+        a.insert(a.end(), {"--vibration-frequency", silo_number(r.frequency), "--vibration-amplitude",
+                           silo_number(o.amplitude), "--vibration-direction", o.direction});
     a.insert(a.end(), o.silo_args.begin(), o.silo_args.end());
-    if (check) a.push_back("--check");
-    return a;
-}
-
-// `demcal silo --resume DIR` with the session options of the silo options (the rest is in the checkpoint).
-std::vector<std::string> resume_command(const VibrationCli& o, const fs::path& dir) {
-    std::vector<std::string> a{"silo", "--resume", dir.string()};
-    for (std::size_t k = 0; k < o.silo_args.size(); ++k) {
-        const std::string& arg = o.silo_args[k];
-        if (arg == "--no-plots") a.push_back(arg);
-        if ((arg == "--threads" || arg == "--checkpoint-every" || arg == "--wall-limit") && k + 1 < o.silo_args.size())
-            a.insert(a.end(), {arg, o.silo_args[k + 1]});
-    }
-    return a;
-}
-
-// Runs this demcal with `args`, stdout and stderr to `log`; returns its exit status.
-int run_demcal(const std::vector<std::string>& args, const fs::path& log) {
-    std::vector<char*> argv;
-    // this very binary, even when the file was replaced since it started (a rebuild during a long sweep)
-    std::string self = "/proc/self/exe";
-    argv.push_back(self.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    posix_spawnattr_t attr;  // the run gets the default dispositions (it checkpoints on SIGINT/SIGTERM itself)
-    posix_spawnattr_init(&attr);
-    sigset_t defaults;
-    sigemptyset(&defaults);
-    sigaddset(&defaults, SIGINT);
-    sigaddset(&defaults, SIGTERM);
-    posix_spawnattr_setsigdefault(&attr, &defaults);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
-    pid_t pid = 0;
-    const int err = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&fa);
-    posix_spawnattr_destroy(&attr);
-    if (err != 0) throw std::runtime_error("cannot start " + self + ": " + std::strerror(err));
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return {r.name(), a};
 }
 
 json campaign_settings(const VibrationCli& o) {
@@ -129,10 +73,17 @@ json campaign_settings(const VibrationCli& o) {
 }
 
 void check_options(const VibrationCli& o) {
-    for (const std::string& a : o.silo_args)
-        for (const char* owned : kOwnedSiloOptions)
-            if (a == owned || a.rfind(std::string(owned) + "=", 0) == 0)
-                throw UserError("silo option " + a + " after --: demcal vibration sets it for every run");
+    refuse_owned_silo_options(o.silo_args, kOwnedSiloOptions, "demcal vibration");
+    // before each cell's settings are checked (a subprocess each): a typo's millions of cells end here
+    try {
+        orchestrator::check_run_count(double(o.thetas.size()) * double(o.frequencies.size()) * o.repeats, o.max_runs,
+                                      "--theta x --frequency x --repeats = " + std::to_string(o.thetas.size()) +
+                                          " x " + std::to_string(o.frequencies.size()) + " x " +
+                                          std::to_string(o.repeats));
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+    check_output_folder(o.campaign, "--campaign");
     bool vibrating = false;
     for (double f : o.frequencies) vibrating = vibrating || f > 0;
     if (vibrating && !(o.amplitude > 0)) throw UserError("--amplitude: a frequency above 0 needs an amplitude > 0 m");
@@ -151,17 +102,15 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
     json all = json::array();
     for (const RunSpec& r : runs) {
         Cell& c = cells[{r.theta, r.frequency}];
-        const fs::path summary = dir / "runs" / r.name() / "summary.json";
         json entry = {{"theta_deg", r.theta}, {"frequency_hz", r.frequency}, {"seed", r.seed}};
-        if (fs::exists(summary)) {
-            const json s = read_json_file(summary.string(), "run summary");
-            const double rate = s.at("rate").value("rate_kg_s", NAN) * 1e3;
-            const std::string pattern = s.at("flow_pattern").value("pattern", "?");
+        if (const auto s = silo_run_summary(dir, r.name())) {
+            const double rate = s->at("rate").value("rate_kg_s", NAN) * 1e3;
+            const std::string pattern = s->at("flow_pattern").value("pattern", "?");
             entry["rate_g_s"] = rate;
             entry["flow_pattern"] = pattern;
             if (std::isfinite(rate)) c.rates.push_back(rate);
             ++c.patterns[pattern];
-        } else if (fs::exists(dir / "runs" / r.name() / "failed")) {
+        } else if (silo_run_failed(dir, r.name())) {
             entry["failed"] = true;
             ++c.failed;
         }
@@ -228,67 +177,27 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
     }
 }
 
-volatile std::sig_atomic_t g_stop_requested = 0;
-extern "C" void request_stop(int) { g_stop_requested = 1; }
-
 int run(const VibrationCli& o) {
     check_options(o);
-    // Ctrl-C or SIGTERM: the running silo run checkpoints and exits 75 (it gets the signal too, or is sent it); this
-    // process waits for it and stops the sweep (the same command continues it)
-    std::signal(SIGINT, request_stop);
-    std::signal(SIGTERM, request_stop);
     const fs::path dir = o.campaign;
     std::vector<RunSpec> runs;  // repeat-major: an interrupted campaign has covered every cell once before repeating
     for (int k = 0; k < o.repeats; ++k)
         for (double theta : o.thetas)
             for (double f : o.frequencies) runs.push_back({theta, f, o.first_seed + k});
+    std::vector<SiloRunPlan> plans;
+    for (const RunSpec& r : runs) plans.push_back(silo_plan(o, r));
     // every cell's settings checked by silo itself before anything is written (the repeats differ by seed only)
-    const fs::path scratch = fs::temp_directory_path() / ("demcal-vibration-check-" + std::to_string(::getpid()));
-    for (std::size_t k = 0; k < o.thetas.size() * o.frequencies.size(); ++k) {
-        const fs::path log = scratch.string() + ".log";
-        const int rc = run_demcal(silo_command(o, runs[k], scratch / runs[k].name(), true), log);
-        std::ifstream is(log);
-        std::stringstream text;
-        text << is.rdbuf();
-        fs::remove(log);
-        if (rc != 0) throw UserError("run " + runs[k].name() + ": " + text.str().substr(0, 500));
+    check_silo_runs({plans.begin(), plans.begin() + std::ptrdiff_t(o.thetas.size() * o.frequencies.size())});
+    open_silo_campaign(dir, campaign_settings(o), "vibration");
+    // one run at a time: the sweep's runs take the cores they are given with --threads
+    const SiloCampaignOutcome outcome = run_silo_campaign(dir, plans, o.silo_args, 1, "vibration");
+    if (outcome.stopped) {
+        report(o, dir, runs);
+        return kExitResumeLater;
     }
-    const json settings = campaign_settings(o);
-    const fs::path settings_file = dir / "campaign.json";
-    if (fs::exists(settings_file)) {
-        if (read_json_file(settings_file.string(), "campaign settings") != settings)
-            throw UserError("campaign = '" + dir.string() + "' holds a sweep with other settings (" +
-                            settings_file.string() + "): give another --campaign, or the same settings to continue it");
-    } else {
-        fs::create_directories(dir / "runs");
-        orchestrator::write_text_file_atomically(settings_file, settings.dump(1) + "\n");
-    }
-    std::size_t done = 0, failed = 0;
-    for (const RunSpec& r : runs) {
-        const fs::path rd = dir / "runs" / r.name();
-        if (fs::exists(rd / "summary.json")) { ++done; continue; }
-        if (fs::exists(rd / "failed")) { ++failed; continue; }
-        const bool resume = fs::exists(rd / "checkpoint.bin");
-        fs::create_directories(rd);
-        std::cout << "[" << done + failed + 1 << "/" << runs.size() << "] " << r.name() << (resume ? " (resumed)" : "")
-                  << std::endl;
-        const int rc = resume ? run_demcal(resume_command(o, rd), rd / "silo.log")
-                              : run_demcal(silo_command(o, r, rd, false), rd / "silo.log");
-        if (rc == 0 && !g_stop_requested) { ++done; continue; }
-        if (rc == 0) ++done;
-        if (rc == 0 || rc == kExitResumeLater || rc == 128 + SIGINT || rc == 128 + SIGTERM || g_stop_requested) {
-            std::cout << "stopped at " << r.name() << " (exit " << rc << "); the same command continues the sweep\n";
-            report(o, dir, runs);
-            return kExitResumeLater;
-        }
-        std::ofstream(rd / "failed") << "exit status " << rc << "; see silo.log\n";
-        std::cerr << "demcal vibration: run " << r.name() << " failed (exit " << rc << "), see " << (rd / "silo.log")
-                  << "\n";
-        ++failed;
-    }
-    std::cout << done << " runs finished, " << failed << " failed\n";
+    std::cout << outcome.finished << " runs finished, " << outcome.failed << " failed\n";
     report(o, dir, runs);
-    return failed == 0 ? 0 : 1;
+    return outcome.failed == 0 ? 0 : 1;
 }
 
 }  // namespace
@@ -313,6 +222,9 @@ void add_vibration_command(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--first-seed", o->first_seed, "seed of the first repeat")->check(integer_in(0, 1LL << 62));
     sub->add_option("--campaign", o->campaign, "campaign directory (the same command continues it)")->required();
+    sub->add_option("--max-runs", o->max_runs, "most runs the sweep may plan (a guard against typos)")
+        ->check(integer_in(1, 100000000))
+        ->capture_default_str();
     sub->add_option("silo_args", o->silo_args, "after --: options for every demcal silo run (e.g. --geometry F "
                                                "--particles N --stiffness-scale S --threads 1)");
     sub->footer("Example: demcal vibration --theta 10,30,60 --frequency 0,50,100,145 --amplitude 1.1e-4 --repeats 3 "

@@ -1,5 +1,6 @@
 // Fuzz tests of the analytics readers: thousands of seeded mutations of valid files, each either read or refused with
 // std::invalid_argument (what every command turns into exit code 2); any other exception or a crash fails.
+#include "analytics/dem_diagnosis.hpp"
 #include "analytics/discharge_models.hpp"
 #include "analytics/measured_data.hpp"
 #include "analytics/user_input.hpp"
@@ -53,4 +54,12 @@ TEST_CASE("fuzz: the measured-data CSV reader reads or refuses every mutation", 
         std::istringstream in(text);
         analytics::validate_measured(analytics::parse_csv(in, "data.csv"), analytics::MeasuredKind::discharge);
     });
+}
+
+TEST_CASE("fuzz: the silo-dem measured-rate reader reads or refuses every mutation", "[fuzz][input]") {
+    fuzz(test::read_file(std::string(DEMCAL_SOURCE_DIR) + "/examples/diagnose/silo_dem/wall045_measured.csv"),
+         [](const std::string& text) {
+             std::istringstream in(text);
+             analytics::silo_measurements_from(analytics::parse_csv(in, "data.csv"));
+         });
 }

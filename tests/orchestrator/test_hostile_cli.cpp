@@ -158,6 +158,23 @@ TEST_CASE("cutoff: a search that could not end or would start too many runs is r
     fs::remove_all(root);
 }
 
+TEST_CASE("vibration: a sweep of absurd size or into a folder that cannot be made is refused before any cell is checked",
+          "[cli]") {
+    // 800 angles x 1001 frequencies were checked one `demcal silo --check` subprocess at a time: in effect a hang
+    const fs::path root = test::fresh_test_dir("hostile-vibration"), dir = root / "work";
+    fs::create_directories(dir);
+    std::ofstream(dir / "a-file") << "x";
+    std::string frequencies;
+    for (int f = 0; f <= 1000; ++f) frequencies += (f > 0 ? "," : "") + std::to_string(f);
+    refused({{{"vibration", "--theta", "10,30,60", "--frequency", frequencies, "--amplitude", "1e-4", "--repeats", "5",
+               "--campaign", (dir / "camp").string()},
+              {"--theta x --frequency x --repeats = 3 x 1001 x 5", "--max-runs = 10000"}},
+             {{"vibration", "--theta", "30", "--frequency", "0", "--campaign", (dir / "a-file" / "camp").string()},
+              {"--campaign", "a-file", "is a file"}}},
+            dir);
+    fs::remove_all(root);
+}
+
 TEST_CASE("crosscheck silo: repeated angles, too many angles and settings the kernel run refuses, before any folder",
           "[cli]") {
     const fs::path root = test::fresh_test_dir("hostile-xsilo"), dir = root / "work";

@@ -1,0 +1,561 @@
+#include "analytics/dem_diagnosis.hpp"
+
+#include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"
+
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_min.h>
+#include <gsl/gsl_multifit.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <numeric>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace demcal::analytics {
+
+std::string to_string(ParameterScale scale) { return scale == ParameterScale::log ? "log" : "linear"; }
+
+const std::vector<DemEffectCandidate>& dem_effect_candidates() {
+    static const std::vector<DemEffectCandidate> table{
+        {"rolling_friction",
+         {"grain_grain.rolling_friction", "grain_wall.rolling_friction"},
+         1e-3,
+         0.3,
+         ParameterScale::log,
+         "rolling resistance of the grain (its shape's departure from the clump's spheres): a property of the grain, so "
+         "grain-grain and grain-wall together; the rates alone cannot tell the two apart (one parameter per candidate)"},
+        {"wall_friction",
+         {"grain_wall.friction"},
+         0.05,
+         0.9,
+         ParameterScale::linear,
+         "particle-wall sliding friction (wall material, roughness, wear): it sets whether the hopper flows in mass "
+         "flow, so it acts most at steep hoppers"},
+        // from 0.3: at 0.1 the reduced silo at 10 deg nearly jammed (1042 of its grains out after 4.5 s instead of
+        // all in under 1 s), a run of many minutes for a grain no wheat is
+        {"restitution",
+         {"grain_grain.restitution"},
+         0.3,
+         0.95,
+         ParameterScale::linear,
+         "grain-grain restitution (energy lost in collisions; grain-grain contacts dominate the flowing bed, the "
+         "grain-wall one keeps its declared value)"},
+    };
+    return table;
+}
+
+std::vector<std::string> candidate_table_defects(const std::vector<DemEffectCandidate>& table) {
+    std::vector<std::string> defects;
+    std::set<std::string> names, fields;
+    for (const auto& c : table) {
+        const std::string who = "candidate '" + c.name + "'";
+        if (c.name.empty() || c.name.find_first_of(" \t,") != std::string::npos)
+            defects.push_back(who + ": a name must be one word");
+        if (!names.insert(c.name).second) defects.push_back(who + ": name used twice");
+        if (c.fields.empty()) defects.push_back(who + ": no material field");
+        for (const auto& f : c.fields) {
+            const auto dot = f.find('.');
+            if (dot == std::string::npos || dot == 0 || dot + 1 == f.size() || f.find('.', dot + 1) != std::string::npos)
+                defects.push_back(who + ": field '" + f + "' is not object.key");
+            if (!fields.insert(f).second) defects.push_back(who + ": field '" + f + "' belongs to two candidates");
+        }
+        if (!(std::isfinite(c.lower) && std::isfinite(c.upper) && c.lower < c.upper))
+            defects.push_back(who + ": bounds must be finite with lower < upper");
+        if (c.scale == ParameterScale::log && !(c.lower > 0)) defects.push_back(who + ": log scale needs lower > 0");
+    }
+    return defects;
+}
+
+namespace {
+
+double to_search(double v, ParameterScale s) { return s == ParameterScale::log ? std::log(v) : v; }
+double from_search(double t, ParameterScale s) { return s == ParameterScale::log ? std::exp(t) : t; }
+
+std::string invalid_cell(const MeasuredData& d, std::size_t row, const std::string& column, const std::string& why) {
+    return d.where(row, column) + ": value '" + shortened_text(d.at(column).text[row]) + "' " + why;
+}
+
+}  // namespace
+
+std::vector<double> candidate_grid(const DemEffectCandidate& c, int points) {
+    std::vector<double> values;
+    const double a = to_search(c.lower, c.scale), b = to_search(c.upper, c.scale);
+    for (int k = 0; k < points; ++k)
+        values.push_back(run_value(from_search(points == 1 ? 0.5 * (a + b) : a + (b - a) * k / (points - 1), c.scale)));
+    return values;
+}
+
+double run_value(double value) {
+    // through its 4-digit text, so that the value is the double nearest to what a report prints (0.1235, not
+    // 0.12350000000000001)
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", value);
+    return std::strtod(text, nullptr);
+}
+
+// --- measured data ------------------------------------------------------------------------------------------------
+
+std::string SiloCondition::label() const {
+    std::string s = "theta" + number_text(theta_deg, 10);
+    if (std::isfinite(outlet_m)) s += "_outlet" + number_text(outlet_m, 10);
+    if (std::isfinite(diameter_m)) s += "_D" + number_text(diameter_m, 10);
+    if (std::isfinite(body_height_m)) s += "_H" + number_text(body_height_m, 10);
+    return s;
+}
+
+bool SiloCondition::operator==(const SiloCondition& o) const {
+    auto same = [](double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; };
+    return same(theta_deg, o.theta_deg) && same(outlet_m, o.outlet_m) && same(diameter_m, o.diameter_m) &&
+           same(body_height_m, o.body_height_m);
+}
+
+const std::vector<std::string>& silo_measurement_columns() {
+    static const std::vector<std::string> columns{"theta_deg", "rate_g_s", "outlet_m", "D_m", "body_height_m",
+                                                  "replicate"};
+    return columns;
+}
+
+SiloMeasurements silo_measurements_from(const MeasuredData& d) {
+    const auto& known = silo_measurement_columns();
+    std::string known_list;
+    for (const auto& k : known) known_list += (known_list.empty() ? "" : ", ") + k;
+    for (const auto& c : d.columns)
+        if (std::find(known.begin(), known.end(), c.name) == known.end())
+            throw std::invalid_argument(d.source + ": line 1, column " + shortened_text(c.name) +
+                                        ": unknown column for the silo-dem model (known: " + known_list + ")");
+    for (const char* required : {"theta_deg", "rate_g_s"})
+        if (!d.find(required))
+            throw std::invalid_argument(d.source + ": line 1: column " + required + " is missing (silo-dem needs " +
+                                        "theta_deg and rate_g_s)");
+    if (d.rows() == 0) throw std::invalid_argument(d.source + ": no data rows");
+    // every cell a usable number (parse_csv applied the number rule to the cells that read as numbers)
+    for (const auto& c : d.columns)
+        for (std::size_t r = 0; r < d.rows(); ++r) {
+            const TypedNumber n = read_typed_number(c.text[r]);
+            if (c.text[r].empty()) throw std::invalid_argument(d.where(r, c.name) + ": empty cell");
+            if (!n.is_number) throw std::invalid_argument(invalid_cell(d, r, c.name, "is not a number"));
+            if (n.defect) throw std::invalid_argument(invalid_cell(d, r, c.name, *n.defect));
+        }
+    SiloMeasurements m;
+    m.source = d.source;
+    auto value = [&](const char* column, std::size_t r) {
+        const DataColumn* c = d.find(column);
+        return c ? read_typed_number(c->text[r]).value : NAN;
+    };
+    for (std::size_t r = 0; r < d.rows(); ++r) {
+        SiloCondition c{value("theta_deg", r), value("outlet_m", r), value("D_m", r), value("body_height_m", r)};
+        if (!(c.theta_deg > 0 && c.theta_deg < 90))
+            throw std::invalid_argument(invalid_cell(d, r, "theta_deg", "must be in (0, 90) deg (a conical hopper)"));
+        for (const char* size : {"outlet_m", "D_m", "body_height_m"})
+            if (d.find(size) && !(value(size, r) > 0))
+                throw std::invalid_argument(invalid_cell(d, r, size, "must be > 0 m"));
+        const double rate = value("rate_g_s", r);
+        if (!(rate > 0)) throw std::invalid_argument(invalid_cell(d, r, "rate_g_s", "must be > 0 g/s"));
+        auto it = std::find(m.conditions.begin(), m.conditions.end(), c);
+        if (it == m.conditions.end()) it = m.conditions.insert(m.conditions.end(), c);
+        m.condition_of_row.push_back(std::size_t(it - m.conditions.begin()));
+        m.rate_g_s.push_back(rate);
+        m.lines.push_back(d.lines[r]);
+    }
+    return m;
+}
+
+SiloMeasurements read_silo_measurements(const std::string& path) {
+    std::istringstream in(read_input_file(path, "data file " + shortened_text(path, 200), kMaxMeasuredDataBytes));
+    return silo_measurements_from(parse_csv(in, path));
+}
+
+// --- the diagnosis --------------------------------------------------------------------------------------------------
+
+namespace {
+
+// Measured log rates by condition: means, counts, pooled within-condition variance.
+struct ConditionStats {
+    std::vector<double> log_rate;        // per row
+    std::vector<double> mean;            // per condition
+    std::vector<int> count;              // per condition
+    double pure_error_ss = 0;
+    int df_pure_error = 0;
+    double s2 = NAN;
+};
+
+ConditionStats condition_stats(const SiloMeasurements& d) {
+    ConditionStats s;
+    const std::size_t C = d.conditions.size();
+    s.mean.assign(C, 0);
+    s.count.assign(C, 0);
+    for (std::size_t i = 0; i < d.rows(); ++i) {
+        s.log_rate.push_back(std::log(d.rate_g_s[i]));
+        s.mean[d.condition_of_row[i]] += s.log_rate.back();
+        ++s.count[d.condition_of_row[i]];
+    }
+    for (std::size_t c = 0; c < C; ++c) s.mean[c] /= s.count[c];
+    for (std::size_t i = 0; i < d.rows(); ++i) {
+        const double e = s.log_rate[i] - s.mean[d.condition_of_row[i]];
+        s.pure_error_ss += e * e;
+    }
+    s.df_pure_error = int(d.rows()) - int(C);
+    s.s2 = s.df_pure_error > 0 ? s.pure_error_ss / s.df_pure_error : NAN;
+    return s;
+}
+
+// Row SSE and RMSE of log residuals for predicted log rates per condition.
+double row_sse(const SiloMeasurements& d, const ConditionStats& s, const std::vector<double>& log_pred) {
+    double sse = 0;
+    for (std::size_t i = 0; i < d.rows(); ++i) {
+        const double e = s.log_rate[i] - log_pred[d.condition_of_row[i]];
+        sse += e * e;
+    }
+    return sse;
+}
+
+double chi2_of(const ConditionStats& s, const std::vector<double>& log_pred, int K) {
+    double chi2 = 0;
+    for (std::size_t c = 0; c < s.mean.size(); ++c) {
+        const double var = s.s2 * (1.0 / s.count[c] + 1.0 / K);
+        chi2 += (s.mean[c] - log_pred[c]) * (s.mean[c] - log_pred[c]) / var;
+    }
+    return chi2;
+}
+
+std::vector<double> logs(const std::vector<double>& rates) {
+    std::vector<double> l;
+    for (double r : rates) l.push_back(std::log(r));
+    return l;
+}
+
+double rmse_g_s(const SiloMeasurements& d, const std::vector<double>& rates) {
+    double ss = 0;
+    for (std::size_t i = 0; i < d.rows(); ++i) ss += std::pow(d.rate_g_s[i] - rates[d.condition_of_row[i]], 2);
+    return std::sqrt(ss / double(d.rows()));
+}
+
+// The kernel's log rate per condition as a polynomial in the parameter's search scale, mapped to [-1, 1] over the
+// bounds: the seed scatter of single runs averaged out, so that neither the fit nor the CV chases it.
+class Surrogate {
+public:
+    Surrogate(const DemEffectCandidate& spec, const std::map<double, std::vector<double>>& runs) : spec_(spec) {
+        const std::size_t npts = runs.size();
+        degree_ = int(std::clamp<std::size_t>((npts - 1) / 2, 1, 3));
+        const std::size_t p = std::size_t(degree_) + 1;
+        const std::size_t C = runs.begin()->second.size();
+        gsl_matrix* X = gsl_matrix_alloc(npts, p);
+        gsl_vector* y = gsl_vector_alloc(npts);
+        gsl_vector* beta = gsl_vector_alloc(p);
+        gsl_matrix* cov = gsl_matrix_alloc(p, p);
+        gsl_multifit_linear_workspace* w = gsl_multifit_linear_alloc(npts, p);
+        std::size_t row = 0;
+        for (const auto& [value, rates] : runs) {
+            double power = 1;
+            for (std::size_t k = 0; k < p; ++k, power *= unit(value)) gsl_matrix_set(X, row, k, power);
+            ++row;
+        }
+        coefficients_.assign(C, std::vector<double>(p, 0));
+        for (std::size_t c = 0; c < C; ++c) {
+            row = 0;
+            for (const auto& [value, rates] : runs) gsl_vector_set(y, row++, std::log(rates[c]));
+            double chisq = 0;
+            gsl_multifit_linear(X, y, beta, cov, &chisq, w);
+            for (std::size_t k = 0; k < p; ++k) coefficients_[c][k] = gsl_vector_get(beta, k);
+        }
+        gsl_multifit_linear_free(w);
+        gsl_matrix_free(cov);
+        gsl_vector_free(beta);
+        gsl_vector_free(y);
+        gsl_matrix_free(X);
+    }
+
+    double unit(double value) const {
+        const double a = to_search(spec_.lower, spec_.scale), b = to_search(spec_.upper, spec_.scale);
+        return 2 * (to_search(value, spec_.scale) - a) / (b - a) - 1;
+    }
+    double value_of_unit(double u) const {
+        const double a = to_search(spec_.lower, spec_.scale), b = to_search(spec_.upper, spec_.scale);
+        return from_search(a + (u + 1) / 2 * (b - a), spec_.scale);
+    }
+    // log rate of every condition at unit position u
+    std::vector<double> at_unit(double u) const {
+        std::vector<double> l;
+        for (const auto& beta : coefficients_) {
+            double v = 0, power = 1;
+            for (double b : beta) v += b * power, power *= u;
+            l.push_back(v);
+        }
+        return l;
+    }
+    int degree() const { return degree_; }
+
+private:
+    DemEffectCandidate spec_;
+    int degree_ = 1;
+    std::vector<std::vector<double>> coefficients_;
+};
+
+struct MinimiseData {
+    const std::function<double(double)>* f;
+};
+double call_objective(double u, void* p) { return (*static_cast<MinimiseData*>(p)->f)(u); }
+
+// Minimum of f over [-1, 1]: a scan of 201 points, then GSL's Brent minimiser in the best point's bracket.
+double minimise_on_unit(const std::function<double(double)>& f) {
+    constexpr int n = 201;
+    int best = 0;
+    double best_f = INFINITY;
+    for (int k = 0; k < n; ++k)
+        if (const double v = f(-1 + 2.0 * k / (n - 1)); v < best_f) best_f = v, best = k;
+    if (best == 0 || best == n - 1) return -1 + 2.0 * best / (n - 1);
+    const double lo = -1 + 2.0 * (best - 1) / (n - 1), hi = -1 + 2.0 * (best + 1) / (n - 1),
+                 mid = -1 + 2.0 * best / (n - 1);
+    if (!(f(mid) < f(lo) && f(mid) < f(hi))) return mid;  // flat: the scan's point is as good as any
+    MinimiseData data{&f};
+    gsl_function F{&call_objective, &data};
+    gsl_min_fminimizer* m = gsl_min_fminimizer_alloc(gsl_min_fminimizer_brent);
+    gsl_error_handler_t* old = gsl_set_error_handler_off();
+    double x = mid;
+    if (gsl_min_fminimizer_set(m, &F, mid, lo, hi) == GSL_SUCCESS) {
+        for (int it = 0; it < 60; ++it) {
+            if (gsl_min_fminimizer_iterate(m) != GSL_SUCCESS) break;
+            x = gsl_min_fminimizer_x_minimum(m);
+            if (gsl_min_test_interval(gsl_min_fminimizer_x_lower(m), gsl_min_fminimizer_x_upper(m), 1e-6, 0) ==
+                GSL_SUCCESS)
+                break;
+        }
+    }
+    gsl_set_error_handler(old);
+    gsl_min_fminimizer_free(m);
+    return x;
+}
+
+std::vector<double> holm(const std::vector<double>& p) {
+    std::vector<std::size_t> order(p.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](auto a, auto b) { return p[a] < p[b]; });
+    std::vector<double> adjusted(p.size());
+    double running = 0;
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        running = std::max(running, std::min(1.0, double(order.size() - k) * p[order[k]]));
+        adjusted[order[k]] = running;
+    }
+    return adjusted;
+}
+
+}  // namespace
+
+DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double>& rates_declared,
+                          const std::vector<DemCandidateSetup>& setups, const DemDiagnoseOptions& o) {
+    const std::size_t C = data.conditions.size();
+    if (C < 3)
+        throw std::invalid_argument(data.source + ": " + std::to_string(C) +
+                                    " distinct condition(s); the cross-validation leaves one out and refits one "
+                                    "parameter: give at least 3");
+    const ConditionStats s = condition_stats(data);
+    if (s.df_pure_error < 1 || !(s.s2 > 0))
+        throw std::invalid_argument(data.source + ": no repeats (rows of one condition with different rates): the noise "
+                                    "scale is the measured repeat scatter; give repeats of at least one condition");
+    if (rates_declared.size() != C) throw std::logic_error("diagnose_dem: one declared rate per condition");
+    const int K = std::max(1, o.prediction_seeds);
+    DemDiagnosis r;
+    r.n = int(data.rows());
+    r.conditions = int(C);
+    r.df_pure_error = s.df_pure_error;
+    r.prediction_seeds = K;
+    r.noise_sd = std::sqrt(s.s2);
+    r.rates_declared = rates_declared;
+    const auto log_declared = logs(rates_declared);
+    r.rmse_before = std::sqrt(row_sse(data, s, log_declared) / r.n);
+    r.rmse_before_g_s = rmse_g_s(data, rates_declared);
+    r.chi2_before = chi2_of(s, log_declared, K);
+    r.lack_of_fit_p_before = gsl_cdf_fdist_Q(r.chi2_before / double(C), double(C), double(s.df_pure_error));
+    const double delta_chi2 = gsl_cdf_fdist_Pinv(o.interval_level, 1.0, double(s.df_pure_error));
+
+    std::vector<std::size_t> tested;
+    for (const DemCandidateSetup& setup : setups) {
+        DemCandidateResult c;
+        c.spec = setup.spec;
+        if (!setup.declared) {
+            c.available = false;
+            c.unavailable = setup.unavailable;
+            r.candidates.push_back(c);
+            continue;
+        }
+        c.declared = *setup.declared;
+        std::map<double, std::vector<double>> runs{{c.declared, rates_declared}};
+        auto run = [&](std::vector<double> values) {
+            std::vector<double> fresh;
+            for (double v : values)
+                if (!runs.count(v) && std::find(fresh.begin(), fresh.end(), v) == fresh.end()) fresh.push_back(v);
+            if (fresh.empty()) return;
+            const auto rates = setup.predict(fresh);
+            for (std::size_t k = 0; k < fresh.size(); ++k) {
+                runs[fresh[k]] = rates.at(k);
+                c.evaluated.push_back(fresh[k]);
+                c.sse_of_runs.push_back(row_sse(data, s, logs(rates[k])));
+            }
+        };
+        run(candidate_grid(c.spec, o.grid_points));
+        auto sse_on = [&](const Surrogate& g, std::optional<std::size_t> without) {
+            return std::function<double(double)>([&, without](double u) {
+                const auto l = g.at_unit(u);
+                double sse = 0;
+                for (std::size_t k = 0; k < C; ++k)
+                    if (!without || *without != k) sse += s.count[k] * (s.mean[k] - l[k]) * (s.mean[k] - l[k]);
+                return sse;
+            });
+        };
+        for (int step = 0; step < o.refine_steps; ++step) {
+            const Surrogate g(c.spec, runs);
+            const double proposal = run_value(g.value_of_unit(minimise_on_unit(sse_on(g, std::nullopt))));
+            const bool known = runs.count(proposal) > 0;
+            if (known) break;  // the surrogate's minimum has been run: converged
+            run({proposal});
+        }
+        const Surrogate g(c.spec, runs);
+        const double u_fit = minimise_on_unit(sse_on(g, std::nullopt));
+        c.fitted = run_value(g.value_of_unit(u_fit));
+        run({c.fitted});
+        c.rates_fitted = runs.at(c.fitted);
+        c.rmse_fitted = std::sqrt(row_sse(data, s, logs(c.rates_fitted)) / r.n);
+        const double u_declared = std::clamp(g.unit(c.declared), -1.0, 1.0);
+        const auto l_declared = g.at_unit(u_declared), l_fit = g.at_unit(u_fit);
+        c.rmse_declared = c.cv_rmse_declared = std::sqrt(row_sse(data, s, l_declared) / r.n);
+        c.chi2_declared = chi2_of(s, l_declared, K);
+        c.chi2_fitted = chi2_of(s, l_fit, K);
+        c.f_statistic = std::max(0.0, c.chi2_declared - c.chi2_fitted);
+        c.p_value = gsl_cdf_fdist_Q(c.f_statistic, 1.0, double(s.df_pure_error));
+        // interval: the connected range around the fit where chi2 stays within the quantile of its minimum
+        constexpr int n_scan = 801;
+        auto chi2_u = [&](double u) { return chi2_of(s, g.at_unit(u), K); };
+        const double chi2_min = std::min(c.chi2_fitted, chi2_u(u_fit));
+        const double step = 2.0 / (n_scan - 1);
+        double lo = u_fit, hi = u_fit;
+        while (lo - step >= -1 && chi2_u(lo - step) <= chi2_min + delta_chi2) lo -= step;
+        while (hi + step <= 1 && chi2_u(hi + step) <= chi2_min + delta_chi2) hi += step;
+        c.interval_at_lower_bound = lo - step < -1;
+        c.interval_at_upper_bound = hi + step > 1;
+        c.interval_low = g.value_of_unit(lo);
+        c.interval_high = g.value_of_unit(hi);
+        // leave one condition out: refit on the others' surrogate SSE, predict the one left out
+        double cv_ss = 0;
+        for (std::size_t k = 0; k < C; ++k) {
+            const double u_k = minimise_on_unit(sse_on(g, k));
+            c.fitted_without.push_back(g.value_of_unit(u_k));
+            const double l = g.at_unit(u_k)[k];
+            for (std::size_t i = 0; i < data.rows(); ++i)
+                if (data.condition_of_row[i] == k) cv_ss += (s.log_rate[i] - l) * (s.log_rate[i] - l);
+        }
+        c.cv_rmse = std::sqrt(cv_ss / r.n);
+        c.cv_gain = c.cv_rmse <= (1 - o.min_cv_gain) * c.cv_rmse_declared;
+        tested.push_back(r.candidates.size());
+        r.candidates.push_back(c);
+    }
+    std::vector<double> p;
+    for (std::size_t k : tested) p.push_back(r.candidates[k].p_value);
+    const auto adjusted = holm(p);
+    for (std::size_t j = 0; j < tested.size(); ++j) {
+        DemCandidateResult& c = r.candidates[tested[j]];
+        c.p_holm = adjusted[j];
+        c.significant = c.p_holm < o.alpha;
+        if (c.significant && c.cv_gain && (r.effect < 0 || c.cv_rmse < r.candidates[std::size_t(r.effect)].cv_rmse))
+            r.effect = int(tested[j]);
+    }
+    if (r.effect >= 0) {
+        DemCandidateResult& e = r.candidates[std::size_t(r.effect)];
+        e.accepted = true;
+        r.rates_after = e.rates_fitted;
+        r.cv_rmse_after = e.cv_rmse;
+    } else {
+        r.rates_after = rates_declared;
+        r.cv_rmse_after = r.rmse_before;
+    }
+    const auto log_after = logs(r.rates_after);
+    r.rmse_after = std::sqrt(row_sse(data, s, log_after) / r.n);
+    r.rmse_after_g_s = rmse_g_s(data, r.rates_after);
+    const int df_after = int(C) - (r.effect >= 0 ? 1 : 0);
+    r.lack_of_fit_p_after =
+        gsl_cdf_fdist_Q(chi2_of(s, log_after, K) / double(df_after), double(df_after), double(s.df_pure_error));
+    if (r.effect >= 0) {
+        const auto& e = r.candidates[std::size_t(r.effect)];
+        if (e.interval_at_lower_bound || e.interval_at_upper_bound)
+            r.warnings.push_back(e.spec.name + ": the interval reaches the candidate's bound; the value may lie "
+                                 "beyond it");
+    }
+    if (r.effect < 0 && r.lack_of_fit_p_before < o.alpha)
+        r.warnings.push_back("the declared material misses the data beyond their repeat scatter (lack of fit p = " +
+                             number_text(r.lack_of_fit_p_before, 3) +
+                             "), but no single candidate explains it: an effect outside the table, or several at once");
+    return r;
+}
+
+nlohmann::json DemDiagnosis::to_json(const SiloMeasurements& data) const {
+    using nlohmann::json;
+    auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    json condition_rows = json::array();
+    for (std::size_t c = 0; c < data.conditions.size(); ++c) {
+        const auto& k = data.conditions[c];
+        json rows = json::array();
+        for (std::size_t i = 0; i < data.rows(); ++i)
+            if (data.condition_of_row[i] == c) rows.push_back({{"line", data.lines[i]}, {"rate_g_s", data.rate_g_s[i]}});
+        condition_rows.push_back({{"label", k.label()}, {"theta_deg", k.theta_deg}, {"outlet_m", num(k.outlet_m)},
+                              {"D_m", num(k.diameter_m)}, {"body_height_m", num(k.body_height_m)},
+                              {"rate_declared_g_s", rates_declared[c]}, {"rate_after_g_s", rates_after[c]},
+                              {"measured", rows}});
+    }
+    json cands = json::array();
+    for (const auto& c : candidates) {
+        json j{{"name", c.spec.name}, {"fields", c.spec.fields}, {"bounds", {c.spec.lower, c.spec.upper}},
+               {"scale", to_string(c.spec.scale)}, {"mechanism", c.spec.mechanism}, {"available", c.available}};
+        if (!c.available) {
+            j["unavailable"] = c.unavailable;
+        } else {
+            j.update({{"declared", c.declared},
+                      {"fitted", c.fitted},
+                      {"interval", {c.interval_low, c.interval_high}},
+                      {"interval_reaches_bound", c.interval_at_lower_bound || c.interval_at_upper_bound},
+                      {"evaluated", c.evaluated},
+                      {"sse_of_runs", c.sse_of_runs},
+                      {"rmse_declared", num(c.rmse_declared)},
+                      {"rmse_fitted", num(c.rmse_fitted)},
+                      {"cv_rmse_declared", num(c.cv_rmse_declared)},
+                      {"cv_rmse", num(c.cv_rmse)},
+                      {"chi2_declared", num(c.chi2_declared)},
+                      {"chi2_fitted", num(c.chi2_fitted)},
+                      {"f_statistic", num(c.f_statistic)},
+                      {"p_value", num(c.p_value)},
+                      {"p_holm", num(c.p_holm)},
+                      {"significant", c.significant},
+                      {"cv_gain", c.cv_gain},
+                      {"accepted", c.accepted},
+                      {"fitted_without_condition", c.fitted_without}});
+        }
+        cands.push_back(j);
+    }
+    json effect_json = nullptr;
+    if (effect >= 0) {
+        const auto& e = candidates[std::size_t(effect)];
+        effect_json = {{"name", e.spec.name},       {"fields", e.spec.fields},   {"declared", e.declared},
+                       {"fitted", e.fitted},        {"interval", {e.interval_low, e.interval_high}},
+                       {"p_holm", e.p_holm},        {"cv_rmse_after", e.cv_rmse}};
+    }
+    return {{"model", "silo-dem"},
+            {"n", n},
+            {"condition_count", conditions},
+            {"df_pure_error", df_pure_error},
+            {"noise_sd_log", noise_sd},
+            {"prediction_seeds", prediction_seeds},
+            {"before", {{"rmse", rmse_before}, {"cv_rmse", rmse_before}, {"rmse_g_s", rmse_before_g_s},
+                        {"chi2", chi2_before}, {"lack_of_fit_p", lack_of_fit_p_before}}},
+            {"effect", effect_json},
+            {"after", {{"rmse", rmse_after}, {"cv_rmse", cv_rmse_after}, {"rmse_g_s", rmse_after_g_s},
+                       {"lack_of_fit_p", lack_of_fit_p_after}}},
+            {"candidates", cands},
+            {"conditions", condition_rows},
+            {"warnings", warnings}};
+}
+
+}  // namespace demcal::analytics

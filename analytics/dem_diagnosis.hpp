@@ -1,0 +1,136 @@
+// The DEM model as a model (issue 26 item 3): measured silo discharge rates against the kernel's silo with a declared
+// material, the residuals traced to a DEM effect the material lacks. Pure numerics: the kernel's predictions come in
+// through a callback (app/diagnose_silo_dem.cpp runs them as a campaign of `demcal silo` runs).
+//
+// Method (each choice because an evaluation is a set of DEM runs, a few seconds each, with seed scatter):
+//  * residuals on log rate (a rate's noise is relative, as in the analytical diagnosis); rows with equal geometry are
+//    one condition; the noise scale is the measured repeat scatter (pooled within-condition variance s^2 of log rate,
+//    df = rows - conditions); a condition mean's residual has variance s^2 (1/n_c + 1/K) with K prediction seeds (the
+//    kernel's own seed scatter taken as that of the measurement: the measured data carry no other estimate of it);
+//  * each candidate (a row of dem_effect_candidates(): a parameter written to one or more material fields) is run on
+//    a coarse grid over its bounds plus its declared value, then a few refinement steps; the kernel's log rate per
+//    condition is smoothed by a low-degree polynomial in the parameter (its search scale), so the fit does not chase
+//    the seed scatter of single runs; the surrogate's SSE is minimised by GSL's Brent minimiser, and every proposal is
+//    run (runs are cached by their material, so nothing runs twice);
+//  * decision: chi2(p) = sum_c (mean_c - pred_c(p))^2 / var_c; F = chi2(declared) - chi2(fitted) against F(1, df)
+//    (one parameter); Holm over the candidates; the candidate must also cut the leave-one-condition-out CV RMSE by
+//    at least min_cv_gain; the lowest CV RMSE among those wins. A clean set (the declared material right) gets none;
+//  * interval: the values whose chi2 is within the F(1, df) quantile of the minimum (profile of the SSE).
+#pragma once
+#include "analytics/measured_data.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace demcal::analytics {
+
+enum class ParameterScale { linear, log };
+std::string to_string(ParameterScale scale);
+
+// A DEM effect the declared material may lack: one parameter, written to every listed field of the silo material.
+struct DemEffectCandidate {
+    std::string name;                 // e.g. "wall_friction"
+    std::vector<std::string> fields;  // material JSON paths, "object.key", e.g. "grain_wall.friction"
+    double lower = 0, upper = 0;      // bounds of the fitted value
+    ParameterScale scale = ParameterScale::linear;  // log: the value spans decades (searched in log)
+    std::string mechanism;            // what it stands for, and why these fields together
+};
+
+// The table of candidates diagnose tries, in order. Adding an effect is one row here (e.g. cohesion, field
+// grain_grain.surface_energy_J_m2, once the silo material has it: until then a material without the field makes the
+// candidate "not in this material" rather than an error).
+const std::vector<DemEffectCandidate>& dem_effect_candidates();
+// Defects of a table (empty: none): unique names, at least one "object.key" field, a field in one row only,
+// finite lower < upper, log bounds > 0.
+std::vector<std::string> candidate_table_defects(const std::vector<DemEffectCandidate>& table);
+
+// One measured condition: the silo geometry a row gives (NaN: not given, the silo options after -- decide).
+struct SiloCondition {
+    double theta_deg = NAN, outlet_m = NAN, diameter_m = NAN, body_height_m = NAN;
+    std::string label() const;  // "theta30" or "theta30_outlet0.03_D0.07_H0.15" (a run folder's name part)
+    bool operator==(const SiloCondition& o) const;
+};
+
+// Measured discharge rates, one row per run. Columns: theta_deg and rate_g_s (required), outlet_m, D_m, body_height_m
+// (optional, conical silo; as demcal silo's --outlet, --diameter, --body-height), replicate (optional, any number:
+// a label, not used). Any other column is refused, as is a missing or non-numeric cell, a number analytics'
+// number rule refuses, a rate <= 0, an angle outside (0, 90) or a size <= 0: FILE: line L, column C: value.
+struct SiloMeasurements {
+    std::string source;
+    std::vector<SiloCondition> conditions;     // in order of first appearance
+    std::vector<std::size_t> condition_of_row;
+    std::vector<double> rate_g_s;
+    std::vector<int> lines;                    // file line of each row
+    std::size_t rows() const { return rate_g_s.size(); }
+};
+const std::vector<std::string>& silo_measurement_columns();
+SiloMeasurements silo_measurements_from(const MeasuredData& data);
+SiloMeasurements read_silo_measurements(const std::string& path);
+
+struct DemDiagnoseOptions {
+    int grid_points = 5;        // coarse bracket: values evenly spaced over the bounds (search scale)
+    int refine_steps = 3;       // proposals of the surrogate's minimiser, each one set of runs (then the fitted value)
+    int prediction_seeds = 1;   // K: kernel runs (seeds) averaged per condition and value
+    double alpha = 0.01;        // family-wise error of the candidates' F tests (Holm)
+    double min_cv_gain = 0.05;  // least relative drop of the CV RMSE for an effect to be named
+    double interval_level = 0.95;
+};
+
+// Rates [g/s] the kernel predicts at each of `values` (outer) for each condition (inner, in SiloMeasurements order).
+using DemPredictor = std::function<std::vector<std::vector<double>>(const std::vector<double>& values)>;
+
+struct DemCandidateSetup {
+    DemEffectCandidate spec;
+    std::optional<double> declared;  // the material's value of the fields; none: not available
+    std::string unavailable;         // why not (field absent from the material, fields declared differently)
+    DemPredictor predict;
+};
+
+struct DemCandidateResult {
+    DemEffectCandidate spec;
+    bool available = true;
+    std::string unavailable;
+    double declared = NAN, fitted = NAN;
+    double interval_low = NAN, interval_high = NAN;
+    bool interval_at_lower_bound = false, interval_at_upper_bound = false;
+    std::vector<double> evaluated;          // values run, in order
+    std::vector<double> sse_of_runs;        // row SSE of log residuals with the raw runs at each evaluated value
+    double rmse_declared = NAN;             // surrogate at the declared value, log scale
+    double cv_rmse_declared = NAN;          // = rmse_declared (nothing fitted)
+    double rmse_fitted = NAN;               // raw runs at the fitted value
+    double cv_rmse = NAN;                   // leave one condition out: refit, predict it (surrogate)
+    double chi2_declared = NAN, chi2_fitted = NAN;
+    double f_statistic = NAN, p_value = NAN, p_holm = NAN;
+    bool significant = false, cv_gain = false, accepted = false;
+    std::vector<double> rates_fitted;       // raw runs at the fitted value, per condition [g/s]
+    std::vector<double> fitted_without;     // per condition: the value refitted without it (CV)
+};
+
+struct DemDiagnosis {
+    int n = 0, conditions = 0, df_pure_error = 0, prediction_seeds = 1;
+    double noise_sd = NAN;  // measured repeat scatter, log rate (~ relative)
+    std::vector<double> rates_declared;  // per condition [g/s]
+    double rmse_before = NAN, rmse_before_g_s = NAN, chi2_before = NAN, lack_of_fit_p_before = NAN;
+    std::vector<DemCandidateResult> candidates;
+    int effect = -1;  // index into candidates of the effect named, -1: none
+    double rmse_after = NAN, rmse_after_g_s = NAN, cv_rmse_after = NAN, lack_of_fit_p_after = NAN;
+    std::vector<double> rates_after;  // per condition [g/s] (= declared when no effect)
+    std::vector<std::string> warnings;
+    nlohmann::json to_json(const SiloMeasurements& data) const;
+};
+
+// Throws std::invalid_argument when the data cannot be diagnosed (fewer than 3 conditions, no repeats).
+DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double>& rates_declared,
+                          const std::vector<DemCandidateSetup>& candidates, const DemDiagnoseOptions& options);
+
+// Values of a candidate's search: `points` evenly spaced in its scale over [lower, upper].
+std::vector<double> candidate_grid(const DemEffectCandidate& c, int points);
+// A value as it is run: 4 significant digits, so that a cache key (the material) is stable across proposals.
+double run_value(double value);
+
+}  // namespace demcal::analytics

@@ -1,0 +1,234 @@
+#include "app/silo_campaign.hpp"
+
+#include "app/cli_support.hpp"
+#include "app/commands.hpp"
+#include "orchestrator/run_identity.hpp"  // write_text_file_atomically
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+extern char** environ;
+
+namespace demcal {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+volatile std::sig_atomic_t g_stop_requested = 0;
+extern "C" void request_campaign_stop(int) { g_stop_requested = 1; }
+
+// Starts this demcal with `args`, stdout and stderr appended to `log`; returns the child's pid.
+pid_t spawn_demcal(const std::vector<std::string>& args, const fs::path& log) {
+    std::vector<char*> argv;
+    // this very binary, even when the file was replaced since it started (a rebuild during a long sweep)
+    std::string self = "/proc/self/exe";
+    argv.push_back(self.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    posix_spawnattr_t attr;  // the run gets the default dispositions (it checkpoints on SIGINT/SIGTERM itself)
+    posix_spawnattr_init(&attr);
+    sigset_t defaults;
+    sigemptyset(&defaults);
+    sigaddset(&defaults, SIGINT);
+    sigaddset(&defaults, SIGTERM);
+    posix_spawnattr_setsigdefault(&attr, &defaults);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
+    pid_t pid = 0;
+    const int err = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    posix_spawnattr_destroy(&attr);
+    if (err != 0) throw std::runtime_error("cannot start " + self + ": " + std::strerror(err));
+    return pid;
+}
+
+int exit_status(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status); }
+
+double cpu_of(const rusage& u) {
+    return double(u.ru_utime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec) + double(u.ru_stime.tv_sec) +
+           1e-6 * double(u.ru_stime.tv_usec);
+}
+
+// `demcal silo --resume DIR` with the session options of the silo options (the rest is in the checkpoint).
+std::vector<std::string> resume_command(const fs::path& dir, const std::vector<std::string>& session_args) {
+    std::vector<std::string> a{"silo", "--resume", dir.string()};
+    for (std::size_t k = 0; k < session_args.size(); ++k) {
+        const std::string& arg = session_args[k];
+        if (arg == "--no-plots") a.push_back(arg);
+        if ((arg == "--threads" || arg == "--checkpoint-every" || arg == "--wall-limit") && k + 1 < session_args.size())
+            a.insert(a.end(), {arg, session_args[k + 1]});
+    }
+    return a;
+}
+
+std::vector<std::string> fresh_command(const SiloRunPlan& plan, const fs::path& out, bool check) {
+    std::vector<std::string> a{"silo"};
+    a.insert(a.end(), plan.silo_args.begin(), plan.silo_args.end());
+    a.insert(a.end(), {"--out", out.string()});
+    if (check) a.push_back("--check");
+    return a;
+}
+
+// Installs the stop handlers for the lifetime of a campaign call and puts the previous ones back.
+class StopHandlers {
+public:
+    StopHandlers() {
+        g_stop_requested = 0;
+        previous_int_ = std::signal(SIGINT, request_campaign_stop);
+        previous_term_ = std::signal(SIGTERM, request_campaign_stop);
+    }
+    ~StopHandlers() {
+        std::signal(SIGINT, previous_int_);
+        std::signal(SIGTERM, previous_term_);
+    }
+    StopHandlers(const StopHandlers&) = delete;
+    StopHandlers& operator=(const StopHandlers&) = delete;
+
+private:
+    void (*previous_int_)(int) = SIG_DFL;
+    void (*previous_term_)(int) = SIG_DFL;
+};
+
+}  // namespace
+
+std::string silo_number(double value) {
+    std::ostringstream s;
+    s << std::setprecision(17) << value;
+    return s.str();
+}
+
+void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const std::vector<std::string>& owned,
+                               const std::string& command) {
+    for (const std::string& a : silo_args)
+        for (const std::string& o : owned)
+            if (a == o || a.rfind(o + "=", 0) == 0)
+                throw UserError("silo option " + a + " after --: " + command + " sets it for every run");
+}
+
+void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
+    const fs::path scratch = fs::temp_directory_path() / ("demcal-silo-check-" + std::to_string(::getpid()));
+    const fs::path log = scratch.string() + ".log";
+    for (const SiloRunPlan& plan : plans) {
+        int status = 0;
+        const pid_t pid = spawn_demcal(fresh_command(plan, scratch / plan.name, true), log);
+        while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+        }
+        std::ifstream is(log);
+        std::stringstream text;
+        text << is.rdbuf();
+        is.close();
+        fs::remove(log);
+        if (exit_status(status) != 0) throw UserError("run " + plan.name + ": " + text.str().substr(0, 500));
+    }
+}
+
+void open_silo_campaign(const fs::path& dir, const json& settings, const std::string& command) {
+    const fs::path settings_file = dir / "campaign.json";
+    if (fs::exists(settings_file)) {
+        if (read_json_file(settings_file.string(), "campaign settings") != settings)
+            throw UserError("campaign = '" + dir.string() + "' holds a " + command + " campaign with other settings (" +
+                            settings_file.string() + "): give another --campaign, or the same settings to continue it");
+        return;
+    }
+    fs::create_directories(dir / "runs");
+    orchestrator::write_text_file_atomically(settings_file, settings.dump(1) + "\n");
+}
+
+std::optional<json> silo_run_summary(const fs::path& dir, const std::string& name) {
+    const fs::path summary = dir / "runs" / name / "summary.json";
+    if (!fs::exists(summary)) return std::nullopt;
+    return read_json_file(summary.string(), "run summary");
+}
+
+bool silo_run_failed(const fs::path& dir, const std::string& name) { return fs::exists(dir / "runs" / name / "failed"); }
+
+SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<SiloRunPlan>& plans,
+                                      const std::vector<std::string>& session_args, int jobs,
+                                      const std::string& command) {
+    StopHandlers handlers;
+    SiloCampaignOutcome outcome;
+    std::vector<const SiloRunPlan*> todo;
+    for (const SiloRunPlan& plan : plans) {
+        const fs::path rd = dir / "runs" / plan.name;
+        if (fs::exists(rd / "summary.json"))
+            ++outcome.finished;
+        else if (fs::exists(rd / "failed"))
+            ++outcome.failed;
+        else
+            todo.push_back(&plan);
+    }
+    std::map<pid_t, const SiloRunPlan*> running;
+    std::size_t next = 0;
+    bool signalled_children = false;
+    while (next < todo.size() || !running.empty()) {
+        const bool stopping = g_stop_requested || outcome.stopped;
+        while (!stopping && next < todo.size() && int(running.size()) < std::max(1, jobs)) {
+            const SiloRunPlan& plan = *todo[next++];
+            const fs::path rd = dir / "runs" / plan.name;
+            const bool resume = fs::exists(rd / "checkpoint.bin");
+            fs::create_directories(rd);
+            std::cout << "[" << outcome.finished + outcome.failed + running.size() + 1 << "/" << plans.size() << "] "
+                      << plan.name << (resume ? " (resumed)" : "") << std::endl;
+            running[spawn_demcal(resume ? resume_command(rd, session_args) : fresh_command(plan, rd, false),
+                                 rd / "silo.log")] = &plan;
+            ++outcome.started;
+        }
+        if (running.empty()) break;
+        if (g_stop_requested && !signalled_children) {
+            // Ctrl-C reaches the runs from the terminal too; a SIGTERM sent to this process alone must reach them.
+            for (const auto& [pid, plan] : running) ::kill(pid, SIGTERM);
+            signalled_children = true;
+        }
+        int status = 0;
+        rusage usage{};
+        const pid_t pid = ::wait4(-1, &status, 0, &usage);
+        if (pid < 0) {
+            if (errno == EINTR) continue;
+            throw std::runtime_error(command + ": waiting for the silo runs: " + std::strerror(errno));
+        }
+        const auto it = running.find(pid);
+        if (it == running.end()) continue;  // not one of ours
+        const SiloRunPlan& plan = *it->second;
+        running.erase(it);
+        outcome.cpu_seconds += cpu_of(usage);
+        const fs::path rd = dir / "runs" / plan.name;
+        const int rc = exit_status(status);
+        if (rc == 0) {
+            ++outcome.finished;
+            if (g_stop_requested) outcome.stopped = true;
+            continue;
+        }
+        if (rc == kExitResumeLater || rc == 128 + SIGINT || rc == 128 + SIGTERM || g_stop_requested) {
+            std::cout << "stopped at " << plan.name << " (exit " << rc << "); the same command continues the "
+                      << command << " campaign\n";
+            outcome.stopped = true;
+            continue;
+        }
+        std::ofstream(rd / "failed") << "exit status " << rc << "; see silo.log\n";
+        std::cerr << "demcal " << command << ": run " << plan.name << " failed (exit " << rc << "), see "
+                  << (rd / "silo.log") << "\n";
+        ++outcome.failed;
+    }
+    if (g_stop_requested) outcome.stopped = true;
+    return outcome;
+}
+
+}  // namespace demcal

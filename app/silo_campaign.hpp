@@ -1,0 +1,57 @@
+// A campaign of `demcal silo` runs, shared by the commands that sweep the silo case (demcal vibration, demcal diagnose
+// --model silo-dem): every run is a subprocess of this very demcal in DIR/runs/<name>/ (its own checkpoint, its own
+// summary.json), so a crash or Ctrl-C of one run loses nothing finished. Running a campaign again continues it:
+// finished runs (summary.json) are read, suspended ones (checkpoint.bin) resumed with `demcal silo --resume`, failed
+// ones (a `failed` marker) left alone, the rest run, up to `jobs` at a time.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace demcal {
+
+// One run: its folder name under DIR/runs/ and its `demcal silo` options except --out (which the campaign sets).
+struct SiloRunPlan {
+    std::string name;
+    std::vector<std::string> silo_args;  // e.g. {"--theta", "30", "--seed", "1", "--particles", "2000", ...}
+};
+
+// Refuses (UserError naming the option and `command`) a silo option after -- that the command sets for every run.
+void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const std::vector<std::string>& owned,
+                               const std::string& command);
+
+// Checks each plan's settings with `demcal silo --check` (nothing written); throws UserError naming the run and silo's
+// message. Call with the distinct settings only (repeats differing by seed need one check).
+void check_silo_runs(const std::vector<SiloRunPlan>& plans);
+
+// DIR/campaign.json: created with `settings` (and DIR/runs) when absent; when present it must hold the same settings,
+// else UserError (another campaign lives there). Call after every check of the input.
+void open_silo_campaign(const std::filesystem::path& dir, const nlohmann::json& settings, const std::string& command);
+
+struct SiloCampaignOutcome {
+    std::size_t finished = 0;  // with a summary.json (before or now)
+    std::size_t failed = 0;    // a `failed` marker (before or now)
+    std::size_t started = 0;   // runs started or resumed by this call
+    bool stopped = false;      // a signal or a run's suspension (exit 75) stopped the campaign: run it again
+    double cpu_seconds = 0;    // CPU time of the children this call waited for
+};
+
+// Runs what is left of `plans` in DIR/runs/<name>/, at most `jobs` at once; progress lines "[k/N] name" on stdout,
+// each run's output in its silo.log. `session_args` are silo options of the session (--threads, --no-plots, ...) that a
+// resumed run takes again (the rest is in its checkpoint). SIGINT/SIGTERM during the call: the running runs are sent
+// SIGTERM (they checkpoint and exit 75), the call waits for them and returns stopped.
+SiloCampaignOutcome run_silo_campaign(const std::filesystem::path& dir, const std::vector<SiloRunPlan>& plans,
+                                      const std::vector<std::string>& session_args, int jobs,
+                                      const std::string& command);
+
+// The summary.json of a finished run of DIR, if any.
+std::optional<nlohmann::json> silo_run_summary(const std::filesystem::path& dir, const std::string& name);
+bool silo_run_failed(const std::filesystem::path& dir, const std::string& name);
+
+// A number as a silo option: all 17 digits, so that the run gets exactly the value planned.
+std::string silo_number(double value);
+
+}  // namespace demcal

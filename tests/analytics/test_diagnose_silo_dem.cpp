@@ -1,0 +1,232 @@
+// demcal diagnose --model silo-dem: the measured-rate reader's refusals, the DEM candidate table, outputs checked
+// before any run, and end to end on a tiny silo: "measured" rates made by the kernel itself with the wall friction
+// raised get wall_friction named with an interval holding the truth; rates made with the declared material get nothing.
+// Real kernel runs through the demcal binary (300 grains, short windows).
+#include "analytics/dem_diagnosis.hpp"
+#include "test_files.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+namespace an = demcal::analytics;
+
+namespace {
+
+using demcal::test::read_file;
+
+an::SiloMeasurements parse(const std::string& csv) {
+    std::istringstream in(csv);
+    return an::silo_measurements_from(an::parse_csv(in, "m.csv"));
+}
+
+std::string refusal(const std::string& csv) {
+    try {
+        parse(csv);
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    }
+    return "(accepted)";
+}
+
+int demcal_run(const std::string& args, const fs::path& log) {
+    const std::string cmd = std::string("'") + DEMCAL_BINARY + "' " + args + " > '" + log.string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// The tiny silo of the CI: 300 grains in the reduced 70 mm silo, 1000 times softer contacts, 0.2 s of discharge.
+const std::string kTinySilo = "--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
+                              "/examples/silo/reduced_conical_70deg.json' --particles 300 --stiffness-scale 0.001 "
+                              "--fill-time 0.3 --max-time 0.2 --threads 1 --no-plots";
+const std::string kDeclared = std::string(DEMCAL_SOURCE_DIR) + "/examples/materials/silo_wheat_table21.json";
+
+}  // namespace
+
+TEST_CASE("silo-dem data: unknown and ill-formed columns and cells are refused naming the line and column",
+          "[diagnose][silo-dem]") {
+    const auto ok = parse("theta_deg,rate_g_s,replicate\n# a comment\n30,160,1\n30,163,2\n50,120.5,1\n");
+    CHECK(ok.rows() == 3);
+    CHECK(ok.conditions.size() == 2);
+    CHECK(ok.lines == std::vector<int>{3, 4, 5});
+    CHECK(ok.condition_of_row == std::vector<std::size_t>{0, 0, 1});
+    const auto geometry = parse("theta_deg,outlet_m,rate_g_s\n30,0.03,160\n30,0.035,200\n");
+    CHECK(geometry.conditions.size() == 2);
+    CHECK(geometry.conditions[1].label() == "theta30_outlet0.035");
+
+    struct Case {
+        std::string csv, message;
+    };
+    const std::vector<Case> cases{
+        {"theta_deg,rate_g_s,moisture\n30,160,2\n", "line 1, column moisture: unknown column"},
+        {"theta_deg,W_kg_s\n30,0.16\n", "line 1, column W_kg_s: unknown column"},
+        {"rate_g_s\n160\n", "column theta_deg is missing"},
+        {"theta_deg,rate_g_s\n30,fast\n", "line 2, column rate_g_s: value 'fast' is not a number"},
+        {"theta_deg,rate_g_s\n30,160\n95,100\n", "line 3, column theta_deg: value '95' must be in (0, 90)"},
+        {"theta_deg,rate_g_s\n30,-3\n", "line 2, column rate_g_s: value '-3' must be > 0 g/s"},
+        {"theta_deg,rate_g_s\n30,1e999\n", "line 2, column rate_g_s"},
+        {"theta_deg,rate_g_s\n30,nan\n", "line 2, column rate_g_s"},
+        {"theta_deg,outlet_m,rate_g_s\n30,0,160\n", "line 2, column outlet_m: value '0' must be > 0 m"},
+        {"theta_deg,rate_g_s\n30,160,5\n", "line 2"},
+        {"theta_deg,rate_g_s\n", "no data rows"}};
+    for (const auto& c : cases) {
+        INFO(c.csv);
+        CHECK_THAT(refusal(c.csv), Catch::Matchers::Contains(c.message));
+    }
+}
+
+TEST_CASE("silo-dem candidates: the table is sane, its defects are caught, and its grid spans its bounds",
+          "[diagnose][silo-dem]") {
+    const auto& table = an::dem_effect_candidates();
+    CHECK(an::candidate_table_defects(table).empty());
+    std::vector<std::string> names;
+    for (const auto& c : table) names.push_back(c.name);
+    CHECK(names == std::vector<std::string>{"rolling_friction", "wall_friction", "restitution"});
+    // the declared wheat lies inside every candidate's bounds, so each candidate is nested in the declared model
+    const auto material = nlohmann::json::parse(read_file(kDeclared));
+    for (const auto& c : table)
+        for (const auto& f : c.fields) {
+            const auto dot = f.find('.');
+            const double v = material.at(f.substr(0, dot)).at(f.substr(dot + 1)).get<double>();
+            INFO(c.name << " " << f);
+            CHECK(v > c.lower);
+            CHECK(v < c.upper);
+        }
+    // a later row (cohesion) and broken rows
+    auto extended = table;
+    extended.push_back({"cohesion", {"grain_grain.surface_energy_J_m2"}, 0, 0.5, an::ParameterScale::linear, "JKR"});
+    CHECK(an::candidate_table_defects(extended).empty());
+    auto broken = table;
+    broken.push_back({"wall_friction", {"grain_wall.friction"}, 0.5, 0.1, an::ParameterScale::log, ""});
+    broken.push_back({"shape", {"elongation"}, 0, 1, an::ParameterScale::log, ""});
+    // (the first broken row is also a log scale, but from 0.5 > 0: no defect of its own there)
+    const auto defects = an::candidate_table_defects(broken);
+    // name used twice, field in two rows, lower > upper; a field without an object, a log scale from 0
+    CHECK(defects.size() == 5);
+    const auto grid = an::candidate_grid(table[0], 5);  // log: 1e-3 .. 0.3 evenly in decades
+    REQUIRE(grid.size() == 5);
+    CHECK(grid.front() == Approx(1e-3));
+    CHECK(grid.back() == Approx(0.3));
+    CHECK(grid[2] == Approx(std::sqrt(1e-3 * 0.3)).epsilon(1e-3));
+    CHECK(an::run_value(0.123456) == 0.1235);
+}
+
+TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any run, naming them",
+          "[diagnose][silo-dem]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-dem-bad-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir / "folder");  // (tests run as root: a folder's permissions would not stop a write)
+    std::ofstream(dir / "m.csv") << "theta_deg,rate_g_s\n30,160\n30,162\n50,120\n70,100\n";
+    std::ofstream(dir / "few.csv") << "theta_deg,rate_g_s\n30,160\n30,162\n50,120\n";
+    const std::string data = " --data '" + (dir / "m.csv").string() + "'";
+    const std::string campaign = " --campaign '" + (dir / "never").string() + "'";
+    const std::string material = " --material '" + kDeclared + "'";
+    struct Case {
+        std::string args, message;
+    };
+    const std::vector<Case> cases{
+        {"--model silo-dem" + data + campaign + material + " --json '" + (dir / "folder").string() + "' -- " +
+             kTinySilo,
+         "--json = '" + (dir / "folder").string() + "' is a folder"},
+        {"--model silo-dem" + data + campaign + material + " --report '" + (dir / "m.csv/sub/r.md").string() +
+             "' -- " + kTinySilo,
+         "--report = '" + (dir / "m.csv/sub/r.md").string() + "': " + (dir / "m.csv").string() + " is a file, so the folder cannot be created"},
+        {"--model silo-dem" + data + campaign + " -- " + kTinySilo, "--material"},
+        {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --theta 30", "--theta"},
+        {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --stop-fraction 7", "stop_fraction"},
+        {"--model silo-dem --data '" + (dir / "few.csv").string() + "'" + campaign + material + " -- " + kTinySilo,
+         "at least 3 conditions"},
+        {"--model silo-dem" + data + campaign + " --material '" + (dir / "m.csv").string() + "' -- " + kTinySilo,
+         "--material"},
+        {"--model oldal" + data + material, "--material: only --model silo-dem"},
+        {"--model silo-dem" + data + campaign + material + " --drop-outliers -- " + kTinySilo,
+         "--drop-outliers: the analytical models take it"},
+        {"--model oldal --data '" + std::string(DEMCAL_SOURCE_DIR) + "/examples/diagnose/oldal_clean.csv' --json '" +
+             (dir / "folder").string() + "'",
+         "--json = '" + (dir / "folder").string() + "' is a folder"}};
+    for (const auto& c : cases) {
+        INFO(c.args);
+        CHECK(demcal_run("diagnose " + c.args, dir / "log") == 2);
+        INFO(read_file(dir / "log"));
+        CHECK_THAT(read_file(dir / "log"), Catch::Matchers::Contains(c.message));
+        CHECK_FALSE(fs::exists(dir / "never"));
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value inside the interval; the declared "
+          "material's own rates get nothing; the same command again runs nothing",
+          "[diagnose][silo-dem][slow]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-dem-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    // the "measured" sets: the kernel with the wall friction raised from 0.25 to 0.6, and with the declared material,
+    // seeds the predictions do not use
+    constexpr double kTrueWallFriction = 0.6;
+    auto material = nlohmann::json::parse(read_file(kDeclared));
+    material["grain_wall"]["friction"] = kTrueWallFriction;
+    std::ofstream(dir / "rough_wall.json") << material.dump(1);
+    const int angles[] = {20, 30, 40, 50, 60};
+    std::ofstream rough(dir / "rough.csv"), clean(dir / "clean.csv");
+    rough << "theta_deg,rate_g_s,replicate\n";
+    clean << "theta_deg,rate_g_s,replicate\n";
+    for (int theta : angles)
+        for (int seed : {101, 102, 103}) {
+            for (const auto& [file, name, out] :
+                 {std::tuple{(dir / "rough_wall.json").string(), std::string("rough"), &rough},
+                  std::tuple{kDeclared, std::string("clean"), &clean}}) {
+                const fs::path run = dir / "data" / (name + std::to_string(theta) + "_" + std::to_string(seed));
+                REQUIRE(demcal_run("silo --theta " + std::to_string(theta) + " --seed " + std::to_string(seed) +
+                                       " --material '" + file + "' --out '" + run.string() + "' " + kTinySilo,
+                                   dir / "silo.log") == 0);
+                const auto s = nlohmann::json::parse(read_file(run / "summary.json"));
+                *out << theta << "," << s["rate"]["rate_kg_s"].get<double>() * 1e3 << "," << seed - 100 << "\n";
+            }
+        }
+    rough.close();
+    clean.close();
+    const std::string common = " --material '" + kDeclared + "' --campaign '" + (dir / "campaign").string() +
+                               "' --jobs 2 --grid-points 4 --refine-steps 2 -- " + kTinySilo;
+
+    const auto start = std::chrono::steady_clock::now();
+    REQUIRE(demcal_run("diagnose --model silo-dem --data '" + (dir / "rough.csv").string() + "' --json '" +
+                           (dir / "rough.json").string() + "' --report '" + (dir / "report/rough.md").string() + "'" +
+                           common,
+                       dir / "rough.log") == 0);
+    INFO(read_file(dir / "rough.log"));
+    const auto r = nlohmann::json::parse(read_file(dir / "rough.json"));
+    REQUIRE(r["effect"].is_object());
+    CHECK(r["effect"]["name"] == "wall_friction");
+    CHECK(r["effect"]["interval"][0].get<double>() <= kTrueWallFriction);
+    CHECK(r["effect"]["interval"][1].get<double>() >= kTrueWallFriction);
+    CHECK(r["after"]["cv_rmse"].get<double>() < 0.95 * r["before"]["rmse"].get<double>());
+    CHECK(fs::exists(dir / "report/rough_residuals_after.png"));
+    CHECK_THAT(read_file(dir / "report/rough.md"), Catch::Matchers::Contains("**wall_friction**"));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    WARN("rough-wall diagnosis: " << seconds << " s wall, " << r["runs"]["run_now"] << " kernel runs");
+
+    REQUIRE(demcal_run("diagnose --model silo-dem --data '" + (dir / "clean.csv").string() + "' --json '" +
+                           (dir / "clean.json").string() + "'" + common,
+                       dir / "clean.log") == 0);
+    INFO(read_file(dir / "clean.log"));
+    const auto c = nlohmann::json::parse(read_file(dir / "clean.json"));
+    CHECK(c["effect"].is_null());
+    CHECK(c["after"]["rmse"] == c["before"]["rmse"]);
+
+    // the same command again: every run comes from the campaign
+    REQUIRE(demcal_run("diagnose --model silo-dem --data '" + (dir / "rough.csv").string() + "'" + common,
+                       dir / "again.log") == 0);
+    CHECK_THAT(read_file(dir / "again.log"), Catch::Matchers::Contains("0 run now"));
+    CHECK_THAT(read_file(dir / "again.log"), Catch::Matchers::Contains("DEM effect: wall_friction"));
+    fs::remove_all(dir);
+}
