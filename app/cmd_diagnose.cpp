@@ -280,7 +280,7 @@ struct DiagnoseArgs {
 
 // Options that only the silo-dem model takes, refused (named) with an analytical model.
 const char* const kSiloDemOptions[] = {"--material", "--campaign", "--jobs", "--seeds", "--first-seed", "--grid-points",
-                                       "--refine-steps"};
+                                       "--refine-steps", "--executor", "--partition"};
 // Options of the analytical search that silo-dem does not use (one effect from its table, no regimes or outliers yet):
 // refused rather than ignored.
 const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column", "--effective-friction-deg",
@@ -399,6 +399,10 @@ void add_discharge_commands(CLI::App& app) {
                          "command continues it and reruns nothing");
     diagnose->add_option("--jobs", dem.jobs, "silo-dem: kernel runs at once")->capture_default_str()->check(
         integer_in(1, 256));
+    diagnose->add_option("--executor", dem.executor, "silo-dem: local (processes) or slurm (job arrays)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"local", "slurm"}));
+    diagnose->add_option("--partition", dem.partition, "silo-dem: SLURM partition (--executor slurm)");
     diagnose->add_option("--seeds", dem.seeds, "silo-dem: kernel runs (seeds) averaged per condition and material")
         ->capture_default_str()
         ->check(integer_in(1, 20));

@@ -40,6 +40,8 @@ struct VibrationCli {
     long long first_seed = 1;
     std::string campaign;
     long max_runs = 10000;
+    int jobs = 1;  // runs at once: one locally (each takes the cores its --threads gives it), SLURM array slots
+    std::string executor = "local", partition;
     std::vector<std::string> silo_args;  // after --: passed to every `demcal silo`
 };
 
@@ -189,8 +191,8 @@ int run(const VibrationCli& o) {
     // every cell's settings checked by silo itself before anything is written (the repeats differ by seed only)
     check_silo_runs({plans.begin(), plans.begin() + std::ptrdiff_t(o.thetas.size() * o.frequencies.size())});
     open_silo_campaign(dir, campaign_settings(o), "vibration");
-    // one run at a time: the sweep's runs take the cores they are given with --threads
-    const SiloCampaignOutcome outcome = run_silo_campaign(dir, plans, o.silo_args, 1, "vibration");
+    const SiloCampaignOutcome outcome =
+        run_silo_campaign(dir, plans, o.silo_args, o.jobs, "vibration", {o.executor, o.partition});
     if (outcome.stopped) {
         report(o, dir, runs);
         return kExitResumeLater;
@@ -222,6 +224,14 @@ void add_vibration_command(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--first-seed", o->first_seed, "seed of the first repeat")->check(integer_in(0, 1LL << 62));
     sub->add_option("--campaign", o->campaign, "campaign directory (the same command continues it)")->required();
+    sub->add_option("--jobs", o->jobs, "runs at once (locally 1 by default: each run takes the cores --threads "
+                                       "gives it; on SLURM the array's slots)")
+        ->check(integer_in(1, 256))
+        ->capture_default_str();
+    sub->add_option("--executor", o->executor, "local (processes of this machine) or slurm (job arrays)")
+        ->check(CLI::IsMember({"local", "slurm"}))
+        ->capture_default_str();
+    sub->add_option("--partition", o->partition, "SLURM partition (--executor slurm)");
     sub->add_option("--max-runs", o->max_runs, "most runs the sweep may plan (a guard against typos)")
         ->check(integer_in(1, 100000000))
         ->capture_default_str();

@@ -11,7 +11,8 @@ namespace demcal {
 
 struct SiloDemArgs {
     std::string data, material, campaign, json_out, report_out;
-    int jobs = 1;
+    int jobs = 1;             // runs at once (processes here, or SLURM array tasks)
+    std::string executor = "local", partition;  // local | slurm (app/silo_campaign.hpp), SLURM partition
     int seeds = 1;            // prediction seeds per condition and material
     long long first_seed = 1;
     int grid_points = 5, refine_steps = 3;

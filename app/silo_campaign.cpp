@@ -2,7 +2,10 @@
 
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "orchestrator/executor.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
+#include "orchestrator/shear_campaign.hpp"  // pinned_program
+#include "orchestrator/slurm_executor.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -160,10 +163,71 @@ std::optional<json> silo_run_summary(const fs::path& dir, const std::string& nam
 
 bool silo_run_failed(const fs::path& dir, const std::string& name) { return fs::exists(dir / "runs" / name / "failed"); }
 
+namespace {
+
+// The run's end as the campaign records it: finished, stopped (resume later), or failed (a marker; left alone).
+void record_run_end(const fs::path& rd, const std::string& name, int rc, bool stop_requested,
+                    const std::string& log, const std::string& command, SiloCampaignOutcome& outcome) {
+    if (rc == 0) {
+        ++outcome.finished;
+        if (stop_requested) outcome.stopped = true;
+        return;
+    }
+    if (rc == kExitResumeLater || rc == 128 + SIGINT || rc == 128 + SIGTERM || stop_requested) {
+        std::cout << "stopped at " << name << " (exit " << rc << "); the same command continues the " << command
+                  << " campaign\n";
+        outcome.stopped = true;
+        return;
+    }
+    std::ofstream(rd / "failed") << "exit status " << rc << "; see " << log << "\n";
+    std::cerr << "demcal " << command << ": run " << name << " failed (exit " << rc << "), see " << (rd / log) << "\n";
+    ++outcome.failed;
+}
+
+// The runs left as SLURM array tasks (orchestrator::SlurmExecutor: sbatch, squeue, the tasks' exit_status files).
+void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& todo, std::size_t total,
+                  const std::vector<std::string>& session_args, int jobs, const std::string& command,
+                  const SiloCampaignExecutor& where, SiloCampaignOutcome& outcome) {
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) throw std::runtime_error(command + ": cannot find this program's own path (/proc/self/exe)");
+    const std::string program = orchestrator::pinned_program(self.string(), dir / ".program");
+    std::vector<orchestrator::Job> queue;
+    for (const SiloRunPlan* plan : todo) {
+        const fs::path rd = dir / "runs" / plan->name;
+        const bool resume = fs::exists(rd / "checkpoint.bin");
+        fs::create_directories(rd);
+        std::vector<std::string> argv{program};
+        const auto args = resume ? resume_command(rd, session_args) : fresh_command(*plan, rd, false);
+        argv.insert(argv.end(), args.begin(), args.end());
+        queue.push_back({plan->name, rd, argv, where.time_limit_s});
+    }
+    orchestrator::SlurmExecutor executor(std::max(1, jobs), dir / "slurm", where.partition);
+    orchestrator::InterruptGuard interrupts;  // Ctrl-C / SIGTERM: the executor cancels the tasks (they checkpoint)
+    std::size_t next = 0;
+    executor.run([&]() -> std::optional<orchestrator::Job> {
+                     if (next >= queue.size()) return std::nullopt;
+                     return queue[next++];
+                 },
+                 {[&](const orchestrator::Job& job, long handle) {
+                      std::cout << "[" << outcome.finished + outcome.failed + ++outcome.started << "/" << total
+                                << "] " << job.id << " (SLURM task " << handle / orchestrator::SlurmExecutor::kTaskBase
+                                << "_" << handle % orchestrator::SlurmExecutor::kTaskBase << ")" << std::endl;
+                  },
+                  [&](const orchestrator::Job& job, const orchestrator::JobOutcome& o) {
+                      outcome.cpu_seconds += o.cpu_s;
+                      const int rc = o.timed_out ? kExitResumeLater : o.exit_code >= 0 ? o.exit_code : 128 + o.term_signal;
+                      record_run_end(job.dir, job.id, rc, o.interrupted || orchestrator::interrupted(), "stderr.log",
+                                     command, outcome);
+                  }});
+    if (orchestrator::interrupted()) outcome.stopped = true;
+}
+
+}  // namespace
+
 SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<SiloRunPlan>& plans,
                                       const std::vector<std::string>& session_args, int jobs,
-                                      const std::string& command) {
-    StopHandlers handlers;
+                                      const std::string& command, const SiloCampaignExecutor& where) {
     SiloCampaignOutcome outcome;
     std::vector<const SiloRunPlan*> todo;
     for (const SiloRunPlan& plan : plans) {
@@ -175,6 +239,13 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
         else
             todo.push_back(&plan);
     }
+    if (where.executor == "slurm") {
+        run_on_slurm(dir, todo, plans.size(), session_args, jobs, command, where, outcome);
+        return outcome;
+    }
+    if (where.executor != "local")
+        throw UserError("executor = '" + where.executor.substr(0, 40) + "': local or slurm");
+    StopHandlers handlers;
     std::map<pid_t, const SiloRunPlan*> running;
     std::size_t next = 0;
     bool signalled_children = false;
@@ -209,23 +280,8 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
         const SiloRunPlan& plan = *it->second;
         running.erase(it);
         outcome.cpu_seconds += cpu_of(usage);
-        const fs::path rd = dir / "runs" / plan.name;
-        const int rc = exit_status(status);
-        if (rc == 0) {
-            ++outcome.finished;
-            if (g_stop_requested) outcome.stopped = true;
-            continue;
-        }
-        if (rc == kExitResumeLater || rc == 128 + SIGINT || rc == 128 + SIGTERM || g_stop_requested) {
-            std::cout << "stopped at " << plan.name << " (exit " << rc << "); the same command continues the "
-                      << command << " campaign\n";
-            outcome.stopped = true;
-            continue;
-        }
-        std::ofstream(rd / "failed") << "exit status " << rc << "; see silo.log\n";
-        std::cerr << "demcal " << command << ": run " << plan.name << " failed (exit " << rc << "), see "
-                  << (rd / "silo.log") << "\n";
-        ++outcome.failed;
+        record_run_end(dir / "runs" / plan.name, plan.name, exit_status(status), g_stop_requested, "silo.log", command,
+                       outcome);
     }
     if (g_stop_requested) outcome.stopped = true;
     return outcome;

@@ -39,13 +39,24 @@ struct SiloCampaignOutcome {
     double cpu_seconds = 0;    // CPU time of the children this call waited for
 };
 
+// Where a campaign's runs go: processes of this machine, or SLURM job arrays (one array task per run, at most `jobs`
+// at once), for sweeps that outgrow one machine. On SLURM each task runs a copy of this demcal pinned in
+// DIR/.program/ (a rebuild during the campaign changes nothing), its output in the run folder's stdout.log and
+// stderr.log, under a SLURM time limit of `time_limit_s` (a run that reaches it checkpoints on SLURM's SIGTERM and
+// the same command resumes it).
+struct SiloCampaignExecutor {
+    std::string executor = "local";  // local | slurm
+    std::string partition;           // SLURM partition; empty: the default one
+    double time_limit_s = 86400;     // SLURM only
+};
+
 // Runs what is left of `plans` in DIR/runs/<name>/, at most `jobs` at once; progress lines "[k/N] name" on stdout,
 // each run's output in its silo.log. `session_args` are silo options of the session (--threads, --no-plots, ...) that a
 // resumed run takes again (the rest is in its checkpoint). SIGINT/SIGTERM during the call: the running runs are sent
 // SIGTERM (they checkpoint and exit 75), the call waits for them and returns stopped.
 SiloCampaignOutcome run_silo_campaign(const std::filesystem::path& dir, const std::vector<SiloRunPlan>& plans,
                                       const std::vector<std::string>& session_args, int jobs,
-                                      const std::string& command);
+                                      const std::string& command, const SiloCampaignExecutor& where = {});
 
 // The summary.json of a finished run of DIR, if any.
 std::optional<nlohmann::json> silo_run_summary(const std::filesystem::path& dir, const std::string& name);

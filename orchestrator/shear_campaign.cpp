@@ -171,21 +171,6 @@ void write_kernel_run_directory(const PlannedRun& r, const EngineSetup& engine) 
     write_params(r);
 }
 
-// The kernel engine's program is copied into the campaign (DIR/.kernel-engine/, replaced atomically when it
-// changed): a rebuild of demcal while a campaign runs then neither fails the runs it starts ("cannot start:
-// permission denied" while the linker writes the file: measured, an overnight campaign stopped at 182 of 300 runs)
-// nor mixes two builds within one campaign call.
-std::string pinned_program(const std::string& program, const fs::path& dir) {
-    fs::create_directories(dir);
-    const fs::path copy = dir / fs::path(program).filename();
-    const std::string bytes = read_text_file(program);
-    if (fs::exists(copy) && fs::file_size(copy) == bytes.size() && read_text_file(copy) == bytes) return copy.string();
-    write_text_file_atomically(copy, bytes);
-    fs::permissions(copy, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
-                              fs::perms::others_read | fs::perms::others_exec);
-    return copy.string();
-}
-
 EngineSetup engine_setup(const ShearCampaignSpec& spec, const ExecutionOptions& o) {
     if (spec.engine == ShearEngine::kernel) {
         if (o.kernel_command.empty() || o.kernel_engine.empty())
@@ -227,6 +212,17 @@ std::unique_ptr<Executor> make_executor(const ExecutionOptions& o, const fs::pat
 }
 
 }  // namespace
+
+std::string pinned_program(const std::string& program, const fs::path& dir) {
+    fs::create_directories(dir);
+    const fs::path copy = dir / fs::path(program).filename();
+    const std::string bytes = read_text_file(program);
+    if (fs::exists(copy) && fs::file_size(copy) == bytes.size() && read_text_file(copy) == bytes) return copy.string();
+    write_text_file_atomically(copy, bytes);
+    fs::permissions(copy, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                              fs::perms::others_read | fs::perms::others_exec);
+    return copy.string();
+}
 
 void check_run_count(double runs, long max_runs, const std::string& breakdown) {
     if (runs > static_cast<double>(max_runs))

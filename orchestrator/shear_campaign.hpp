@@ -39,6 +39,12 @@ struct ShearCampaignSpec {
     static ShearCampaignSpec from_json(const nlohmann::json& j);
 };
 
+// A copy of `program` in `dir` (replaced atomically when it changed), returned as the path to run: a rebuild of the
+// program while a campaign runs then neither fails the runs it starts ("cannot start: permission denied" while the
+// linker writes the file: measured, an overnight campaign stopped at 182 of 300 runs) nor mixes two builds within one
+// campaign call. Used for the kernel engine (DIR/.kernel-engine/) and the silo campaigns' SLURM tasks.
+std::string pinned_program(const std::string& program, const std::filesystem::path& dir);
+
 struct ExecutionOptions {
     int jobs = 0;                 // parallel runs; 0 = the number of cores
     double timeout_s = 3600;      // per run

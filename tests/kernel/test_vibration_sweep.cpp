@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -80,5 +81,35 @@ TEST_CASE("demcal vibration: bad input exits 2 naming it before anything is writ
     CHECK_THAT(demcal::test::read_file(dir / "log"), Catch::Matchers::Contains(expect));
     CHECK_FALSE(fs::exists(dir / "never"));
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("demcal vibration --executor slurm: the sweep's runs as SLURM array tasks give the local sweep's rates",
+          "[silo][vibration][slurm]") {
+  if (::geteuid() != 0) {
+    WARN("not root: cannot start SLURM daemons here, skipped");
+    return;
+  }
+  const std::string source = DEMCAL_SOURCE_DIR;
+  const fs::path dir = fs::temp_directory_path() / ("demcal-test-vibration-slurm-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string sweep = "vibration --theta 45 --frequency 0,100 --amplitude 1.1e-4 --repeats 1 ";
+  REQUIRE(demcal_run(sweep + "--campaign '" + (dir / "local").string() + "' -- " + kTiny, dir / "local.log") == 0);
+  const bool already_up = std::system("sinfo -h -o %T 2>/dev/null | grep -qE '^idle|^mixed'") == 0;
+  if (!already_up) REQUIRE(std::system(("bash " + source + "/scripts/slurm/slurm_up.sh >/dev/null").c_str()) == 0);
+  const int rc = demcal_run(sweep + "--executor slurm --jobs 2 --campaign '" + (dir / "slurm").string() + "' -- " + kTiny,
+                            dir / "slurm.log");
+  if (!already_up) std::system(("bash " + source + "/scripts/slurm/slurm_down.sh >/dev/null").c_str());
+  INFO(demcal::test::read_file(dir / "slurm.log"));
+  REQUIRE(rc == 0);
+  CHECK_THAT(demcal::test::read_file(dir / "slurm.log"), Catch::Matchers::Contains("SLURM task"));
+  const auto local = nlohmann::json::parse(demcal::test::read_file(dir / "local" / "vibration.json"));
+  const auto slurm = nlohmann::json::parse(demcal::test::read_file(dir / "slurm" / "vibration.json"));
+  REQUIRE(slurm["runs"].size() == 2);
+  CHECK(slurm["runs"] == local["runs"]);  // the same runs, bit for bit, wherever they ran
+  // each task ran the program pinned in the campaign, its log in the run folder
+  CHECK(fs::exists(dir / "slurm" / ".program" / "demcal"));
+  CHECK(fs::exists(dir / "slurm" / "runs" / "theta45_f100_seed1" / "stdout.log"));
   fs::remove_all(dir);
 }
