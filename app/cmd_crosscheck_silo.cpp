@@ -12,6 +12,7 @@
 #include "orchestrator/executor.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
+#include "orchestrator/slurm_executor.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -21,6 +22,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <thread>
 
@@ -42,6 +44,7 @@ struct SiloCrosscheckOptions {
     double max_time = 10;
     std::string dir = "campaigns/crosscheck-silo";
     int jobs = 0;
+    std::string executor = "local", partition;  // local | slurm (array tasks), SLURM partition
     double timeout_s = 7200;
     std::string yade = "yade";
     std::string plot_format = "png";
@@ -221,6 +224,9 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     for (double theta : o.thetas) check_kernel_run(kernel_argv(o, theta, "out", "bed.json", self), theta);
     const fs::path root = fs::absolute(o.dir).lexically_normal();
     fs::create_directories(root);
+    // the kernel runs start a copy of this program kept in the campaign: a rebuild while they run (or wait in a SLURM
+    // queue) neither fails them nor mixes two builds
+    const std::string program = orchestrator::pinned_program(self, root / ".program");
     const std::string script_text = orchestrator::read_text_file(script);
 
     // 1. the kernel fills and discharges at every angle, writing its bed at the opening
@@ -229,7 +235,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     for (double theta : o.thetas) {
         const fs::path d = root / theta_name(theta);
         fs::create_directories(d / "kernel");
-        const auto argv = kernel_argv(o, theta, d / "kernel", d / "bed.json", self);
+        const auto argv = kernel_argv(o, theta, d / "kernel", d / "bed.json", program);
         std::string id = "demcal silo";
         for (std::size_t i = 1; i < argv.size(); ++i) id += " " + argv[i];
         if (!o.material.empty()) id += "\nmaterial " + orchestrator::sha256_hex(orchestrator::read_text_file(o.material));
@@ -242,7 +248,11 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     }
     const int slots = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
     auto run_jobs = [&](std::deque<orchestrator::Job> queue, const std::map<std::string, std::string>& identities) {
-        orchestrator::LocalExecutor executor(slots);
+        std::unique_ptr<orchestrator::Executor> executor;
+        if (o.executor == "slurm")
+            executor = std::make_unique<orchestrator::SlurmExecutor>(slots, root / "slurm", o.partition);
+        else
+            executor = std::make_unique<orchestrator::LocalExecutor>(slots);
         orchestrator::ExecutorEvents events;
         events.started = [](const orchestrator::Job& j, long) { std::cout << "started  " << j.id << std::endl; };
         events.finished = [&](const orchestrator::Job& j, const orchestrator::JobOutcome& r) {
@@ -251,7 +261,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
             if (r.succeeded()) orchestrator::write_text_file_atomically(j.dir / "IDENTITY", identities.at(j.id));
         };
         orchestrator::InterruptGuard guard;
-        executor.run(
+        executor->run(
             [&]() -> std::optional<orchestrator::Job> {
                 if (queue.empty()) return std::nullopt;
                 auto j = queue.front();
@@ -395,6 +405,10 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
     silo->add_option("--campaign,-c", o->dir, "output directory (runs reused from it)")->capture_default_str();
     silo->add_option("--jobs,-j", o->jobs, "runs in parallel (0 = one per core)")->check(non_negative_number());
     silo->add_option("--timeout", o->timeout_s, "per-run wall-clock limit [s]")->check(positive_number());
+    silo->add_option("--executor", o->executor, "local (processes of this machine) or slurm (job arrays)")
+        ->check(CLI::IsMember({"local", "slurm"}))
+        ->capture_default_str();
+    silo->add_option("--partition", o->partition, "SLURM partition (--executor slurm)");
     silo->add_option("--yade", o->yade, "YADE launcher");
     silo->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (a guard against typos)")

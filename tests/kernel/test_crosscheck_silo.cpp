@@ -70,3 +70,33 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     CHECK_FALSE(fs::exists(dir / "bad"));
     fs::remove_all(dir);
 }
+
+TEST_CASE("crosscheck silo --executor slurm: both codes' runs as SLURM array tasks give the local report's rates",
+          "[yade][slurm]") {
+    if (::geteuid() != 0) {
+        WARN("not root: cannot start SLURM daemons here, skipped");
+        return;
+    }
+    const std::string source = DEMCAL_SOURCE_DIR;
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-xsilo-slurm-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string args = "crosscheck silo --theta 45 --particles 300 --stiffness-scale 1e-3 --geometry '" +
+                             (fs::path(source) / "examples/silo/reduced_conical_70deg.json").string() +
+                             "' --max-time 3 --jobs 1 ";
+    REQUIRE(run_demcal(args + "-c '" + (dir / "local").string() + "'", dir / "local.log") == 0);
+    const bool already_up = std::system("sinfo -h -o %T 2>/dev/null | grep -qE '^idle|^mixed'") == 0;
+    if (!already_up) REQUIRE(std::system(("bash " + source + "/scripts/slurm/slurm_up.sh >/dev/null").c_str()) == 0);
+    const int rc = run_demcal(args + "--executor slurm -c '" + (dir / "slurm").string() + "'", dir / "slurm.log");
+    if (!already_up) std::system(("bash " + source + "/scripts/slurm/slurm_down.sh >/dev/null").c_str());
+    INFO(read_file(dir / "slurm.log"));
+    REQUIRE(rc == 0);
+    const auto local = nlohmann::json::parse(read_file(dir / "local" / "crosscheck_silo.json"));
+    const auto slurm = nlohmann::json::parse(read_file(dir / "slurm" / "crosscheck_silo.json"));
+    // the same bed (the kernel is deterministic) and the same YADE discharge of it, wherever they ran
+    CHECK(slurm["angles"][0]["kernel"]["rate_kg_s"] == local["angles"][0]["kernel"]["rate_kg_s"]);
+    CHECK(slurm["angles"][0]["yade"]["rate_kg_s"] == local["angles"][0]["yade"]["rate_kg_s"]);
+    CHECK(fs::exists(dir / "slurm" / "slurm"));     // the executor's batch scripts
+    CHECK(fs::exists(dir / "slurm" / ".program"));  // the pinned program the kernel tasks ran
+    fs::remove_all(dir);
+}
