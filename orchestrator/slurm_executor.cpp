@@ -62,6 +62,21 @@ void write_task_script(const Job& job) {
       << "echo \"$code $start $end $cpu\" > exit_status.tmp && mv exit_status.tmp exit_status\nexit $code\n";
     write_text_file_atomically(job.dir / "run.sh", s.str());
     fs::permissions(job.dir / "run.sh", fs::perms::owner_all | fs::perms::group_read | fs::perms::others_read);
+    // a previous attempt's record (it may have appeared after that attempt was given up) is not this attempt's: the
+    // task's own `rm -f` comes only when it starts, and the poll would read the old file while this one waits
+    std::error_code ec;
+    fs::remove(job.dir / "exit_status", ec);
+}
+
+// The task's own record of how it ended (run.sh's last line, renamed into place), if it is there.
+bool read_exit_status(const Job& job, JobOutcome& o) {
+    std::ifstream st(job.dir / "exit_status");
+    double start = 0, end = 0, cpu = 0;
+    if (!(st >> o.exit_code >> start >> end >> cpu)) return false;
+    o.wall_s = end - start;
+    o.cpu_s = cpu;
+    read_failure_from_stderr(job.dir / "stderr.log", o);
+    return true;
 }
 
 // Task index -> SLURM state for an array job, from `squeue -r` (one line per task; finished tasks stay listed for
@@ -142,19 +157,15 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
         for (std::size_t i = 0; i < tasks.size();) {
             Task& t = tasks[i];
             JobOutcome o;
-            bool ended = false;
-            std::ifstream st(t.job.dir / "exit_status");
-            double start = 0, end = 0, cpu = 0;
-            if (st >> o.exit_code >> start >> end >> cpu) {
-                ended = true;
-                o.wall_s = end - start;
-                o.cpu_s = cpu;
-                read_failure_from_stderr(t.job.dir / "stderr.log", o);
-            } else {
+            bool ended = read_exit_status(t.job, o);
+            if (!ended) {
                 if (!states.count(t.array_id)) states[t.array_id] = array_task_states(t.array_id);
                 const auto& s = states[t.array_id];
                 const auto it = s.find(t.index);
-                if (it != s.end() && is_terminal(it->second)) {
+                // a task that ended between the file's read and SLURM's answer left its record by then: read again
+                if (it != s.end() && is_terminal(it->second) && read_exit_status(t.job, o)) {
+                    ended = true;
+                } else if (it != s.end() && is_terminal(it->second)) {
                     ended = true;
                     o.exit_code = -1;
                     o.timed_out = it->second == "TIMEOUT";
