@@ -7,6 +7,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/silo_material.hpp"
+#include "app/silo_settings.hpp"
 #include "app/gnuplot.hpp"
 #include "analytics/user_input.hpp"
 #include "orchestrator/executor.hpp"
@@ -165,30 +166,20 @@ void write_curve_plot(const fs::path& dir, double theta, const std::vector<Curve
     render_gnuplot(dir / ("mass_time." + format), s.str());
 }
 
-// The kernel run of one angle checked by `demcal silo --check` in this process (the very parser and checks the run
-// will meet), before the campaign folder exists: a setting the silo refuses (a material, a time limit, a particle
-// count) was found only once the runs had started. The output options are left out: their folders come later.
-void check_kernel_run(std::vector<std::string> argv, double theta) {
-    for (const char* option : {"--out", "--export-bed"}) {
-        const auto it = std::find(argv.begin(), argv.end(), option);
-        if (it != argv.end()) argv.erase(it, it + 2);
+// The kernel run of one angle checked by demcal silo's own parser and checks (silo_case_settings), before the
+// campaign folder exists: a setting the silo refuses (a material, a time limit, a particle count) was found only once
+// the runs had started. The run's outputs and sessions (--out, --export-bed, --no-plots, --no-checkpoint) are this
+// command's: the settings alone are checked.
+void check_kernel_run(const SiloCrosscheckOptions& o, double theta) {
+    const std::vector<std::string> argv = kernel_argv(o, theta, "out", "bed.json", "demcal");
+    std::vector<std::string> settings;
+    for (std::size_t i = 2; i < argv.size(); ++i) {  // after the program and "silo"
+        if (argv[i] == "--out" || argv[i] == "--export-bed") ++i;
+        else if (argv[i] != "--no-plots" && argv[i] != "--no-checkpoint") settings.push_back(argv[i]);
     }
-    argv.erase(argv.begin());  // the program
-    argv.push_back("--check");
-    std::reverse(argv.begin(), argv.end());  // CLI11 takes the arguments last first
-    CLI::App app;
-    add_silo_command(app);
-    refuse_empty_values(app);
-    std::ostringstream quiet;  // "the settings are valid", once per angle: not news
-    auto* const previous = std::cout.rdbuf(quiet.rdbuf());
     try {
-        app.parse(argv);
-        std::cout.rdbuf(previous);
-    } catch (const CLI::ParseError& e) {
-        std::cout.rdbuf(previous);
-        throw UserError("theta = " + g(theta) + ": the kernel run refuses its settings: " + e.what());
+        silo_case_settings(settings, "demcal crosscheck silo");
     } catch (const std::exception& e) {
-        std::cout.rdbuf(previous);
         throw UserError("theta = " + g(theta) + ": the kernel run refuses its settings: " + e.what());
     }
 }
@@ -221,7 +212,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
                             "has no JKR cohesion to match the kernel's; cross-check cohesionless materials");
     if (!o.geometry.empty()) analytics::read_json_input(o.geometry, "geometry");
     const json yade_material = o.yade_material.empty() ? json() : analytics::read_json_input(o.yade_material, "yade-material");
-    for (double theta : o.thetas) check_kernel_run(kernel_argv(o, theta, "out", "bed.json", self), theta);
+    for (double theta : o.thetas) check_kernel_run(o, theta);
     const fs::path root = fs::absolute(o.dir).lexically_normal();
     fs::create_directories(root);
     // the kernel runs start a copy of this program kept in the campaign: a rebuild while they run (or wait in a SLURM
@@ -248,11 +239,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     }
     const int slots = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
     auto run_jobs = [&](std::deque<orchestrator::Job> queue, const std::map<std::string, std::string>& identities) {
-        std::unique_ptr<orchestrator::Executor> executor;
-        if (o.executor == "slurm")
-            executor = std::make_unique<orchestrator::SlurmExecutor>(slots, root / "slurm", o.partition);
-        else
-            executor = std::make_unique<orchestrator::LocalExecutor>(slots);
+        const auto executor = orchestrator::make_executor(o.executor, slots, root / "slurm", o.partition);
         orchestrator::ExecutorEvents events;
         events.started = [](const orchestrator::Job& j, long) { std::cout << "started  " << j.id << std::endl; };
         events.finished = [&](const orchestrator::Job& j, const orchestrator::JobOutcome& r) {

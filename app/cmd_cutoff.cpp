@@ -65,18 +65,15 @@ std::pair<double, double> parse_bracket(const std::string& text) {
     return {ends[0], ends[1]};
 }
 
-// Bisections that halve HI - LO down to the tolerance: below 2^-30 of the bracket the frequencies no longer differ
-// in any digit a run could resolve, and near 2^-52 the midpoint equals an end and the search never ends.
-constexpr int kMaxBisections = 30;
-
 // The runs the search may make (both ends, then every bisection, each with every seed), refused above --max-runs
-// before the first run; a tolerance finer than the bisection bound is refused by name.
+// before the first run; a tolerance finer than the search's bisection bound (kc::kMaxBisections) is refused naming
+// the option.
 void check_search_size(const kc::CutoffSearch& s, long max_runs) {
     const double width = s.hi - s.lo;
     if (!(width > 0) || !(s.tol > 0) || s.tol >= width) return;  // kc::validate names these
-    if (s.tol < std::ldexp(width, -kMaxBisections))
+    if (s.tol < std::ldexp(width, -kc::kMaxBisections))
         throw UserError("--tol = " + analytics::number_text(s.tol) + " Hz: finer than 2^-" +
-                        std::to_string(kMaxBisections) + " of the bracket (" + analytics::number_text(width) +
+                        std::to_string(kc::kMaxBisections) + " of the bracket (" + analytics::number_text(width) +
                         " Hz), more bisections than frequencies a run can tell apart");
     const int bisections = static_cast<int>(std::ceil(std::log2(width / s.tol)));
     orchestrator::check_run_count(static_cast<double>(2 + bisections) * s.seeds.size(), max_runs,
@@ -247,8 +244,9 @@ void add_cutoff_command(CLI::App& app) {
     sub->add_option("silo_args", o->silo_args,
                     "after --: search in the silo case instead, with these demcal silo options (a cohesive --material, "
                     "--theta, --geometry, --particles, --stiffness-scale, ...)");
-    sub->footer("Silo: demcal cutoff --amplitude 1.1e-4 --bracket 0,400 --tol 25 --seeds 1,2 -- --material "
-                "examples/materials/silo_meal.json --theta 30 --particles 3000 --stiffness-scale 0.001 --fill-time 0.5");
+    sub->footer("Silo (the measured search of examples/cohesive_arch/README.md): demcal cutoff --amplitude 1.1e-4 "
+                "--bracket 0,400 --tol 25 --seeds 1,2 -- --material examples/materials/silo_meal.json --theta 30 "
+                "--particles 2000 --stiffness-scale 0.01 --fill-time 0.5");
     sub->callback([o, sub] {
         const int status = run(*o, *sub);
         if (status != 0) throw CLI::RuntimeError(status);

@@ -8,7 +8,6 @@
 #include "app/silo_settings.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
-#include "kernel/silo/wheat.hpp"  // the Rayleigh step of the run size
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <nlohmann/json.hpp>
@@ -308,10 +307,7 @@ constexpr double kMaxSiloSteps = 1e9;
 constexpr double kMaxVtkSnapshots = 1e5;
 
 void check_run_size(const ks::SiloCaseSettings& s) {
-    double smallest_radius = 1;
-    for (const auto& sphere : ks::wheat_clump()) smallest_radius = std::min(smallest_radius, sphere.radius);
-    const double rayleigh = ks::rayleigh_time_step(s.materials.wheat_scaled(), smallest_radius);
-    const double dt = s.time_step > 0 ? s.time_step : s.time_step_fraction * rayleigh;
+    const double dt = ks::planned_time_step(s);
     const double simulated = s.fill_time_max + s.max_time;
     const double steps = simulated / dt;
     if (!(steps <= kMaxSiloSteps)) {

@@ -116,7 +116,7 @@ public:
                     const double rate = summary ? summary->at("rate").value("rate_kg_s", NAN) * 1e3 : NAN;
                     if (!(rate > 0))
                         throw std::runtime_error("run " + name + (summary ? " gave no discharge rate" : " failed") +
-                                                 " (see " + (dir_ / "runs" / name / "silo.log").string() +
+                                                 " (see its log in " + (dir_ / "runs" / name).string() +
                                                  "); a failed run is not retried: remove its folder to run it again");
                     sum += rate;
                 }

@@ -202,10 +202,10 @@ void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& to
         argv.insert(argv.end(), args.begin(), args.end());
         queue.push_back({plan->name, rd, argv, where.time_limit_s});
     }
-    orchestrator::SlurmExecutor executor(std::max(1, jobs), dir / "slurm", where.partition);
+    const auto executor = orchestrator::make_executor("slurm", std::max(1, jobs), dir / "slurm", where.partition);
     orchestrator::InterruptGuard interrupts;  // Ctrl-C / SIGTERM: the executor cancels the tasks (they checkpoint)
     std::size_t next = 0;
-    executor.run([&]() -> std::optional<orchestrator::Job> {
+    executor->run([&]() -> std::optional<orchestrator::Job> {
                      if (next >= queue.size()) return std::nullopt;
                      return queue[next++];
                  },

@@ -206,9 +206,7 @@ bool retry_is_pointless(const std::string& cause) {
 
 std::unique_ptr<Executor> make_executor(const ExecutionOptions& o, const fs::path& campaign_dir) {
     const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
-    if (o.executor == "local") return std::make_unique<LocalExecutor>(jobs);
-    if (o.executor == "slurm") return std::make_unique<SlurmExecutor>(jobs, campaign_dir / "slurm", o.slurm_partition);
-    throw std::invalid_argument("executor = '" + o.executor + "' is not one of: local, slurm");
+    return orchestrator::make_executor(o.executor, jobs, campaign_dir / "slurm", o.slurm_partition);
 }
 
 }  // namespace

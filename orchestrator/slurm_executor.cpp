@@ -192,6 +192,13 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
     }
 }
 
+std::unique_ptr<Executor> make_executor(const std::string& kind, int slots, const fs::path& work_dir,
+                                        const std::string& partition) {
+    if (kind == "local") return std::make_unique<LocalExecutor>(slots);
+    if (kind == "slurm") return std::make_unique<SlurmExecutor>(slots, work_dir, partition);
+    throw std::invalid_argument("executor = '" + kind + "' is not one of: local, slurm");
+}
+
 void cancel_stale_slurm_task(long handle) {
     if (handle <= 0) return;
     const long array_id = handle / SlurmExecutor::kTaskBase, task = handle % SlurmExecutor::kTaskBase;

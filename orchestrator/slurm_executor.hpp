@@ -6,6 +6,8 @@
 #include "orchestrator/campaign_store.hpp"
 #include "orchestrator/executor.hpp"
 
+#include <memory>
+
 namespace demcal::orchestrator {
 
 class SlurmExecutor : public Executor {
@@ -24,6 +26,12 @@ private:
     std::string partition_;
     int batches_ = 0;
 };
+
+// The executor a campaign asked for by name: "local" (LocalExecutor, `slots` processes) or "slurm" (SlurmExecutor,
+// `slots` array tasks at once, its batch files in `work_dir`, on `partition` or the default one). Throws
+// std::invalid_argument naming any other.
+std::unique_ptr<Executor> make_executor(const std::string& kind, int slots, const std::filesystem::path& work_dir,
+                                        const std::string& partition = {});
 
 // On resume: cancels the SLURM array task (a handle reported to `started`) that a dead orchestrator left behind.
 void cancel_stale_slurm_task(long handle);

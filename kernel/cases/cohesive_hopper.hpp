@@ -5,9 +5,9 @@
 // F_pulloff = 3 pi gamma R*, R* = r/2. Measured results: examples/cohesive_arch/README.md.
 #pragma once
 #include <functional>
+#include <vector>
 
 #include "kernel/cases/cutoff_search.hpp"
-#include <vector>
 
 namespace demcal::kernel::cases {
 
@@ -38,10 +38,10 @@ struct CohesiveHopperOutcome {
 
 CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c);
 
-/// The lowest frequency at which this bed flows (cutoff_search.hpp), every seed at each frequency; `report` sees
-/// every run.
 /// Throws std::invalid_argument naming the setting when the search or the case at either end of the bracket is invalid.
 void validate(const CohesiveHopperCase& c, const CutoffSearch& s);
+/// The lowest frequency at which this bed flows (cutoff_search.hpp), every seed at each frequency; `report` sees
+/// every run.
 CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,
                          const std::function<void(const CohesiveHopperCase&, const CohesiveHopperOutcome&)>& report);
 

@@ -1,6 +1,8 @@
 #include "kernel/cases/cutoff_search.hpp"
 
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "kernel/silo/input_error.hpp"
 
@@ -12,6 +14,9 @@ void validate(const CutoffSearch& s) {
                                 "]: needs 0 <= LO < HI <= 1000 Hz");
   if (!(s.tol > 0 && s.tol < s.hi - s.lo))
     throw std::invalid_argument("tol = " + silo::setting_text(s.tol) + ": must be > 0 and below HI - LO");
+  if (s.tol < std::ldexp(s.hi - s.lo, -kMaxBisections))
+    throw std::invalid_argument("tol = " + silo::setting_text(s.tol) + ": finer than 2^-" +
+                                std::to_string(kMaxBisections) + " of the bracket: the bisection would not end");
   if (s.seeds.empty()) throw std::invalid_argument("seeds: give at least one");
 }
 

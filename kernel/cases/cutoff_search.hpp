@@ -18,7 +18,12 @@ struct CutoffResult {
   const char* reason = "";  ///< when not found: which end failed
 };
 
-/// Throws std::invalid_argument naming the setting: 0 <= lo < hi <= 1000 Hz, 0 < tol < hi - lo, a seed at least.
+/// Bisections that halve HI - LO down to the tolerance at most: below 2^-30 of the bracket the frequencies no longer
+/// differ in any digit a run could resolve, and near 2^-52 the midpoint equals an end and the search never ends.
+inline constexpr int kMaxBisections = 30;
+
+/// Throws std::invalid_argument naming the setting: 0 <= lo < hi <= 1000 Hz, 2^-kMaxBisections (hi - lo) <= tol <
+/// hi - lo, a seed at least.
 void validate(const CutoffSearch& s);
 
 /// A frequency flows when at least half of the seeds flow there (a majority; a tie counts as flowing).

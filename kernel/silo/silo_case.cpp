@@ -137,7 +137,7 @@ kernel::Material to_kernel(const silo::Material& m, const char* name) {
 }
 
 // The pair's inputs of the law the run is on: the cohesion only where the law has it (a law without it runs only
-// cohesionless materials: SiloCaseLaw's choice).
+// cohesionless materials: run_on_its_law's choice).
 template <class Law>
 typename Law::Params to_kernel(const PairCoefficients& p) {
     typename Law::Params k;
@@ -177,6 +177,16 @@ int add_silo_walls(Sim& sim, const SiloGeometry& g, int steel, double wall_top,
 
 }  // namespace
 
+double smallest_sphere_rayleigh_step(const WheatMaterials& m) {
+    double smallest_radius = 1;
+    for (const auto& sphere : wheat_clump()) smallest_radius = std::min(smallest_radius, sphere.radius);
+    return rayleigh_time_step(m.wheat_scaled(), smallest_radius);
+}
+
+double planned_time_step(const SiloCaseSettings& s) {
+    return s.time_step > 0 ? s.time_step : s.time_step_fraction * smallest_sphere_rayleigh_step(s.materials);
+}
+
 void validate(const SiloCaseSettings& s) {
     // the materials first: the checks below derive masses and time steps from them
     const auto solid = [](const Material& m, const std::string& name) {
@@ -211,10 +221,8 @@ void validate(const SiloCaseSettings& s) {
     if (!(s.materials.stiffness_scale > 0) || s.materials.stiffness_scale > 100)
         reject_setting("stiffness_scale", s.materials.stiffness_scale, "must lie in (0, 100]");
     if (s.time_step < 0 || !std::isfinite(s.time_step)) reject_setting("dt", s.time_step, "must be >= 0 s (0: automatic)");
-    double smallest_radius = 1;
-    for (const auto& sphere : wheat_clump()) smallest_radius = std::min(smallest_radius, sphere.radius);
     // beyond the Rayleigh step the explicit integration of the stiffest contact is no longer resolved
-    if (const double rayleigh = rayleigh_time_step(s.materials.wheat_scaled(), smallest_radius); s.time_step > rayleigh)
+    if (const double rayleigh = smallest_sphere_rayleigh_step(s.materials); s.time_step > rayleigh)
         reject_setting("dt", s.time_step,
                        "larger than the Rayleigh time step of the smallest wheat sphere (" + setting_text(rayleigh) +
                            " s at this stiffness); use a fraction of it, or --dt-fraction");
@@ -224,9 +232,7 @@ void validate(const SiloCaseSettings& s) {
     if (s.vibration.vibrates()) {
         // a period resolved by fewer steps would alias: the walls jump rather than oscillate
         constexpr double kStepsPerPeriod = 20;
-        const double dt = s.time_step > 0 ? s.time_step
-                                          : s.time_step_fraction *
-                                                rayleigh_time_step(s.materials.wheat_scaled(), smallest_radius);
+        const double dt = planned_time_step(s);
         if (s.vibration.frequency * dt * kStepsPerPeriod > 1)
             reject_setting("vibration_frequency", s.vibration.frequency,
                            "a period is only " + setting_text(1 / (s.vibration.frequency * dt)) + " time steps of " +
@@ -264,9 +270,9 @@ void validate(const SiloCaseSettings& s) {
 namespace {
 
 // Version 5: the pairs' surface energies (JKR cohesion) at the end of the settings; version 4, the same without them
-// (no cohesion), is read too. Version 4: each section (tag and settings; the case's state; the kernel's state) closed by a checksum, the kernel's
-// state in its format 3 (contact histories of any size, moving walls); the settings include the bin's vibration
-// (version 3 had none). Versions 1 to 3 are refused with a message that says so.
+// (no cohesion), is read too. Version 4: each section (tag and settings; the case's state; the kernel's state) closed
+// by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
+// include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
 constexpr int kCheckpointVersion = 5;
 constexpr int kCheckpointVersionWithoutCohesion = 4;

@@ -98,6 +98,12 @@ struct SiloCaseSettings {
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions, the vibration).
 void validate(const SiloCaseSettings& s);
 
+// The Rayleigh time step of the grain's smallest sphere at the materials' (scaled) stiffness [s], and the time step a
+// run of these settings plans from it (time_step, or time_step_fraction of it): what the checks of a run's settings
+// and size are made against. (The run itself takes the kernel's own Rayleigh step, the same formula.)
+double smallest_sphere_rayleigh_step(const WheatMaterials& m);
+double planned_time_step(const SiloCaseSettings& s);
+
 struct SiloProgress {
     std::string phase;  // "generated", "resumed", "filling", "filled", "discharge", "checkpoint", "suspended", "done"
     double time = 0;            // simulated time since the start [s]
