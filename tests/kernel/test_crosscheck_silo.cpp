@@ -2,6 +2,7 @@
 // discharges the same bed; the report holds both rates (within 25 % of each other on 300 grains), the curve gap, the
 // costs; the same command again reuses both runs (nothing started); a deliberate mismatch of the grains' friction is
 // flagged; a bad angle is refused before anything runs.
+#include "slurm_for_test.hpp"
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -85,10 +86,10 @@ TEST_CASE("crosscheck silo --executor slurm: both codes' runs as SLURM array tas
                              (fs::path(source) / "examples/silo/reduced_conical_70deg.json").string() +
                              "' --max-time 3 --jobs 1 ";
     REQUIRE(run_demcal(args + "-c '" + (dir / "local").string() + "'", dir / "local.log") == 0);
-    const bool already_up = std::system("sinfo -h -o %T 2>/dev/null | grep -qE '^idle|^mixed'") == 0;
-    if (!already_up) REQUIRE(std::system(("bash " + source + "/scripts/slurm/slurm_up.sh >/dev/null").c_str()) == 0);
+    demcal::test::SlurmForTest cluster;
+    REQUIRE(cluster.up());
     const int rc = run_demcal(args + "--executor slurm -c '" + (dir / "slurm").string() + "'", dir / "slurm.log");
-    if (!already_up) std::system(("bash " + source + "/scripts/slurm/slurm_down.sh >/dev/null").c_str());
+    cluster.stop();
     INFO(read_file(dir / "slurm.log"));
     REQUIRE(rc == 0);
     const auto local = nlohmann::json::parse(read_file(dir / "local" / "crosscheck_silo.json"));

@@ -2,6 +2,7 @@
 // and stops: a tiny silo case stopped by SIGTERM to its batch shell (as SLURM's --signal=B:TERM@120 sends it before
 // the time limit) suspends with its checkpoint, submits the next job, and the chain ends with the discharge.csv of an
 // uninterrupted run. Needs root (the SLURM daemons) and the demcal binary.
+#include "slurm_for_test.hpp"
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -78,8 +79,8 @@ TEST_CASE("silo_slurm.sbatch: a job stopped by SIGTERM resubmits itself and the 
                                   "' > '" + (dir / "whole.log").string() + "' 2>&1";
     REQUIRE(std::system(whole_cmd.c_str()) == 0);
 
-    const bool already_up = std::system("sinfo -h -o %T 2>/dev/null | grep -qE '^idle|^mixed'") == 0;
-    if (!already_up) REQUIRE(std::system(("bash " + source + "/scripts/slurm/slurm_up.sh >/dev/null").c_str()) == 0);
+    demcal::test::SlurmForTest cluster;
+    REQUIRE(cluster.up());
     const fs::path out = dir / "chain";
     const std::string submit = "cd '" + dir.string() + "' && SILO_OUT='" + out.string() + "' SILO_ARGS='" +
                                case_args + "' SILO_JOB_ARGS='--no-plots --checkpoint-every 0.05' DEMCAL='" +
@@ -98,7 +99,7 @@ TEST_CASE("silo_slurm.sbatch: a job stopped by SIGTERM resubmits itself and the 
         std::chrono::seconds(180));
     if (!ended) std::system("scancel -n demcal-silo");
     const std::string logs = chain_logs(dir);
-    if (!already_up) std::system(("bash " + source + "/scripts/slurm/slurm_down.sh >/dev/null").c_str());
+    cluster.stop();
     INFO(logs);
     REQUIRE(!first_job.empty());
     REQUIRE(checkpointed);

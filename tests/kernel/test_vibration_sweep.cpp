@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "slurm_for_test.hpp"
 #include "test_files.hpp"
 
 namespace fs = std::filesystem;
@@ -90,17 +91,16 @@ TEST_CASE("demcal vibration --executor slurm: the sweep's runs as SLURM array ta
     WARN("not root: cannot start SLURM daemons here, skipped");
     return;
   }
-  const std::string source = DEMCAL_SOURCE_DIR;
   const fs::path dir = fs::temp_directory_path() / ("demcal-test-vibration-slurm-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string sweep = "vibration --theta 45 --frequency 0,100 --amplitude 1.1e-4 --repeats 1 ";
   REQUIRE(demcal_run(sweep + "--campaign '" + (dir / "local").string() + "' -- " + kTiny, dir / "local.log") == 0);
-  const bool already_up = std::system("sinfo -h -o %T 2>/dev/null | grep -qE '^idle|^mixed'") == 0;
-  if (!already_up) REQUIRE(std::system(("bash " + source + "/scripts/slurm/slurm_up.sh >/dev/null").c_str()) == 0);
+  demcal::test::SlurmForTest cluster;
+  REQUIRE(cluster.up());
   const int rc = demcal_run(sweep + "--executor slurm --jobs 2 --campaign '" + (dir / "slurm").string() + "' -- " + kTiny,
                             dir / "slurm.log");
-  if (!already_up) std::system(("bash " + source + "/scripts/slurm/slurm_down.sh >/dev/null").c_str());
+  cluster.stop();
   INFO(demcal::test::read_file(dir / "slurm.log"));
   REQUIRE(rc == 0);
   CHECK_THAT(demcal::test::read_file(dir / "slurm.log"), Catch::Matchers::Contains("SLURM task"));

@@ -1,4 +1,5 @@
 // The SLURM executor against a real single-node SLURM that this test starts (scripts/slurm/slurm_up.sh) and stops.
+#include "slurm_for_test.hpp"
 #include "campaign_test_support.hpp"
 
 #include <catch2/catch.hpp>
@@ -15,16 +16,15 @@ TEST_CASE("a tiny shear campaign runs as a SLURM job array", "[yade][slurm]") {
         WARN("not root: cannot start SLURM daemons here, skipped");
         return;
     }
-    const bool already_up = std::system("sinfo -h -o %T 2>/dev/null | grep -qE '^idle|^mixed'") == 0;
-    if (!already_up)
-        REQUIRE(std::system(("bash " + test::source_path("scripts/slurm/slurm_up.sh").string() + " >/dev/null").c_str()) == 0);
+    test::SlurmForTest cluster;
+    REQUIRE(cluster.up());
     const fs::path dir = test::fresh_test_dir("slurm-campaign");
     const int code = test::run_demcal({"shear", test::source_path("examples/materials/sand-tiny.json").string(),
                                        "--normal-stress", "2e3,4e3,6e3", "--executor", "slurm", "--jobs", "2",
                                        "--timeout", "600", "--campaign", dir.string()},
                                       dir / "run.log");
     const std::string log = test::read_file(dir / "run.log");
-    if (!already_up) std::system(("bash " + test::source_path("scripts/slurm/slurm_down.sh").string() + " >/dev/null").c_str());
+    cluster.stop();
     INFO(log);
     REQUIRE(code == 0);
     orchestrator::CampaignStore store(dir / "campaign.sqlite");
