@@ -15,6 +15,7 @@
 //   sim.set_timestep(0.3 * sim.rayleigh_timestep());
 //   sim.step(1000);
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
@@ -210,7 +211,7 @@ class BasicSimulation {
   void kick(double sign = 1.0);  // the second half kick of velocity Verlet; -1 takes it back
   void refresh_forces();         // forces of the current state after a change (step() calls it)
   void update_members(std::size_t c, const Mat3& R, bool positions);  // R: the clump's rotation matrix
-  void rebuild_body_index();
+  void rebuild_body_index();  // the body <-> sphere maps and the members' offsets, after cmem_ or a template changed
   // Every per-sphere array (with its entries per sphere) and every per-clump array, listed once: renumbering and
   // removal apply the same permutation or compaction to all of them.
   template <class F>
@@ -262,6 +263,14 @@ class BasicSimulation {
   std::vector<double> omega_norm_;                          // |w_| per sphere, for the rolling torques
   bool omega_norm_fresh_ = false;                           // kick_drift filled omega_norm_ for the current w_
   static constexpr int kMaxWallCandidates = 64;             // walls tracked per sphere (bit mask)
+  // The lowest wall index left in a candidate mask, taken out of it; kMaxWallCandidates (>= any tracked wall count)
+  // once the mask is empty.
+  static int next_wall_candidate(std::uint64_t& mask) {
+    if (mask == 0) return kMaxWallCandidates;
+    const int w = std::countr_zero(mask);
+    mask &= mask - 1;
+    return w;
+  }
   std::vector<std::uint64_t> wall_cand_;                    // per sphere: walls within reach at the last build
 
   // per clump
@@ -270,6 +279,9 @@ class BasicSimulation {
   std::vector<double> cm_;
   std::vector<std::int32_t> ctmpl_, cmat_;
   std::vector<std::uint32_t> cmem_start_, cmem_;  // member sphere indices (CSR)
+  // the template offset of each cmem_ entry (body frame), side by side: a clump update reads them contiguously
+  // instead of through its template (each clump of a spread of sizes has its own, scattered in memory)
+  std::vector<Vec3> cmem_offset_;
 
   // bodies
   std::vector<std::int32_t> body_ref_;  // >= 0: sphere index; < 0: -(clump + 1)

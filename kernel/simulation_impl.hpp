@@ -211,6 +211,7 @@ BodyId BasicSimulation<Law>::add_clump(int tmpl, int material, const Vec3& com, 
   for (std::size_t k = 0; k < t.offsets.size(); ++k) {
     const Vec3 d = R * t.offsets[k];
     cmem_.push_back(std::uint32_t(x_.size()));
+    cmem_offset_.push_back(t.offsets[k]);
     x_.push_back(com + d); v_.push_back(velocity + omega.cross(d)); w_.push_back(omega);
     f_.push_back(Vec3::Zero()); t_.push_back(Vec3::Zero());
     r_.push_back(t.radii[k]); mass_.push_back(t.mass); inv_mass_.push_back(0.0); inv_inertia_.push_back(0.0);
@@ -242,6 +243,11 @@ void BasicSimulation<Law>::rebuild_body_index() {
       clump_body_[c] = std::uint32_t(b);
       for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) sphere_body_[cmem_[k]] = std::uint32_t(b);
     }
+  }
+  cmem_offset_.resize(cmem_.size());
+  for (std::size_t c = 0; c < cx_.size(); ++c) {
+    const ClumpTemplate& t = templates_[ctmpl_[c]];
+    for (std::uint32_t k = cmem_start_[c], m = 0; k < cmem_start_[c + 1]; ++k, ++m) cmem_offset_[k] = t.offsets[m];
   }
 }
 
@@ -292,11 +298,10 @@ void BasicSimulation<Law>::prepare() {
 
 template <class Law>
 void BasicSimulation<Law>::update_members(std::size_t c, const Mat3& R, bool positions) {
-  const ClumpTemplate& t = templates_[ctmpl_[c]];
   const Vec3 w = cw_[c];
-  for (std::uint32_t k = cmem_start_[c], m = 0; k < cmem_start_[c + 1]; ++k, ++m) {
+  for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) {
     const std::uint32_t s = cmem_[k];
-    const Vec3 d = R * t.offsets[m];
+    const Vec3 d = R * cmem_offset_[k];
     if (positions) x_[s] = cx_[c] + d;
     v_[s] = cv_[c] + w.cross(d);
     w_[s] = w;
@@ -602,10 +607,12 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         double ns[kWallSlots][kH];
         Vec3 nf[kWallSlots];
         int used = 0;
-        // only the walls within reach at the last neighbour build (all of them past kMaxWallCandidates walls)
+        // only the walls within reach at the last neighbour build (all of them past kMaxWallCandidates walls), in
+        // ascending order either way: the set bits of the candidate mask, not a test of every wall
         const bool tracked = nw <= kMaxWallCandidates;
-        for (int wdx = 0; wdx < nw; ++wdx) {
-          if (tracked && !((wall_cand_[i] >> wdx) & 1u)) continue;
+        std::uint64_t candidates = tracked ? wall_cand_[i] : 0;
+        for (int wdx = tracked ? next_wall_candidate(candidates) : 0; wdx < nw;
+             wdx = tracked ? next_wall_candidate(candidates) : wdx + 1) {
           const Wall& wall = walls_[wdx];
           if (!wall.enabled) continue;
           Vec3 nrm;
@@ -788,6 +795,7 @@ void BasicSimulation<Law>::scale_particles(double factor) {
     throw std::invalid_argument("scale_particles: factor must be finite and > 0, got " + std::to_string(factor));
   const double f3 = factor * factor * factor, f5 = f3 * factor * factor;
   for (ClumpTemplate& t : templates_) scale_clump_template(t, factor);
+  for (Vec3& o : cmem_offset_) o *= factor;  // (as scale_clump_template scales the offsets: the same numbers)
   for (std::size_t i = 0; i < x_.size(); ++i) {
     r_[i] *= factor;
     mass_[i] *= f3;  // a member's m* is its clump's mass

@@ -18,6 +18,7 @@ replicates=${REPLICATES:-1}                        # packings per stress (averag
 params=${PARAMS:-friction_coefficient,bond_shear_strength,bond_normal_strength}
 levels=${LEVELS:-5}                                 # 3 levels cannot tell a parabola (sand box: friction -> mu_b)
 strict=(${STRICT---strict})                         # STRICT= : also stop when the target is inside the simulated CI
+tol=(${TOL:+--tol "$TOL"})                          # TOL=0.05: relative tolerance on each target (calibrate's default 2 %)
 # The tiny box is too noisy to show a friction effect (calibration/README.md); the overnight variant on sand.json's box:
 #   HIDDEN=examples/calibration/hidden-sand.json START=examples/materials/sand.json STRESSES=5e3,10e3,15e3,20e3 \
 #   bench/calibration/yade_recovery.sh build/app/demcal campaigns/recovery-sand
@@ -38,7 +39,7 @@ import json,glob
 runs=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['runs']
 print(','.join('%.9g:%.9g' % (r['label']['normal_stress'], r['peak_shear_stress']) for r in runs if r['state']=='done'))")")
 fi
-common=("${target_option[@]}" --start "$start" "${strict[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
+common=("${target_option[@]}" --start "$start" "${strict[@]}" "${tol[@]}" --normal-stress $stresses --replicates "$replicates" --jobs 2
         "${template[@]}" "${engine[@]}" --params "$params" --levels "$levels" --campaign "$dir/loop")
 $demcal calibrate "${common[@]}" --max-evaluations 7 | tee "$dir/surrogate.log" || true
 # The baselines cost tens of failure lines: run them with COORDINATE=1 and/or GRID=1 (GRID_POINTS per parameter over
