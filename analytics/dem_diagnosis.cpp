@@ -29,14 +29,16 @@ const std::vector<DemEffectCandidate>& dem_effect_candidates() {
          0.3,
          ParameterScale::log,
          "rolling resistance of the grain (its shape's departure from the clump's spheres): a property of the grain, so "
-         "grain-grain and grain-wall together; the rates alone cannot tell the two apart (one parameter per candidate)"},
+         "grain-grain and grain-wall together; the rates alone cannot tell the two apart (one parameter per candidate)",
+         std::nullopt},
         {"wall_friction",
          {"grain_wall.friction"},
          0.05,
          0.9,
          ParameterScale::linear,
          "particle-wall sliding friction (wall material, roughness, wear): it sets whether the hopper flows in mass "
-         "flow, so it acts most at steep hoppers"},
+         "flow, so it acts most at steep hoppers",
+         std::nullopt},
         // from 0.3: at 0.1 the reduced silo at 10 deg nearly jammed (1042 of its grains out after 4.5 s instead of
         // all in under 1 s), a run of many minutes for a grain no wheat is
         {"restitution",
@@ -45,7 +47,19 @@ const std::vector<DemEffectCandidate>& dem_effect_candidates() {
          0.95,
          ParameterScale::linear,
          "grain-grain restitution (energy lost in collisions; grain-grain contacts dominate the flowing bed, the "
-         "grain-wall one keeps its declared value)"},
+         "grain-wall one keeps its declared value)",
+         std::nullopt},
+        // JKR pull-off 1.5 pi gamma R*, whatever the stiffness: at 0.3 J/m^2 and R* 0.75 mm (two 1.5 mm members)
+        // 1.06 mN, three times a wheat grain's weight per contact, which arches the 105 mm silo's bed above 10 deg
+        // (examples/cohesive_arch, at a hundredth of the stiffness); 0 is the cohesionless law, the default
+        {"cohesion",
+         {"grain_grain.surface_energy_J_m2"},
+         0.0,
+         0.3,
+         ParameterScale::linear,
+         "grain-grain cohesion (moisture, fines, fat: JKR surface energy), which slows and finally arches the flow; the "
+         "grain-wall adhesion keeps its declared value",
+         0.0},
     };
     return table;
 }
@@ -68,6 +82,8 @@ std::vector<std::string> candidate_table_defects(const std::vector<DemEffectCand
         if (!(std::isfinite(c.lower) && std::isfinite(c.upper) && c.lower < c.upper))
             defects.push_back(who + ": bounds must be finite with lower < upper");
         if (c.scale == ParameterScale::log && !(c.lower > 0)) defects.push_back(who + ": log scale needs lower > 0");
+        if (c.absent && !(*c.absent >= c.lower && *c.absent <= c.upper))
+            defects.push_back(who + ": the absent value must lie within the bounds (it is the declared value then)");
     }
     return defects;
 }
@@ -366,6 +382,10 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
     r.df_pure_error = s.df_pure_error;
     r.prediction_seeds = K;
     r.noise_sd = std::sqrt(s.s2);
+    for (std::size_t k = 0; k < rates_declared.size(); ++k)
+        if (!(rates_declared[k] > 0))
+            throw std::invalid_argument("the declared material does not discharge at " + data.conditions[k].label() +
+                                        " (no steady rate: an arch or a jam), where the data have a rate");
     r.rates_declared = rates_declared;
     const auto log_declared = logs(rates_declared);
     r.rmse_before = std::sqrt(row_sse(data, s, log_declared) / r.n);
@@ -388,17 +408,46 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
         std::map<double, std::vector<double>> runs{{c.declared, rates_declared}};
         auto run = [&](std::vector<double> values) {
             std::vector<double> fresh;
+            auto stops = [&](double v) { return std::find(c.stops_flow.begin(), c.stops_flow.end(), v) != c.stops_flow.end(); };
             for (double v : values)
-                if (!runs.count(v) && std::find(fresh.begin(), fresh.end(), v) == fresh.end()) fresh.push_back(v);
+                if (!runs.count(v) && !stops(v) && std::find(fresh.begin(), fresh.end(), v) == fresh.end())
+                    fresh.push_back(v);
             if (fresh.empty()) return;
             const auto rates = setup.predict(fresh);
             for (std::size_t k = 0; k < fresh.size(); ++k) {
-                runs[fresh[k]] = rates.at(k);
                 c.evaluated.push_back(fresh[k]);
-                c.sse_of_runs.push_back(row_sse(data, s, logs(rates[k])));
+                const auto& r_k = rates.at(k);
+                if (std::any_of(r_k.begin(), r_k.end(), [](double x) { return !(x > 0); })) {
+                    c.stops_flow.push_back(fresh[k]);
+                    c.sse_of_runs.push_back(NAN);
+                    continue;
+                }
+                runs[fresh[k]] = r_k;
+                c.sse_of_runs.push_back(row_sse(data, s, logs(r_k)));
             }
         };
         run(candidate_grid(c.spec, o.grid_points));
+        if (!c.stops_flow.empty()) {
+            // the flowing side of the declared value: up to the last flowing value before the nearest stop
+            double upper = c.spec.upper, lower = c.spec.lower;
+            for (double v : c.stops_flow) {
+                if (v > c.declared) upper = std::min(upper, v);
+                if (v < c.declared) lower = std::max(lower, v);
+            }
+            for (auto it = runs.begin(); it != runs.end();)
+                it = (it->first >= upper && upper < c.spec.upper) || (it->first <= lower && lower > c.spec.lower)
+                         ? runs.erase(it)
+                         : std::next(it);
+            if (runs.size() < 3) {
+                c.available = false;
+                c.unavailable = "the flow stops at " + number_text(upper < c.spec.upper ? upper : lower) +
+                                ", leaving fewer than 3 flowing values to fit";
+                r.candidates.push_back(c);
+                continue;
+            }
+            c.spec.lower = runs.begin()->first;
+            c.spec.upper = runs.rbegin()->first;
+        }
         auto sse_on = [&](const Surrogate& g, std::optional<std::size_t> without) {
             return std::function<double(double)>([&, without](double u) {
                 const auto l = g.at_unit(u);
@@ -414,11 +463,18 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
             const bool known = runs.count(proposal) > 0;
             if (known) break;  // the surrogate's minimum has been run: converged
             run({proposal});
+            if (!runs.count(proposal)) break;  // it stopped the flow (the flow is not monotone in the parameter)
         }
         const Surrogate g(c.spec, runs);
         const double u_fit = minimise_on_unit(sse_on(g, std::nullopt));
         c.fitted = run_value(g.value_of_unit(u_fit));
         run({c.fitted});
+        if (!runs.count(c.fitted)) {
+            c.available = false;
+            c.unavailable = "the fitted value " + number_text(c.fitted) + " stops the flow in a condition";
+            r.candidates.push_back(c);
+            continue;
+        }
         c.rates_fitted = runs.at(c.fitted);
         c.rmse_fitted = std::sqrt(row_sse(data, s, logs(c.rates_fitted)) / r.n);
         const double u_declared = std::clamp(g.unit(c.declared), -1.0, 1.0);
@@ -519,6 +575,7 @@ nlohmann::json DemDiagnosis::to_json(const SiloMeasurements& data) const {
                       {"interval_reaches_bound", c.interval_at_lower_bound || c.interval_at_upper_bound},
                       {"evaluated", c.evaluated},
                       {"sse_of_runs", c.sse_of_runs},
+                      {"stops_flow", c.stops_flow},
                       {"rmse_declared", num(c.rmse_declared)},
                       {"rmse_fitted", num(c.rmse_fitted)},
                       {"cv_rmse_declared", num(c.cv_rmse_declared)},

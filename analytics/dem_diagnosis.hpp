@@ -39,14 +39,16 @@ struct DemEffectCandidate {
     double lower = 0, upper = 0;      // bounds of the fitted value
     ParameterScale scale = ParameterScale::linear;  // log: the value spans decades (searched in log)
     std::string mechanism;            // what it stands for, and why these fields together
+    // The value a material without the fields has (the silo material reader's default, e.g. no cohesion = 0); none:
+    // a material must declare the fields for the candidate to be tried.
+    std::optional<double> absent;
 };
 
-// The table of candidates diagnose tries, in order. Adding an effect is one row here (e.g. cohesion, field
-// grain_grain.surface_energy_J_m2, once the silo material has it: until then a material without the field makes the
-// candidate "not in this material" rather than an error).
+// The table of candidates diagnose tries, in order. Adding an effect is one row here; a material without a row's
+// fields makes the candidate "not in this material" rather than an error, unless the row says what absent means.
 const std::vector<DemEffectCandidate>& dem_effect_candidates();
 // Defects of a table (empty: none): unique names, at least one "object.key" field, a field in one row only,
-// finite lower < upper, log bounds > 0.
+// finite lower < upper, log bounds > 0, an absent value inside the bounds.
 std::vector<std::string> candidate_table_defects(const std::vector<DemEffectCandidate>& table);
 
 // One measured condition: the silo geometry a row gives (NaN: not given, the silo options after -- decide).
@@ -109,6 +111,9 @@ struct DemCandidateResult {
     bool significant = false, cv_gain = false, accepted = false;
     std::vector<double> rates_fitted;       // raw runs at the fitted value, per condition [g/s]
     std::vector<double> fitted_without;     // per condition: the value refitted without it (CV)
+    // values run at which some condition did not discharge (an arch or a jam: no rate to fit); the search is then
+    // confined to the flowing side of the smallest such value beyond the declared one (spec's bounds narrowed)
+    std::vector<double> stops_flow;
 };
 
 struct DemDiagnosis {

@@ -100,7 +100,8 @@ See examples/diagnose/README.md.)";
 constexpr const char* silo_dem_help = R"(--model silo-dem --material M.json [--campaign DIR] [--jobs N] [-- silo options]:
   data: theta_deg, rate_g_s (g/s), optional outlet_m, D_m, body_height_m (conical), replicate; repeats as rows.
   Every condition is predicted by demcal silo with the declared material (a resumable, cached campaign); the
-  residuals are traced to a DEM effect among rolling_friction, wall_friction, restitution, each fitted (coarse
+  residuals are traced to a DEM effect among rolling_friction, wall_friction, restitution and cohesion (grain-grain
+  JKR surface energy; a material without it has none), or those named by --candidates, each fitted (coarse
   bracket, refinement), tested (F against the repeat scatter, Holm) and cross-validated leaving one condition out.)";
 
 std::string sci(double v) {
@@ -280,7 +281,7 @@ struct DiagnoseArgs {
 
 // Options that only the silo-dem model takes, refused (named) with an analytical model.
 const char* const kSiloDemOptions[] = {"--material", "--campaign", "--jobs", "--seeds", "--first-seed", "--grid-points",
-                                       "--refine-steps", "--executor", "--partition"};
+                                       "--refine-steps", "--executor", "--partition", "--candidates"};
 // Options of the analytical search that silo-dem does not use (one effect from its table, no regimes or outliers yet):
 // refused rather than ignored.
 const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column", "--effective-friction-deg",
@@ -415,6 +416,11 @@ void add_discharge_commands(CLI::App& app) {
     diagnose->add_option("--refine-steps", dem.refine_steps, "silo-dem: refinement proposals after the bracket")
         ->capture_default_str()
         ->check(integer_in(0, 20));
+    diagnose->add_option("--candidates", dem.candidates,
+                         "silo-dem: the DEM effects to try, by name (default: all of rolling_friction, wall_friction, "
+                         "restitution, cohesion; e.g. wall_friction,cohesion)")
+        ->allow_extra_args(false)  // (one value, split at commas: not the silo options after --)
+        ->delimiter(',');
     diagnose->add_option("silo_args", dem.silo_args,
                          "silo-dem, after --: options of every demcal silo run (e.g. --geometry G --particles 2000 "
                          "--stiffness-scale 0.001 --fill-time 0.5 --threads 1 --no-plots)");

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -65,6 +66,14 @@ std::pair<std::optional<double>, std::string> declared_value(const json& materia
     std::optional<double> value;
     for (const auto& f : c.fields) {
         const json* v = field_at(material, f);
+        if (!v && c.absent) {  // the reader's default stands for the missing field
+            if (value && *value != *c.absent)
+                return {std::nullopt, "its fields are declared with different values (" + f + " absent, meaning " +
+                                          an::number_text(*c.absent) + ", and " + an::number_text(*value) +
+                                          "); the candidate sets them to one value"};
+            value = *c.absent;
+            continue;
+        }
         if (!v) return {std::nullopt, "the material has no field " + f};
         if (!v->is_number()) return {std::nullopt, f + " is not a number"};
         if (value && *value != v->get<double>())
@@ -74,6 +83,25 @@ std::pair<std::optional<double>, std::string> declared_value(const json& materia
         value = v->get<double>();
     }
     return {value, ""};
+}
+
+// The table's rows named by --candidates (all when none is named), in the table's order; an unknown or repeated name
+// is refused with the known ones listed.
+std::vector<an::DemEffectCandidate> chosen_candidates(const std::vector<std::string>& names) {
+    const auto& table = an::dem_effect_candidates();
+    std::string known;
+    for (const auto& c : table) known += (known.empty() ? "" : ", ") + c.name;
+    std::set<std::string> wanted;
+    for (const auto& n : names)
+        if (!wanted.insert(n).second)
+            throw UserError("--candidates: '" + an::shortened_text(n) + "' named twice");
+    for (const auto& n : wanted)
+        if (std::none_of(table.begin(), table.end(), [&](const auto& c) { return c.name == n; }))
+            throw UserError("--candidates: no DEM effect '" + an::shortened_text(n) + "' (known: " + known + ")");
+    std::vector<an::DemEffectCandidate> out;
+    for (const auto& c : table)
+        if (wanted.empty() || wanted.count(c.name)) out.push_back(c);
+    return out;
 }
 
 class SiloDemCampaign {
@@ -113,12 +141,14 @@ public:
                 for (int k = 0; k < args_.seeds; ++k) {
                     const std::string name = run_name(hash, c, args_.first_seed + k);
                     const auto summary = silo_run_summary(dir_, name);
-                    const double rate = summary ? summary->at("rate").value("rate_kg_s", NAN) * 1e3 : NAN;
-                    if (!(rate > 0))
-                        throw std::runtime_error("run " + name + (summary ? " gave no discharge rate" : " failed") +
-                                                 " (see its log in " + (dir_ / "runs" / name).string() +
+                    if (!summary)
+                        throw std::runtime_error("run " + name + " failed (see its log in " +
+                                                 (dir_ / "runs" / name).string() +
                                                  "); a failed run is not retried: remove its folder to run it again");
-                    sum += rate;
+                    // a run that ended without a steady discharge (an arch, a jam) predicts no flow: NaN, which the
+                    // diagnosis reads as "this value stops the flow" (analytics/dem_diagnosis.hpp)
+                    const double rate = summary->at("rate").value("rate_kg_s", NAN) * 1e3;
+                    sum += rate > 0 ? rate : NAN;
                 }
                 per_condition.push_back(sum / args_.seeds);
             }
@@ -130,6 +160,8 @@ public:
     json material_with(const an::DemEffectCandidate& c, double value) const {
         json m = declared_;
         for (const auto& f : c.fields) {
+            // a missing field at its absent value is left out: the declared material itself (and its runs reused)
+            if (!field_at(declared_, f) && c.absent && value == *c.absent) continue;
             const auto dot = f.find('.');
             m[f.substr(0, dot)][f.substr(dot + 1)] = value;
         }
@@ -307,6 +339,7 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
     const json declared = read_json_file(a.material, "--material");
     const auto defects = an::candidate_table_defects(an::dem_effect_candidates());
     if (!defects.empty()) throw std::logic_error("the DEM candidate table: " + defects.front());
+    const auto candidates = chosen_candidates(a.candidates);
     SiloDemCampaign campaign(a, data, declared);
     campaign.check_settings();  // silo's own checks of every condition and the material, nothing written
     const json settings{{"command", "diagnose --model silo-dem"}, {"silo_args", a.silo_args},
@@ -320,7 +353,7 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
     options.alpha = a.alpha;
     options.min_cv_gain = a.min_cv_gain;
     std::vector<an::DemCandidateSetup> setups;
-    for (const auto& spec : an::dem_effect_candidates()) {
+    for (const auto& spec : candidates) {
         an::DemCandidateSetup s;
         s.spec = spec;
         std::tie(s.declared, s.unavailable) = declared_value(declared, spec);

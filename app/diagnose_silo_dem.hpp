@@ -19,6 +19,7 @@ struct SiloDemArgs {
     double alpha = 0.01, min_cv_gain = 0.05;
     bool no_plots = false;
     std::vector<std::string> silo_args;  // after --: options of every demcal silo run
+    std::vector<std::string> candidates;  // names of the DEM effects to try (empty: every row of the table)
 };
 
 // Checks every input and output before any run; returns the exit status (0, or 75 when stopped: run again).

@@ -91,28 +91,39 @@ TEST_CASE("silo-dem candidates: the table is sane, its defects are caught, and i
     CHECK(an::candidate_table_defects(table).empty());
     std::vector<std::string> names;
     for (const auto& c : table) names.push_back(c.name);
-    CHECK(names == std::vector<std::string>{"rolling_friction", "wall_friction", "restitution"});
-    // the declared wheat lies inside every candidate's bounds, so each candidate is nested in the declared model
+    CHECK(names == std::vector<std::string>{"rolling_friction", "wall_friction", "restitution", "cohesion"});
+    // the declared wheat lies inside every candidate's bounds (a field it lacks: at the row's absent value, which may
+    // be a bound, as no cohesion is), so each candidate is nested in the declared model
     const auto material = nlohmann::json::parse(read_file(kDeclared));
     for (const auto& c : table)
         for (const auto& f : c.fields) {
             const auto dot = f.find('.');
-            const double v = material.at(f.substr(0, dot)).at(f.substr(dot + 1)).get<double>();
+            const auto& object = material.at(f.substr(0, dot));
             INFO(c.name << " " << f);
+            if (!object.contains(f.substr(dot + 1))) {
+                REQUIRE(c.absent.has_value());
+                CHECK(*c.absent >= c.lower);
+                CHECK(*c.absent <= c.upper);
+                continue;
+            }
+            const double v = object.at(f.substr(dot + 1)).get<double>();
             CHECK(v > c.lower);
             CHECK(v < c.upper);
         }
-    // a later row (cohesion) and broken rows
+    CHECK_FALSE(material.at("grain_grain").contains("surface_energy_J_m2"));  // (so the branch above is taken)
+    // a later row and broken rows
     auto extended = table;
-    extended.push_back({"cohesion", {"grain_grain.surface_energy_J_m2"}, 0, 0.5, an::ParameterScale::linear, "JKR"});
+    extended.push_back({"elongation", {"grain.elongation"}, 1, 3, an::ParameterScale::linear, "shape", std::nullopt});
     CHECK(an::candidate_table_defects(extended).empty());
     auto broken = table;
-    broken.push_back({"wall_friction", {"grain_wall.friction"}, 0.5, 0.1, an::ParameterScale::log, ""});
-    broken.push_back({"shape", {"elongation"}, 0, 1, an::ParameterScale::log, ""});
+    broken.push_back({"wall_friction", {"grain_wall.friction"}, 0.5, 0.1, an::ParameterScale::log, "", std::nullopt});
+    broken.push_back({"shape", {"elongation"}, 0, 1, an::ParameterScale::log, "", std::nullopt});
+    broken.push_back({"moisture", {"grain_wall.surface_energy_J_m2"}, 0.1, 1, an::ParameterScale::linear, "", 0.0});
     // (the first broken row is also a log scale, but from 0.5 > 0: no defect of its own there)
     const auto defects = an::candidate_table_defects(broken);
-    // name used twice, field in two rows, lower > upper; a field without an object, a log scale from 0
-    CHECK(defects.size() == 5);
+    // name used twice, field in two rows, lower > upper; a field without an object, a log scale from 0; an absent
+    // value outside the bounds
+    CHECK(defects.size() == 6);
     const auto grid = an::candidate_grid(table[0], 5);  // log: 1e-3 .. 0.3 evenly in decades
     REQUIRE(grid.size() == 5);
     CHECK(grid.front() == Approx(1e-3));
@@ -148,6 +159,10 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
          "at least 3 conditions"},
         {"--model silo-dem" + data + campaign + " --material '" + (dir / "m.csv").string() + "' -- " + kTinySilo,
          "--material"},
+        {"--model silo-dem" + data + campaign + material + " --candidates wall_friction,moisture -- " + kTinySilo,
+         "--candidates: no DEM effect 'moisture' (known: rolling_friction, wall_friction, restitution, cohesion)"},
+        {"--model silo-dem" + data + campaign + material + " --candidates cohesion,cohesion -- " + kTinySilo,
+         "--candidates: 'cohesion' named twice"},
         {"--model oldal" + data + material, "--material: only --model silo-dem"},
         {"--model silo-dem" + data + campaign + material + " --drop-outliers -- " + kTinySilo,
          "--drop-outliers: the analytical models take it"},
@@ -164,8 +179,8 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
     fs::remove_all(dir);
 }
 
-TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value inside the interval; the declared "
-          "material's own rates get nothing; the same command again runs nothing",
+TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value inside the interval - the declared "
+          "material's own rates get nothing - the same command again runs nothing",
           "[diagnose][silo-dem][slow]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-dem-" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -195,8 +210,12 @@ TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value ins
         }
     rough.close();
     clean.close();
+    // Without cohesion among the candidates: on this tiny set (300 grains, 5 angles, one seed) a small cohesion
+    // (about 0.09 J/m^2) explains the raised wall friction's rates better by cross-validation, and is named instead
+    // (measured 2026-12-02; examples/diagnose/README.md): the two effects are confounded on rates alone here.
     const std::string common = " --material '" + kDeclared + "' --campaign '" + (dir / "campaign").string() +
-                               "' --jobs 2 --grid-points 4 --refine-steps 2 -- " + kTinySilo;
+                               "' --jobs 2 --grid-points 4 --refine-steps 2 --candidates rolling_friction,wall_friction,restitution -- " +
+                               kTinySilo;
 
     const auto start = std::chrono::steady_clock::now();
     REQUIRE(demcal_run("diagnose --model silo-dem --data '" + (dir / "rough.csv").string() + "' --json '" +

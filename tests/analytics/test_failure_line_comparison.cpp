@@ -25,7 +25,7 @@ FailureLine noisy_line(double mu, double c, double noise, unsigned seed, int rep
 }
 }  // namespace
 
-TEST_CASE("lines of the same law agree; lines of different laws are told apart", "[analytics][failure_line_comparison]") {
+TEST_CASE("lines of the same law agree - lines of different laws are told apart", "[analytics][failure_line_comparison]") {
     int agree_same = 0, mu_within_same = 0, p_small_same = 0, agree_different = 0;
     for (unsigned k = 0; k < 200; ++k) {
         const auto a = noisy_line(0.8, 1000, 300, 2 * k + 1), b = noisy_line(0.8, 1000, 300, 2 * k + 2);

@@ -77,7 +77,7 @@ TEST_CASE("neighbour list and brute force find the same contacts", "[kernel][nei
   CHECK(s.sim.neighbor_builds() > 3);    // and several rebuilds
 }
 
-TEST_CASE("same input and thread count give bit-identical states; so do 1 and 2 threads", "[kernel][determinism]") {
+TEST_CASE("same input and thread count give bit-identical states - so do 1 and 2 threads", "[kernel][determinism]") {
   Scene a(1, 42, 200), b(1, 42, 200), c(1, 42, 200);
   // to the first wall and grain contacts on one thread (barriers are costly on a loaded machine), then 2 threads
   // for a and b (results do not depend on the thread count: c, on one thread, must agree bit for bit)
@@ -100,7 +100,7 @@ TEST_CASE("same input and thread count give bit-identical states; so do 1 and 2 
   CHECK_FALSE(same_state(a.sim, d.sim));
 }
 
-TEST_CASE("grains rest in the closed hopper; opening the plate discharges them; removal counts the mass",
+TEST_CASE("grains rest in the closed hopper - opening the plate discharges them - removal counts the mass",
           "[kernel][walls]") {
   Scene s(1, 42, 160);
   s.sim.set_min_parallel(2000);

@@ -38,7 +38,7 @@ std::string tiny_run(const fs::path& dir, const std::string& name, const std::st
 
 }  // namespace
 
-TEST_CASE("demcal silo --material: the Table 2.1 file is the default, bit for bit; another material changes the run",
+TEST_CASE("demcal silo --material: the Table 2.1 file is the default, bit for bit - another material changes the run",
           "[silo][cli][material]") {
   const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-material-" + std::to_string(::getpid()));
   fs::create_directories(dir);
@@ -70,7 +70,7 @@ TEST_CASE("demcal silo --material: the Table 2.1 file is the default, bit for bi
   fs::remove_all(dir);
 }
 
-TEST_CASE("demcal silo --material: bad files name the file, the field and the value; nothing is written",
+TEST_CASE("demcal silo --material: bad files name the file, the field and the value - nothing is written",
           "[silo][cli][material]") {
   const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-material-bad-" + std::to_string(::getpid()));
   fs::create_directories(dir);
