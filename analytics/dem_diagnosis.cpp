@@ -536,6 +536,23 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
     r.lack_of_fit_p_after =
         gsl_cdf_fdist_Q(chi2_of(s, log_after, K) / double(df_after), double(df_after), double(s.df_pure_error));
     if (r.effect >= 0) {
+        // rivals: other significant candidates whose fit is not worse than the effect's by more than the interval's
+        // chi2 quantile. The rates then cannot tell them apart: the effect is the likelier one, not the proven one.
+        const auto& e = r.candidates[std::size_t(r.effect)];
+        for (std::size_t k : tested) {
+            const auto& c = r.candidates[k];
+            if (int(k) == r.effect || !c.significant || !c.cv_gain) continue;
+            if (c.chi2_fitted - e.chi2_fitted < delta_chi2) {
+                r.rivals.push_back(int(k));
+                r.warnings.push_back(c.spec.name + " = " + number_text(c.fitted, 4) + " explains the data nearly as well "
+                                     "as " + e.spec.name + " (CV RMSE " + number_text(c.cv_rmse, 3) + " against " +
+                                     number_text(e.cv_rmse, 3) + ", chi2 " + number_text(c.chi2_fitted, 3) +
+                                     " against " + number_text(e.chi2_fitted, 3) + "): these rates cannot tell the two "
+                                     "apart; more conditions, repeats or another measured quantity can");
+            }
+        }
+    }
+    if (r.effect >= 0) {
         const auto& e = r.candidates[std::size_t(r.effect)];
         if (e.interval_at_lower_bound || e.interval_at_upper_bound)
             r.warnings.push_back(e.spec.name + ": the interval reaches the candidate's bound; the value may lie "
@@ -598,6 +615,9 @@ nlohmann::json DemDiagnosis::to_json(const SiloMeasurements& data) const {
         effect_json = {{"name", e.spec.name},       {"fields", e.spec.fields},   {"declared", e.declared},
                        {"fitted", e.fitted},        {"interval", {e.interval_low, e.interval_high}},
                        {"p_holm", e.p_holm},        {"cv_rmse_after", e.cv_rmse}};
+        json rival_names = json::array();
+        for (int k : rivals) rival_names.push_back(candidates[std::size_t(k)].spec.name);
+        effect_json["rivals"] = rival_names;
     }
     return {{"model", "silo-dem"},
             {"n", n},

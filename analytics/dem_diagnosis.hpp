@@ -123,6 +123,7 @@ struct DemDiagnosis {
     double rmse_before = NAN, rmse_before_g_s = NAN, chi2_before = NAN, lack_of_fit_p_before = NAN;
     std::vector<DemCandidateResult> candidates;
     int effect = -1;  // index into candidates of the effect named, -1: none
+    std::vector<int> rivals;  // candidates that explain the data about as well as the effect (see diagnose_dem)
     double rmse_after = NAN, rmse_after_g_s = NAN, cv_rmse_after = NAN, lack_of_fit_p_after = NAN;
     std::vector<double> rates_after;  // per condition [g/s] (= declared when no effect)
     std::vector<std::string> warnings;

@@ -179,8 +179,8 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
     fs::remove_all(dir);
 }
 
-TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value inside the interval - the declared "
-          "material's own rates get nothing - the same command again runs nothing",
+TEST_CASE("diagnose silo-dem: a raised wall friction is named or is the named effect's rival, with its value inside "
+          "its interval - the declared material's own rates get nothing - the same command again runs nothing",
           "[diagnose][silo-dem][slow]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-dem-" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -210,12 +210,12 @@ TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value ins
         }
     rough.close();
     clean.close();
-    // Without cohesion among the candidates: on this tiny set (300 grains, 5 angles, one seed) a small cohesion
-    // (about 0.09 J/m^2) explains the raised wall friction's rates better by cross-validation, and is named instead
-    // (measured 2026-12-02; examples/diagnose/README.md): the two effects are confounded on rates alone here.
+    // Every candidate, cohesion too. On this tiny set (300 grains, 5 angles, one seed) a small cohesion explains the
+    // raised wall friction's rates about as well (measured 2026-12-02: cohesion 0.080 J/m^2, CV RMSE 8.79 %; wall
+    // friction 0.63, 8.86 %; examples/diagnose/README.md), so either may be named: the wall friction must be the
+    // effect or its rival, with the true value in its interval, and cohesion's 0.3 J/m^2 arches the bed there.
     const std::string common = " --material '" + kDeclared + "' --campaign '" + (dir / "campaign").string() +
-                               "' --jobs 2 --grid-points 4 --refine-steps 2 --candidates rolling_friction,wall_friction,restitution -- " +
-                               kTinySilo;
+                               "' --jobs 2 --grid-points 4 --refine-steps 2 -- " + kTinySilo;
 
     const auto start = std::chrono::steady_clock::now();
     REQUIRE(demcal_run("diagnose --model silo-dem --data '" + (dir / "rough.csv").string() + "' --json '" +
@@ -225,12 +225,24 @@ TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value ins
     INFO(read_file(dir / "rough.log"));
     const auto r = nlohmann::json::parse(read_file(dir / "rough.json"));
     REQUIRE(r["effect"].is_object());
-    CHECK(r["effect"]["name"] == "wall_friction");
-    CHECK(r["effect"]["interval"][0].get<double>() <= kTrueWallFriction);
-    CHECK(r["effect"]["interval"][1].get<double>() >= kTrueWallFriction);
+    const std::string named = r["effect"]["name"];
+    bool wall_rival = false;
+    for (const auto& rival : r["effect"]["rivals"]) wall_rival = wall_rival || rival == "wall_friction";
+    CHECK((named == "wall_friction" || wall_rival));
+    nlohmann::json wall;
+    for (const auto& c : r["candidates"])
+        if (c["name"] == "wall_friction") wall = c;
+    REQUIRE(wall.is_object());
+    CHECK(wall["interval"][0].get<double>() <= kTrueWallFriction);
+    CHECK(wall["interval"][1].get<double>() >= kTrueWallFriction);
+    nlohmann::json cohesion;
+    for (const auto& c : r["candidates"])
+        if (c["name"] == "cohesion") cohesion = c;
+    REQUIRE(cohesion.is_object());
+    CHECK(cohesion["declared"] == 0.0);  // (the wheat file has no surface energy: absent means none)
     CHECK(r["after"]["cv_rmse"].get<double>() < 0.95 * r["before"]["rmse"].get<double>());
     CHECK(fs::exists(dir / "report/rough_residuals_after.png"));
-    CHECK_THAT(read_file(dir / "report/rough.md"), Catch::Matchers::Contains("**wall_friction**"));
+    CHECK_THAT(read_file(dir / "report/rough.md"), Catch::Matchers::Contains("**" + named + "**"));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WARN("rough-wall diagnosis: " << seconds << " s wall, " << r["runs"]["run_now"] << " kernel runs");
 
@@ -246,6 +258,6 @@ TEST_CASE("diagnose silo-dem: a raised wall friction is named with its value ins
     REQUIRE(demcal_run("diagnose --model silo-dem --data '" + (dir / "rough.csv").string() + "'" + common,
                        dir / "again.log") == 0);
     CHECK_THAT(read_file(dir / "again.log"), Catch::Matchers::Contains("0 run now"));
-    CHECK_THAT(read_file(dir / "again.log"), Catch::Matchers::Contains("DEM effect: wall_friction"));
+    CHECK_THAT(read_file(dir / "again.log"), Catch::Matchers::Contains("DEM effect: " + named));
     fs::remove_all(dir);
 }
