@@ -10,13 +10,20 @@ namespace demcal::kernel {
 
 bool NeighborList::needs_rebuild(const std::vector<Vec3>& x, int threads) const {
   if (!valid_ || x.size() != x_built_.size()) return true;
-  const double lim2 = 0.25 * skin_ * skin_;
+  const double allowance = displacement_allowance();
+  const double lim2 = allowance * allowance;
   const std::int64_t n = std::int64_t(x.size());
   int moved = 0;
 #pragma omp parallel for schedule(static) num_threads(threads) reduction(| : moved)
   for (std::int64_t i = 0; i < n; ++i)
     if ((x[i] - x_built_[i]).squaredNorm() > lim2) moved = 1;
   return moved != 0;
+}
+
+void NeighborList::spend(double amount) {
+  if (!(amount > 0)) return;
+  spent_ += amount;
+  if (!(spent_ < 0.5 * skin_)) valid_ = false;
 }
 
 bool CellGrid::fit(const std::vector<Vec3>& x, const std::vector<double>& r, double skin) {
@@ -53,6 +60,7 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
                          const std::vector<std::int32_t>& group, double skin, int threads, double reach) {
   const std::size_t n = x.size();
   skin_ = skin;
+  spent_ = 0;
   ++builds_;
   // keep the old list for the history carry-over
   std::vector<std::uint32_t> old_row;
@@ -223,14 +231,17 @@ namespace demcal::kernel {
 
 void NeighborList::save(StateWriter& w) const {
   w.array(row); w.array(nbr); w.array(hist); w.array(trow); w.array(tpair); w.array(x_built_);
-  w.value(skin_); w.value(valid_); w.value(std::uint64_t(builds_));
+  w.value(skin_); w.value(valid_); w.value(std::uint64_t(builds_)); w.value(spent_);
 }
 
-void NeighborList::load(StateReader& r) {
+void NeighborList::load(StateReader& r, bool spent_in_state) {
   r.array(row, "neighbour rows"); r.array(nbr, "neighbours"); r.array(hist, "pair histories");
   r.array(trow, "transposed rows"); r.array(tpair, "transposed pairs"); r.array(x_built_, "build positions");
   r.value(skin_, "neighbour skin"); r.value(valid_, "neighbour list state");
   builds_ = std::size_t(r.value<std::uint64_t>("neighbour builds"));
+  spent_ = 0;
+  if (spent_in_state) r.value(spent_, "skin spent by growth");
+  if (!(spent_ >= 0 && spent_ < 0.5 * skin_) && valid_) r.fail("skin spent by growth", "out of range");
   if (hist.size() != nbr.size() * hsize_ || (valid_ && (row.empty() || row.back() != nbr.size() || tpair.size() != nbr.size())))
     r.fail("neighbour list", "inconsistent sizes");
 }

@@ -35,8 +35,17 @@ class NeighborList {
   /// |x_i - x_j| < r_i + r_j + skin + reach.
   void build(const std::vector<Vec3>& x, const std::vector<double>& r, const std::vector<std::int32_t>& group,
              double skin, int threads, double reach = 0.0);
-  /// True when some sphere moved more than skin/2 since the last build (or the list was never built / invalidated).
+  /// True when some sphere moved more than displacement_allowance() since the last build (or the list was never
+  /// built / invalidated).
   bool needs_rebuild(const std::vector<Vec3>& x, int threads) const;
+  /// How far a sphere may move from its build position before the list may miss a contact: skin/2, less what growth
+  /// has spent (spend()).
+  double displacement_allowance() const { return 0.5 * skin_ - spent_; }
+  /// Charges a widening of every contact's reach since the build [m] (spheres grown by up to `amount` in radius, a
+  /// law's reach beyond touching grown by `amount`) to the skin: the list stays valid while each sphere's
+  /// displacement plus everything spent stays within skin/2 (then no pair outside the list can touch or act);
+  /// invalidated once nothing is left. A build starts again from the whole skin.
+  void spend(double amount);
   /// Renumbers spheres after a removal or a permutation: old2new[old] = new index or -1 (removed). Pairs keep their
   /// history (passed through swap_history where i and j swap order). The list must then be rebuilt before use.
   void renumber(const std::vector<std::int32_t>& old2new, std::size_t new_count, void (*swap_history)(double*));
@@ -47,7 +56,9 @@ class NeighborList {
 
   /// Checkpoint: the list, its histories and its build positions (kernel/state_io.hpp).
   void save(StateWriter& w) const;
-  void load(StateReader& r);
+  /// spent_in_state: false for a state written before the skin budget existed (nothing was spent then: growth
+  /// invalidated the list)
+  void load(StateReader& r, bool spent_in_state = true);
 
   std::size_t num_pairs() const { return nbr.size(); }
   std::size_t num_builds() const { return builds_; }
@@ -64,6 +75,7 @@ class NeighborList {
  private:
   std::vector<Vec3> x_built_;
   double skin_ = 0;
+  double spent_ = 0;  // of skin/2, by growth since the last build
   std::size_t hsize_ = 0;
   bool valid_ = false;
   std::size_t builds_ = 0;

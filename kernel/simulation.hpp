@@ -204,7 +204,8 @@ class BasicSimulation {
   std::size_t memory_bytes() const;
 
  private:
-  static constexpr const char* kStateFormat = "demcal-kernel-state/3";  // 3: contact histories of any size, walls move
+  // 3: contact histories of any size, walls move; 4: the skin spent by growth (3 is still read)
+  static constexpr const char* kStateFormat = "demcal-kernel-state/4";
   void prepare();
   void compute_forces(bool rebuild, double dt_history);
   bool kick_drift(double kick);

@@ -283,9 +283,9 @@ void BasicSimulation<Law>::prepare() {
     for (int a = 0; a < nm; ++a)
       for (int b = 0; b < nm; ++b)
         if (pair_set_[a * nm + b]) reach = std::max(reach, Law::reach(coeffs_[a * nm + b], r_max));
-    // pairs may now act beyond the list's reach; not so for a list just loaded from a state: it was built with the
-    // reach of these materials and radii (the configuration matched), as the uninterrupted run's list was
-    if (reach > law_reach_ && !list_from_state_) nl_.invalidate();
+    // pairs may now act beyond the list's reach (charged to its skin); not so for a list just loaded from a state: it
+    // was built with the reach of these materials and radii (the configuration matched), as the uninterrupted run's
+    if (reach > law_reach_ && !list_from_state_) nl_.spend(reach - law_reach_);
     law_reach_ = reach;
     list_from_state_ = false;
   }
@@ -316,7 +316,8 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
   const bool check = nl_.valid() && nl_.built_positions().size() == x_.size();
   const Vec3* xb = check ? nl_.built_positions().data() : nullptr;
-  const double lim2 = 0.25 * skin_ * skin_;
+  const double allowance = nl_.displacement_allowance();
+  const double lim2 = allowance * allowance;
   int moved = check ? 0 : 1;
   if (Law::uses_omega_norm) omega_norm_.resize(std::size_t(n));
   double* wnorm = omega_norm_.data();
@@ -813,7 +814,10 @@ void BasicSimulation<Law>::scale_particles(double factor) {
   omega_norm_fresh_ = false;
   if (forces_valid_) rekick_on_refresh_ = true;
   forces_valid_ = false;
-  nl_.invalidate();  // the cells must hold the new largest sphere
+  // every radius grew by at most (factor - 1) r_max: charged to the skin (the grid's cells are sized at each build)
+  double r_max = 0;
+  for (double r : r_) r_max = std::max(r_max, r);
+  if (factor > 1) nl_.spend(r_max - r_max / factor);
 }
 
 template <class Law>
@@ -1147,10 +1151,11 @@ template <class Law>
 void BasicSimulation<Law>::load_state(std::istream& is, const std::string& source) {
   StateReader r(is, source);
   const std::string tag = r.text("format tag");
+  const bool spent_in_state = tag != "demcal-kernel-state/3";  // (/3: before the skin budget; read as nothing spent)
   if (tag == "demcal-kernel-state/1" || tag == "demcal-kernel-state/2")
     r.fail("format tag", "written by an older demcal (" + tag + "; this one reads " + kStateFormat +
                              "): finish that run with the demcal that started it, or start it again");
-  if (tag != kStateFormat)
+  if (tag != kStateFormat && tag != "demcal-kernel-state/3")
     r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a demcal kernel state (" + kStateFormat + ")");
   std::vector<double> saved;
   r.array(saved, "configuration");
@@ -1179,7 +1184,7 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   r.array(cmem_start_, "clump members"); r.array(cmem_, "clump members");
   r.array(body_ref_, "bodies"); r.array(body_id_, "body ids");
   r.value(next_id_, "next body id");
-  nl_.load(r);
+  nl_.load(r, spent_in_state);
   r.value(gravity_, "gravity"); r.value(dt_, "time step"); r.value(time_, "time"); r.value(skin_, "skin");
   r.value(steps_, "step count"); r.value(reorder_every_, "reorder period");
   builds_since_reorder_ = std::size_t(r.value<std::uint64_t>("builds since the last reorder"));
