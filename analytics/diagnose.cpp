@@ -22,6 +22,8 @@ namespace demcal::analytics {
 namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+// Below this RMS of the dimensionless residuals a fit is exact to rounding (doubles carry about 1e-16).
+constexpr double kExactFitResidual = 1e-9;
 // Residual given to a prediction the model cannot make (non-positive rate, outlet blocked by the annulus): large
 // enough that the optimiser steps back, finite so that GSL keeps going.
 constexpr double penalty_residual = 30.0;
@@ -264,6 +266,9 @@ Model base_model(const std::string& name, const MeasuredData& d, Setting& s) {
     if (name == "failure-line") {
         const auto& sigma = d.at("sigma_Pa").values;
         const auto& tau = d.at("tau_Pa").values;
+        if (is_constant(d.at("sigma_Pa")))
+            throw std::invalid_argument("sigma_Pa: every row has the normal stress " + short_number(sigma.front()) +
+                                        " Pa: a failure line needs at least two different normal stresses");
         m.relative = false;
         m.param_names = {"mu_b", "tau_c_Pa"};
         double c0 = 0, c1 = 0, c00, c01, c11, sse;
@@ -539,8 +544,9 @@ std::vector<Term> candidates(const Setting& s, const Model& m, const std::set<st
         out.push_back(t);
     }
     const auto* dp = d.find("d_p_m");
+    // (a d_p that does not vary only rescales every rate: the base model's own constants absorb it)
     if (m.relative && dp && (m.name == "oldal" || m.name == "oldal-rect" || m.name == "johanson") &&
-        !done.count("d_p_m")) {
+        !done.count("d_p_m") && !is_constant(*dp)) {
         // Oldal's effective outlet is d - d_p (k0 = 1), Johanson has none (k0 = 0); the annulus k d_p generalises both.
         const double k0 = m.name == "johanson" ? 0.0 : 1.0;
         const auto& outlet = d.at("outlet_m").values;
@@ -769,6 +775,16 @@ Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions
     LeastSquaresFit& fit = out.fit;
     fit = out.base_fit;
     const std::size_t n = s.rows.size();
+    // Residuals are dimensionless (log ratios, or stresses over their scale): a base fit exact to rounding leaves no
+    // scatter for an F test (0/0) and nothing to explain, whatever a candidate's fit does with the last bits.
+    const double base_rms = std::sqrt(fit.sse / double(std::max<std::size_t>(n, 1)));
+    if (std::isfinite(base_rms) && base_rms < kExactFitResidual) {
+        out.cv_after = cross_validated_rmse(s, m, fit.params);
+        warnings.push_back("the " + m.name + " model fits every row to rounding (residual RMS " + short_number(base_rms) +
+                           "): the data carry no scatter to test an effect against (identical or noiseless rows?); "
+                           "no effect was searched");
+        return out;
+    }
     out.cv_after = cross_validated_rmse(s, m, fit.params);
     double& cv_now = out.cv_after;
     std::set<std::string> done;

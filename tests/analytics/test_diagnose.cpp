@@ -87,6 +87,27 @@ TEST_CASE("diagnose rejects data that do not suit the model", "[diagnose]") {
     CHECK_THROWS_WITH(diagnose(rect, "failure-line"), Catch::Contains("missing column sigma_Pa"));
 }
 
+TEST_CASE("diagnose of degenerate data - identical rows get no effect and a warning - one normal stress is refused",
+          "[diagnose]") {
+    // every row a copy of the first (a file pasted 36 times): nothing varies, nothing scatters
+    auto same = make_synthetic_set(spec("oldal", "moisture", 0.2, 7));
+    for (auto& c : same.columns) {
+        if (c.numeric) std::fill(c.values.begin(), c.values.end(), c.values.front());
+        std::fill(c.text.begin(), c.text.end(), c.text.front());
+    }
+    const auto r = diagnose(same, "oldal");
+    CHECK(r.effects.empty());
+    bool warned = false;
+    for (const auto& w : r.warnings) warned = warned || w.find("no scatter to test an effect against") != std::string::npos;
+    CHECK(warned);
+    // a failure line with every stress equal has no slope to fit
+    auto shear = make_synthetic_set(spec("failure-line", "none", 0, 3));
+    auto& sigma = const_cast<demcal::analytics::DataColumn&>(shear.at("sigma_Pa"));
+    std::fill(sigma.values.begin(), sigma.values.end(), 15000.0);
+    std::fill(sigma.text.begin(), sigma.text.end(), std::string("15000"));
+    CHECK_THROWS_WITH(diagnose(shear, "failure-line"), Catch::Contains("sigma_Pa: every row has the normal stress 15000"));
+}
+
 TEST_CASE("the JSON result has the documented shape", "[diagnose]") {
     const auto r = diagnose(make_synthetic_set(spec("oldal", "moisture", 0.2, 7)), "oldal");
     const auto j = r.to_json();
