@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -452,6 +453,50 @@ std::string pinned_bound_simulated(const Search& s, const SurrogateModel& model,
     return "";
 }
 
+// A step between two simulated evaluations that bracket every target (each target lies strictly between their
+// values): the point of their segment where the lines interpolated linearly miss least (in acceptance units). The
+// surrogate adds one-at-a-time responses and may call a target out of reach where the parameters interact; two
+// evaluations on either side say otherwise. None when no pair brackets every target or the point was simulated.
+std::optional<std::vector<double>> bracketing_step(const Search& s, const std::vector<std::size_t>& controls,
+                                                   const std::vector<std::size_t>& targets) {
+    const auto& its = s.result().iterations;
+    const auto& pts = s.points();
+    std::optional<std::vector<double>> best;
+    double best_miss = std::numeric_limits<double>::infinity();
+    for (std::size_t a = 0; a < pts.size(); ++a)
+        for (std::size_t b = a + 1; b < pts.size(); ++b) {
+            bool brackets = true;
+            double num = 0, den = 0;
+            for (std::size_t t : targets) {
+                const auto& target = s.targets()[t];
+                const double ya = value_at(its[a], target.quantity), yb = value_at(its[b], target.quantity);
+                const double w = 1.0 / std::pow(target.acceptance(s.options().tolerance), 2);
+                brackets = brackets && (ya - target.value) * (yb - target.value) < 0;
+                num += w * (target.value - ya) * (yb - ya);
+                den += w * (yb - ya) * (yb - ya);
+            }
+            if (!brackets || !(den > 0)) continue;
+            const double lambda = std::clamp(num / den, 0.0, 1.0);
+            double miss = 0;
+            for (std::size_t t : targets) {
+                const auto& target = s.targets()[t];
+                const double ya = value_at(its[a], target.quantity), yb = value_at(its[b], target.quantity);
+                miss += std::pow((ya + lambda * (yb - ya) - target.value) / target.acceptance(s.options().tolerance), 2);
+            }
+            std::vector<double> z = pts[b];
+            for (std::size_t j : controls) z[j] = pts[a][j] + lambda * (pts[b][j] - pts[a][j]);
+            z = s.snapped(z);
+            bool simulated = false;
+            for (const auto& q : pts) {
+                double d = 0;
+                for (std::size_t j : controls) d = std::max(d, std::fabs(q[j] - z[j]));
+                simulated = simulated || d < same_point;
+            }
+            if (!simulated && miss < best_miss) best = z, best_miss = miss;
+        }
+    return best;
+}
+
 bool accepted_for(const Search& s, const CalibrationIteration& it, const std::vector<std::size_t>& targets) {
     for (std::size_t t : targets) {
         const auto& target = s.targets()[t];
@@ -479,6 +524,18 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
             for (std::size_t j : controls) d = std::max(d, std::fabs(s.points()[q][j] - proposal[j]));
             if (d < same_point) repeats = true, repeated = q;
         }
+        // Where the surrogate gives up (a simulated point again, or a simulated bound), evaluations that bracket every
+        // target still show a way: a secant step between them.
+        std::size_t at_bound = 0;
+        const auto pinned =
+            repeats ? std::string() : pinned_bound_simulated(s, model, proposal, controls, targets, at_bound);
+        if ((repeats || !pinned.empty()) && s.budget_left())
+            if (const auto step = bracketing_step(s, controls, targets)) {
+                s.evaluate_at(*step, phase + " (bracketed)");
+                k = s.points().size() - 1;
+                model.anchor(s.points()[k], s.values()[k]);
+                continue;
+            }
         if (repeats) {
             const std::string where = bounds_at(s, proposal, controls);
             auto& r = s.result();
@@ -491,11 +548,9 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
             }
             return false;
         }
-        // The model finds no point that meets the targets and wants a bound that has already been simulated: the
-        // simulations confirmed the model there, so more of them cannot help.
-        std::size_t at_bound = 0;
-        if (const auto pinned = pinned_bound_simulated(s, model, proposal, controls, targets, at_bound);
-            !pinned.empty()) {
+        // The model finds no point that meets the targets and wants a bound that has already been simulated, and no
+        // two evaluations bracket the targets: the simulations confirmed the model there, so more cannot help.
+        if (!pinned.empty()) {
             end_at_simulated_bound(s, pinned, at_bound, targets);
             return false;
         }

@@ -49,7 +49,8 @@ struct CalibrationOptions {
 
 struct CalibrationIteration {
     int evaluation = 0;                     // 1-based count of failure lines
-    std::string phase;                      // start, joint, slope, cohesion, coordinate, grid
+    std::string phase;                      // start, joint, slope, cohesion, coordinate, grid; "(bracketed)" added
+                                            // to a secant step between evaluations that bracket the targets
     std::map<std::string, double> values;   // the controlling parameters
     double mu_b = 0, mu_b_half_width = 0, tau_c = 0, tau_c_half_width = 0;
     double mismatch = 0;                    // max over targets of |simulated - target| / acceptance (<= 1: reached)

@@ -34,13 +34,18 @@ double SyntheticShearBox::true_tau_c(const nlohmann::json& m) {
     return 100 + 0.4 * bs + 300 * (f - 0.5) - 150 * (e - 1) * (e - 1) + 400 * (form - 1) * (form - 1);
 }
 
+double SyntheticShearBox::interaction_of(const nlohmann::json& m) {
+    return (m.at("friction_coefficient").get<double>() - 0.5) * (m.at("bond_shear_strength").get<double>() / 1e3 - 2);
+}
+
 calibration::FailureLineEvaluation SyntheticShearBox::operator()(const nlohmann::json& material) {
     ++evaluations;
     const std::string key = material.dump();
     const bool seen = computed.count(key) > 0;
     computed.insert(key);
     std::unique_ptr<gsl_rng, decltype(&gsl_rng_free)> rng(gsl_rng_alloc(gsl_rng_mt19937), gsl_rng_free);
-    const double mu = true_mu_b(material), tau_c = true_tau_c(material);
+    const double mu = true_mu_b(material) + mu_interaction * interaction_of(material),
+                 tau_c = true_tau_c(material) + tau_interaction * interaction_of(material);
     std::vector<double> sigma, tau;
     for (int rep = 0; rep < replicates; ++rep)
         for (std::size_t i = 0; i < normal_stresses.size(); ++i) {

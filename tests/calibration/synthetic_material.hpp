@@ -20,6 +20,10 @@ struct SyntheticShearBox {
     std::set<std::string> computed;     // materials already "run": their runs count as reused
     int evaluations = 0;
 
+    // friction x bond shear interaction, zero along both axes through the base material (0.5, 2 kPa): a one-at-a-time
+    // study cannot see it
+    double mu_interaction = 0.0, tau_interaction = 0.0;  // [-], [Pa] per unit of (f - 0.5) (bond_kPa - 2)
+    static double interaction_of(const nlohmann::json& m);
     static double true_mu_b(const nlohmann::json& m);
     static double true_tau_c(const nlohmann::json& m);
     calibration::FailureLineEvaluation operator()(const nlohmann::json& material);
