@@ -7,6 +7,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/silo_material.hpp"
+#include "app/silo_flow_pattern.hpp"
 #include "app/silo_settings.hpp"
 #include "app/gnuplot.hpp"
 #include "analytics/user_input.hpp"
@@ -51,6 +52,8 @@ struct SiloCrosscheckOptions {
     std::string plot_format = "png";
     long max_runs = 10000;
 };
+
+constexpr const char* kYadeFramesFile = "frames.bin";
 
 // The differences between the two codes' set-ups that YADE cannot remove (yade_scripts/README.md measures them).
 const char* const kKnownDifferences[] = {
@@ -106,7 +109,27 @@ json yade_params(const json& bed, const SiloCrosscheckOptions& o, const json& ya
               {"time_step_fraction", bed.at("time_step_fraction")},
               {"discharge_time_s", o.max_time},
               {"sample_interval_s", bed.at("record_interval_s")},
-              {"removal_depth_m", bed.at("removal_depth_m")}}}};
+              {"removal_depth_m", bed.at("removal_depth_m")},
+              // YADE's flow-pattern frames at the kernel's interval, classified here by the kernel's classifier
+              {"frame_interval_s", bed.at("flow_pattern_sampling").at("frame_interval_s")},
+              {"frames_file", kYadeFramesFile}}}};
+}
+
+// YADE's flow pattern: its frames through the kernel's classifier with the kernel's sampling (from the bed).
+json yade_flow_pattern(const fs::path& dir, const json& bed, const json& yade_result) {
+    try {
+        const FlowPatternSampling sampling =
+            flow_pattern_sampling_from_json(bed.at("flow_pattern_sampling"), (dir / "bed.json").string());
+        const json& geometry = bed.at("geometry");
+        const auto silo = kernel::silo::SiloGeometry::conical(
+            geometry.at("theta_deg").get<double>(), geometry.at("outlet_m").get<double>(),
+            geometry.at("D_m").get<double>(), geometry.at("body_height_m").get<double>());
+        return flow_pattern_json(flow_pattern_of_frames(dir / "yade" / kYadeFramesFile, silo, sampling,
+                                                        yade_result.at("initial_mass_kg").get<double>(),
+                                                        yade_result.at("discharged_mass_kg").get<double>()));
+    } catch (const std::exception& e) {
+        return {{"pattern", "undetermined"}, {"wall_to_axis_velocity_ratio", 0.0}, {"message", e.what()}};
+    }
 }
 
 struct CurvePoint {
@@ -227,7 +250,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
         const fs::path d = root / theta_name(theta);
         fs::create_directories(d / "kernel");
         const auto argv = kernel_argv(o, theta, d / "kernel", d / "bed.json", program);
-        std::string id = "demcal silo";
+        std::string id = "demcal silo (bed with flow_pattern_sampling)";
         for (std::size_t i = 1; i < argv.size(); ++i) id += " " + argv[i];
         if (!o.material.empty()) id += "\nmaterial " + orchestrator::sha256_hex(orchestrator::read_text_file(o.material));
         if (!o.geometry.empty()) id += "\ngeometry " + orchestrator::sha256_hex(orchestrator::read_text_file(o.geometry));
@@ -304,13 +327,13 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     if (!yade_material.is_null()) report["yade_material"] = yade_material;
     std::ostringstream md;
     md << "| theta [deg] | kernel rate [g/s] (batch SE) | YADE rate [g/s] (slope SE) | YADE / kernel | rates | kernel empty [s] | "
-          "YADE empty [s] | kernel pattern (wall/axis) | largest curve gap [% of fill] | kernel CPU [s] | YADE CPU [s] | "
-          "YADE / kernel CPU |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    bool complete = true, all_agree = true;
+          "YADE empty [s] | kernel pattern (wall/axis) | YADE pattern (wall/axis) | largest curve gap [% of fill] | "
+          "kernel CPU [s] | YADE CPU [s] | YADE / kernel CPU |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    bool complete = true, all_agree = true, all_patterns_agree = true, all_patterns_determined = true;
     for (double theta : o.thetas) {
         const fs::path d = root / theta_name(theta);
         if (!fs::exists(d / "kernel" / "summary.json") || !fs::exists(d / "yade" / "result.json")) {
-            md << "| " << theta << " | (a run failed: see " << d.string() << ") |||||||||\n";
+            md << "| " << theta << " | (a run failed: see " << d.string() << ") ||||||||||\n";
             complete = false;
             continue;
         }
@@ -323,14 +346,27 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
         const double gap = largest_gap(kc, yc, filled);
         const double kcpu = k.at("cpu_s").get<double>(), ycpu = y.at("cpu_time_s").get<double>();
         const json& pattern = k.at("flow_pattern");
+        const json yade_pattern = yade_flow_pattern(d, analytics::read_json_input(d / "bed.json", "bed"), y);
         const bool agree = std::abs(yr / kr - 1) <= o.tolerance;
+        // compared only where both codes determined a pattern (too few grains leave a hopper height without samples)
+        const bool patterns_determined =
+            pattern.value("pattern", "undetermined") != "undetermined" &&
+            yade_pattern.value("pattern", "undetermined") != "undetermined";
+        const bool patterns_agree =
+            patterns_determined && pattern.value("pattern", "") == yade_pattern.value("pattern", "");
         all_agree = all_agree && agree;
+        all_patterns_agree = all_patterns_agree && (patterns_agree || !patterns_determined);
+        all_patterns_determined = all_patterns_determined && patterns_determined;
         md << "| " << theta << " | " << g(kr * 1e3) << " (" << g(k["rate"].value("rate_batch_se_kg_s", 0.0) * 1e3, 2)
            << ") | " << g(yr * 1e3) << " (" << g(y["rate"].value("rate_se_kg_s", 0.0) * 1e3, 2) << ") | "
            << g(yr / kr, 4) << " | " << (agree ? "agree" : "**DIFFER**") << " | "
            << g(k.at("discharge").at("time_s").get<double>(), 3) << " | "
            << g(y.at("discharge_time_s").get<double>(), 3) << " | " << pattern.value("pattern", "?") << " ("
-           << g(pattern.value("wall_to_axis_velocity_ratio", 0.0), 2) << ") | " << g(100 * gap, 2) << " | "
+           << g(pattern.value("wall_to_axis_velocity_ratio", 0.0), 2) << ") | "
+           << (patterns_determined && !patterns_agree ? "**" : "") << yade_pattern.value("pattern", "?") << " ("
+           << g(yade_pattern.value("wall_to_axis_velocity_ratio", 0.0), 2) << ")"
+           << (patterns_determined && !patterns_agree ? "**" : "")
+           << " | " << g(100 * gap, 2) << " | "
            << g(kcpu, 3) << " | " << g(ycpu, 3) << " | " << g(ycpu / kcpu, 3) << " |\n";
         report["angles"].push_back({{"theta_deg", theta},
                                     {"kernel", {{"rate_kg_s", kr},
@@ -343,10 +379,12 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
                                               {"rate_se_kg_s", y["rate"].value("rate_se_kg_s", 0.0)},
                                               {"time_to_empty_s", y.at("discharge_time_s")},
                                               {"stop_reason", y.at("stop_reason")},
+                                              {"flow_pattern", yade_pattern},
                                               {"cpu_s", ycpu},
                                               {"wall_s", y.at("wall_time_s")}}},
                                     {"rate_ratio_yade_over_kernel", yr / kr},
                                     {"rates_agree", agree},
+                                    {"patterns_agree", patterns_determined ? json(patterns_agree) : json(nullptr)},
                                     {"yade_material_as_bed", y.value("material_as_bed", true)},
                                     {"largest_curve_gap_of_filled_mass", gap},
                                     {"cpu_ratio_yade_over_kernel", ycpu / kcpu}});
@@ -360,10 +398,17 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
        << (all_agree ? ": they do at every angle." : ": **they do not at every angle**.");
     if (!yade_material.is_null())
         md << " YADE ran a different material on purpose (--yade-material " << o.yade_material << ").";
-    md << "\n\nThe YADE flow pattern is not measured (silo.py records the discharged mass only). Differences YADE "
-          "cannot remove (yade_scripts/README.md):\n";
+    md << " Flow patterns: YADE's frames (at the kernel's frame interval) classified by the kernel's own "
+          "classifier with the kernel's settings; "
+       << (!all_patterns_agree            ? "**not the same at every angle** (marked)."
+           : all_patterns_determined      ? "the same at every angle."
+                                          : "the same wherever both were determined (see each report's message for "
+                                            "the others).")
+       << "\n\nDifferences YADE cannot remove (yade_scripts/README.md):\n";
     for (const char* d : kKnownDifferences) md << "- " << d << "\n";
     report["rates_agree"] = all_agree;
+    report["patterns_agree"] = all_patterns_agree;  // at every angle where both codes determined one
+    report["patterns_determined"] = all_patterns_determined;
     orchestrator::write_text_file_atomically(root / "crosscheck_silo.json", report.dump(2) + "\n");
     orchestrator::write_text_file_atomically(root / "crosscheck_silo.md", md.str());
     std::cout << "\n" << md.str() << "\nresults: " << (root / "crosscheck_silo.json").string() << ", "

@@ -4,6 +4,7 @@
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
 #include "app/silo_bed_export.hpp"
+#include "app/silo_flow_pattern.hpp"
 #include "app/silo_material.hpp"
 #include "app/silo_settings.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
@@ -626,14 +627,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
         fit["message"] = r.fit.message;
     }
     j["rate"] = fit;
-    j["flow_pattern"] = {{"pattern", ks::to_string(r.flow.pattern)},
-                         {"wall_to_axis_velocity_ratio", r.flow.ratio},
-                         {"wall_speed_m_s", r.flow.wall_speed},
-                         {"axis_speed_m_s", r.flow.axis_speed},
-                         {"wall_samples", r.flow.wall_samples},
-                         {"frames", r.flow.frames},
-                         {"measure", r.flow.measure}};
-    if (!r.flow.message.empty()) j["flow_pattern"]["message"] = r.flow.message;
+    j["flow_pattern"] = flow_pattern_json(r.flow);
     j["vibration"] = vibration_json(s, r);
     if (r.bulk_density > 0) j["beverloo_check"] = beverloo_check(s, r);
     j["steps"] = r.steps;

@@ -1,5 +1,6 @@
 #include "app/silo_bed_export.hpp"
 
+#include "app/silo_flow_pattern.hpp"
 #include "app/silo_material.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
@@ -79,6 +80,7 @@ json silo_bed_json(const ks::OpenedBed& bed, const ks::SiloCaseSettings& s) {
             {"gravity_m_s2", s.gravity},
             {"removal_depth_m", s.removal_depth},
             {"record_interval_s", s.record_interval},
+            {"flow_pattern_sampling", flow_pattern_sampling_json(s)},
             {"geometry", geometry},
             {"material", silo_material_json(s.materials)},
             {"stiffness_scale", s.materials.stiffness_scale},

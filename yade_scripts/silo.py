@@ -19,8 +19,10 @@ file: exit 2 with `DEMCAL_FAILURE params: <field>=<value> <reason>`. Every param
 import json
 import math
 import os
+import struct
 import sys
 import time
+from array import array
 
 from yade import utils
 
@@ -30,6 +32,7 @@ CPU_START = time.process_time()
 SCHEMA = "demcal.silo_result/1"
 BED_SCHEMA = "demcal.silo_bed/1"
 READBACK_SCHEMA = "demcal.silo_readback/1"
+FRAMES_SCHEMA = "demcal.silo_frames/1"
 REQUIRED = object()
 
 
@@ -95,6 +98,10 @@ PARAM_SPECS = {
     "run.rolling_moment": number("-", 0, 1, "1: YADE's elastic-plastic rolling moment (includeMoment) capped at "
                                  "rolling_friction x (R1 + R2) / 2 x Fn; 0: no rolling resistance. Needs "
                                  "hertzian_facets 0", default=0, integer=True),
+    "run.frame_interval_s": number("s", 0.0, 10.0, "flow-pattern frames (the hopper's grains: centre, downward "
+                                   "velocity) every ... (the kernel's frame interval); 0: none", default=0.0),
+    "run.frames_file": text("if not empty: the flow-pattern frames go to this file (format in FlowFrames; demcal "
+                            "classifies them with the kernel's own classifier)", default=""),
     "run.readback_file": text("if not empty: write the bed as YADE holds it at t = 0 (before any step) to this file",
                               default=""),
 }
@@ -690,7 +697,58 @@ class DischargeRecord:
         return sum(O.bodies[c].state.mass for c in self.in_silo)
 
 
-def discharge(p, record, contact):
+class FlowFrames:
+    """Flow-pattern frames for the kernel's classifier (kernel/silo/flow_pattern.hpp), which demcal runs on them: the
+    measure is computed in one place for both codes. Written while the discharged fraction is at most STEADY_UPPER
+    (the classifier's window lies below it), every frame_interval_s of discharge, at the first sample after each due
+    time (the kernel's rule, with its sampling interval). Only grains in the hopper (0 < z < hopper height) are kept:
+    the classifier looks at no other.
+
+    File (little-endian): the line "demcal.silo_frames/1\n", then per frame: float64 time [s], float64 discharged
+    mass [kg], uint32 grain count n, then n x 4 float32: x, y, z [m], vz [m/s]. Written to a temporary file and
+    renamed at the end, so a file present is complete."""
+
+    def __init__(self, p, record):
+        self.path = p["run.frames_file"]
+        self.interval = p["run.frame_interval_s"]
+        self.record = record
+        self.hopper_height = hopper_height(p)
+        self.next_time = 0.0
+        self.frames = 0
+        self.file = None
+        if self.path and self.interval > 0:
+            self.tmp = self.path + ".tmp%d" % os.getpid()
+            self.file = open(self.tmp, "wb")
+            self.file.write((FRAMES_SCHEMA + "\n").encode())
+
+    def sample(self):
+        if self.file is None or O.time < self.next_time * (1 - 1e-12):
+            return
+        self.next_time += self.interval
+        if self.record.discharged_mass > STEADY_UPPER * self.record.initial_mass:
+            return
+        values = array("f")
+        for clump_id in self.record.in_silo:
+            state = O.bodies[clump_id].state
+            if 0.0 < state.pos[2] < self.hopper_height:
+                values.extend((state.pos[0], state.pos[1], state.pos[2], state.vel[2]))
+        if sys.byteorder != "little":
+            values.byteswap()
+        self.file.write(struct.pack("<ddI", O.time, self.record.discharged_mass, len(values) // 4))
+        values.tofile(self.file)
+        self.frames += 1
+
+    def close(self):
+        if self.file is None:
+            return None
+        self.file.flush()
+        os.fsync(self.file.fileno())
+        self.file.close()
+        os.replace(self.tmp, self.path)
+        return {"file": self.path, "frames": self.frames, "interval_s": self.interval, "schema": FRAMES_SCHEMA}
+
+
+def discharge(p, record, frames, contact):
     """Runs sampling interval after sampling interval until a stop rule holds; returns (stop reason, the stiffness
     check taken once the bed's contacts exist, after the first interval)."""
     chunk = max(1, int(round(p["run.sample_interval_s"] / contact.dt)))
@@ -698,6 +756,7 @@ def discharge(p, record, contact):
     while True:
         O.run(chunk, True)
         record.sample()
+        frames.sample()
         if stiffness is None:
             stiffness = contact.stiffness_check()
         reason = record.stop_reason()
@@ -726,7 +785,9 @@ def main():
     for plate_id in plate_ids:
         O.bodies.erase(plate_id)
     record = DischargeRecord(p, bed, clumps, wall_top)
-    stop_reason, stiffness = discharge(p, record, contact)
+    frames = FlowFrames(p, record)
+    stop_reason, stiffness = discharge(p, record, frames, contact)
+    frames_written = frames.close()
 
     fit = fit_rate(record.times, record.masses)
     result = {
@@ -742,6 +803,7 @@ def main():
         "stop_reason": stop_reason,
         "discharge_time_s": O.time,
         "import_errors": errors,
+        "flow_frames": frames_written,
         "yade_template_frame": {"centre_m": list(frame.centre), "orientation_wxyz": quaternion_wxyz(frame.orientation)},
         "steps": O.iter,
         "time_step_s": contact.dt,

@@ -14,6 +14,10 @@ std::string to_string(FlowPattern p) {
     }
 }
 
+bool gathers_frame(double fraction_out, double steady_lower, double steady_upper) {
+    return fraction_out >= steady_lower * 0.5 && fraction_out <= steady_upper;
+}
+
 FlowPatternClassifier::FlowPatternClassifier(const SiloGeometry& g, FlowPatternSettings s) : g_(g), s_(s) {}
 
 void FlowPatternClassifier::add_frame(const std::vector<Eigen::Vector3d>& pos, const std::vector<Eigen::Vector3d>& vel,

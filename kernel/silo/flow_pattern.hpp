@@ -52,6 +52,11 @@ struct FlowPatternResult {
     std::string message;           // why it is undetermined
 };
 
+// Frames are gathered while the discharged fraction of the filled mass lies in [steady_lower / 2, steady_upper]: the
+// measure's window (steady_lower..steady_upper of the mass discharged at the end) is known only at the end and can
+// begin lower when the flow stops early. One rule for the kernel's run and for frames read from another code.
+bool gathers_frame(double fraction_out, double steady_lower, double steady_upper);
+
 class FlowPatternClassifier {
 public:
     FlowPatternClassifier(const SiloGeometry& g, FlowPatternSettings s = {});

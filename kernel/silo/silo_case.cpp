@@ -688,7 +688,7 @@ private:
             if (sim_.steps_done() >= next_frame_) {
                 next_frame_ += frame_every;
                 const double frac = mass_out_ / r_.filled_mass;
-                if (frac >= s_.steady_lower * 0.5 && frac <= s_.steady_upper) {  // tagged; the window is chosen at the end
+                if (gathers_frame(frac, s_.steady_lower, s_.steady_upper)) {  // tagged; the window is chosen at the end
                     std::vector<Eigen::Vector3d> pos, vel;
                     pos.reserve(sim_.num_bodies());
                     vel.reserve(sim_.num_bodies());

@@ -1,7 +1,8 @@
 // demcal crosscheck silo end to end with real YADE: the kernel fills and discharges a tiny reduced silo, YADE
 // discharges the same bed; the report holds both rates (within 25 % of each other on 300 grains), the curve gap, the
 // costs; the same command again reuses both runs (nothing started); a deliberate mismatch of the grains' friction is
-// flagged; a bad angle is refused before anything runs.
+// flagged; a bad angle is refused before anything runs. YADE's flow pattern is measured by the kernel's classifier on
+// YADE's frames: on 600 grains in a 20 deg hopper both codes give mass flow.
 #include "slurm_for_test.hpp"
 #include "test_files.hpp"
 
@@ -11,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -70,6 +72,34 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     CHECK(read_file(dir / "bad.log").find("theta") != std::string::npos);
     CHECK_FALSE(fs::exists(dir / "bad"));
     fs::remove_all(dir);
+}
+
+TEST_CASE("crosscheck silo classifies YADE's flow pattern with the kernel's classifier", "[yade]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-xsilo-pattern-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const std::string args = "crosscheck silo --theta 20 --particles 600 --stiffness-scale 1e-3 --geometry '" +
+                             (fs::path(DEMCAL_SOURCE_DIR) / "examples/silo/reduced_conical_70deg.json").string() +
+                             "' --max-time 3 --jobs 1 -c '" + (dir / "c").string() + "'";
+    REQUIRE(run_demcal(args, dir.string() + ".log") == 0);
+    const auto report = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
+    const auto& a = report["angles"][0];
+    INFO(a.dump(1));
+    const auto& kernel = a["kernel"]["flow_pattern"];
+    const auto& yade = a["yade"]["flow_pattern"];
+    // YADE wrote frames at the kernel's interval over the same window of the discharge
+    CHECK(fs::file_size(dir / "c" / "theta_20" / "yade" / "frames.bin") > 1000);
+    CHECK(yade["frames"].get<int>() >= kernel["frames"].get<int>() - 3);
+    CHECK(yade["frames"].get<int>() <= kernel["frames"].get<int>() + 3);
+    CHECK(yade["wall_samples"].get<long>() > 100);
+    CHECK(kernel["pattern"] == "mass");
+    CHECK(yade["pattern"] == "mass");
+    CHECK(std::abs(yade["wall_to_axis_velocity_ratio"].get<double>() -
+                   kernel["wall_to_axis_velocity_ratio"].get<double>()) < 0.2);
+    CHECK(a["patterns_agree"] == true);
+    CHECK(report["patterns_agree"] == true);
+    CHECK(read_file(dir / "c" / "crosscheck_silo.md").find("YADE pattern (wall/axis)") != std::string::npos);
+    fs::remove_all(dir);
+    fs::remove(dir.string() + ".log");
 }
 
 TEST_CASE("crosscheck silo --executor slurm: both codes' runs as SLURM array tasks give the local report's rates",
