@@ -2,8 +2,10 @@
 // bed at the opening (--export-bed); YADE (yade_scripts/silo.py) discharges that very bed. The two discharges side
 // by side: rate with its uncertainty, time to empty, mass-time curves on one plot per angle and their largest gap,
 // wall and CPU time of each code and their ratio, and the differences YADE cannot remove with their expected effect.
-// Runs are subprocesses of the orchestrator's local pool (timeouts, kill on Ctrl-C); a run whose inputs did not change
-// is reused from its folder (IDENTITY beside its result), so the same command continues an interrupted check.
+// --fill own / both: YADE fills the silo itself from the kernel's generated cloud (--export-cloud) instead / as well,
+// so the filling's share of the difference is measured. Runs are subprocesses of the orchestrator's local pool
+// (timeouts, kill on Ctrl-C) or SLURM array tasks; a run whose inputs did not change is reused from its folder
+// (IDENTITY beside its result), so the same command continues an interrupted check.
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/silo_material.hpp"
@@ -35,6 +37,12 @@ using nlohmann::json;
 
 namespace {
 
+// Which beds YADE discharges: the kernel's filled bed (the discharges compared alone), a bed YADE fills itself from the
+// kernel's generated cloud (filling and discharge compared), or both (the filling's share of the difference).
+enum class FillMode { same_bed, own, both };
+const std::map<std::string, FillMode> kFillModes = {
+    {"same-bed", FillMode::same_bed}, {"own", FillMode::own}, {"both", FillMode::both}};
+
 struct SiloCrosscheckOptions {
     std::vector<double> thetas{10, 30, 50, 70};
     int particles = 4000;
@@ -51,7 +59,28 @@ struct SiloCrosscheckOptions {
     std::string yade = "yade";
     std::string plot_format = "png";
     long max_runs = 10000;
+    FillMode fill = FillMode::same_bed;
 };
+
+// A YADE run of one angle: its folder, the bed file it starts from, and whether it fills first.
+struct YadeRunKind {
+    const char* folder;
+    const char* bed_file;
+    bool fills;
+    const char* label;
+};
+constexpr YadeRunKind kYadeSameBed{"yade", "bed.json", false, "YADE from the kernel's filled bed"};
+constexpr YadeRunKind kYadeOwnFill{"yade-own-fill", "cloud.json", true,
+                                   "YADE filling on its own from the kernel's generated cloud"};
+
+std::vector<YadeRunKind> yade_runs(FillMode mode) {
+    switch (mode) {
+        case FillMode::same_bed: return {kYadeSameBed};
+        case FillMode::own: return {kYadeOwnFill};
+        case FillMode::both: return {kYadeSameBed, kYadeOwnFill};
+    }
+    return {};
+}
 
 constexpr const char* kYadeFramesFile = "frames.bin";
 
@@ -91,17 +120,18 @@ std::vector<std::string> kernel_argv(const SiloCrosscheckOptions& o, double thet
                                   "--particles", std::to_string(o.particles), "--stiffness-scale", g(o.stiffness_scale, 17),
                                   "--seed",    std::to_string(o.seed),         "--max-time",      g(o.max_time, 17),
                                   "--threads", "1",              "--no-plots",      "--no-checkpoint",
-                                  "--out",     out.string(),     "--export-bed",    bed.string()};
+                                  "--out",     out.string(),     "--export-bed",    bed.string(),
+                                  "--export-cloud", (bed.parent_path() / "cloud.json").string()};
     if (!o.material.empty()) a.insert(a.end(), {"--material", fs::absolute(o.material).string()});
     if (!o.geometry.empty()) a.insert(a.end(), {"--geometry", fs::absolute(o.geometry).string()});
     return a;
 }
 
 // yade_scripts/silo.py's params for the bed the kernel wrote: its geometry and material, the kernel's run settings.
-json yade_params(const json& bed, const SiloCrosscheckOptions& o, const json& yade_material) {
+json yade_params(const json& bed, const SiloCrosscheckOptions& o, const json& yade_material, const YadeRunKind& kind) {
     json geometry = json::object();
     for (const char* k : {"shape", "theta_deg", "outlet_m", "D_m", "body_height_m"}) geometry[k] = bed.at("geometry").at(k);
-    return {{"bed_file", "../bed.json"},
+    json params = {{"bed_file", std::string("../") + kind.bed_file},
             {"geometry", geometry},
             {"material", yade_material.is_null() ? bed.at("material") : yade_material},
             {"run",
@@ -113,18 +143,20 @@ json yade_params(const json& bed, const SiloCrosscheckOptions& o, const json& ya
               // YADE's flow-pattern frames at the kernel's interval, classified here by the kernel's classifier
               {"frame_interval_s", bed.at("flow_pattern_sampling").at("frame_interval_s")},
               {"frames_file", kYadeFramesFile}}}};
+    if (kind.fills) params["run"]["fill"] = 1;  // silo.py's default is 0: a same-bed run's params stay as they were
+    return params;
 }
 
 // YADE's flow pattern: its frames through the kernel's classifier with the kernel's sampling (from the bed).
-json yade_flow_pattern(const fs::path& dir, const json& bed, const json& yade_result) {
+json yade_flow_pattern(const fs::path& dir, const json& bed, const json& yade_result) {  // dir: the YADE run's
     try {
         const FlowPatternSampling sampling =
-            flow_pattern_sampling_from_json(bed.at("flow_pattern_sampling"), (dir / "bed.json").string());
+            flow_pattern_sampling_from_json(bed.at("flow_pattern_sampling"), "bed of " + dir.string());
         const json& geometry = bed.at("geometry");
         const auto silo = kernel::silo::SiloGeometry::conical(
             geometry.at("theta_deg").get<double>(), geometry.at("outlet_m").get<double>(),
             geometry.at("D_m").get<double>(), geometry.at("body_height_m").get<double>());
-        return flow_pattern_json(flow_pattern_of_frames(dir / "yade" / kYadeFramesFile, silo, sampling,
+        return flow_pattern_json(flow_pattern_of_frames(dir / kYadeFramesFile, silo, sampling,
                                                         yade_result.at("initial_mass_kg").get<double>(),
                                                         yade_result.at("discharged_mass_kg").get<double>()));
     } catch (const std::exception& e) {
@@ -173,31 +205,39 @@ double largest_gap(const std::vector<CurvePoint>& k, const std::vector<CurvePoin
     return filled > 0 ? gap / filled : 0;
 }
 
+// `own`: YADE's discharge of the bed it filled itself (--fill both), drawn when not empty.
 void write_curve_plot(const fs::path& dir, double theta, const std::vector<CurvePoint>& k,
-                      const std::vector<CurvePoint>& y, const std::string& format) {
-    const fs::path data_k = dir / "curve_kernel.dat", data_y = dir / "curve_yade.dat";
+                      const std::vector<CurvePoint>& y, const std::vector<CurvePoint>& own, const std::string& format) {
+    const fs::path data_k = dir / "curve_kernel.dat", data_y = dir / "curve_yade.dat",
+                   data_own = dir / "curve_yade_own_fill.dat";
     std::ofstream fk(data_k), fy(data_y);
     for (const auto& p : k) fk << p.t << " " << p.mass * 1e3 << "\n";
     for (const auto& p : y) fy << p.t << " " << p.mass * 1e3 << "\n";
     fk.close();
     fy.close();
+    if (!own.empty()) {
+        std::ofstream fo(data_own);
+        for (const auto& p : own) fo << p.t << " " << p.mass * 1e3 << "\n";
+    }
     std::ostringstream s;
-    s << "set title 'Discharged mass, cone half angle " << theta << " deg (the same bed)'\n"
+    s << "set title 'Discharged mass, cone half angle " << theta << " deg'\n"
       << "set xlabel 'time since opening [s]'\nset ylabel 'discharged mass [g]'\nset key top left\nset grid\n"
       << "plot " << gnuplot_quote(data_k) << " using 1:2 with lines lw 2 title 'demcal kernel', "
-      << gnuplot_quote(data_y) << " using 1:2 with lines lw 2 dt 2 title 'YADE 2023.02a'\n";
+      << gnuplot_quote(data_y) << " using 1:2 with lines lw 2 dt 2 title 'YADE 2023.02a'";
+    if (!own.empty()) s << ", " << gnuplot_quote(data_own) << " using 1:2 with lines lw 2 dt 3 title 'YADE, its own filling'";
+    s << "\n";
     render_gnuplot(dir / ("mass_time." + format), s.str());
 }
 
 // The kernel run of one angle checked by demcal silo's own parser and checks (silo_case_settings), before the
 // campaign folder exists: a setting the silo refuses (a material, a time limit, a particle count) was found only once
 // the runs had started. The run's outputs and sessions (--out, --export-bed, --no-plots, --no-checkpoint) are this
-// command's: the settings alone are checked.
+// command's (--export-cloud too): the settings alone are checked.
 void check_kernel_run(const SiloCrosscheckOptions& o, double theta) {
     const std::vector<std::string> argv = kernel_argv(o, theta, "out", "bed.json", "demcal");
     std::vector<std::string> settings;
     for (std::size_t i = 2; i < argv.size(); ++i) {  // after the program and "silo"
-        if (argv[i] == "--out" || argv[i] == "--export-bed") ++i;
+        if (argv[i] == "--out" || argv[i] == "--export-bed" || argv[i] == "--export-cloud") ++i;
         else if (argv[i] != "--no-plots" && argv[i] != "--no-checkpoint") settings.push_back(argv[i]);
     }
     try {
@@ -216,8 +256,10 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
         if (std::find(o.thetas.begin(), o.thetas.begin() + i, t) != o.thetas.begin() + i)
             throw UserError("theta = " + g(t) + " deg is given twice");
     }
-    orchestrator::check_run_count(2.0 * static_cast<double>(o.thetas.size()), o.max_runs,
-                                  "crosscheck silo: " + std::to_string(o.thetas.size()) + " angles x 2 codes");
+    const double runs_per_angle = 1.0 + static_cast<double>(yade_runs(o.fill).size());
+    orchestrator::check_run_count(runs_per_angle * static_cast<double>(o.thetas.size()), o.max_runs,
+                                  "crosscheck silo: " + std::to_string(o.thetas.size()) + " angles x " +
+                                      g(runs_per_angle) + " runs");
     if (!(o.tolerance > 0 && o.tolerance < 1)) throw UserError("tolerance = " + g(o.tolerance) + " must lie in (0, 1)");
     check_output_folder(o.dir, "--campaign");
     const fs::path script = orchestrator::default_shear_template().parent_path() / "silo.py";
@@ -255,9 +297,12 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
         if (!o.material.empty()) id += "\nmaterial " + orchestrator::sha256_hex(orchestrator::read_text_file(o.material));
         if (!o.geometry.empty()) id += "\ngeometry " + orchestrator::sha256_hex(orchestrator::read_text_file(o.geometry));
         kernel_identity[theta] = id;
-        if (reusable(d / "kernel" / "summary.json", d / "kernel", id) && fs::exists(d / "bed.json")) continue;
+        if (reusable(d / "kernel" / "summary.json", d / "kernel", id) && fs::exists(d / "bed.json") &&
+            fs::exists(d / "cloud.json"))
+            continue;
         fs::remove(d / "kernel" / "summary.json");
         fs::remove(d / "bed.json");
+        fs::remove(d / "cloud.json");
         jobs.push_back({theta_name(theta) + " kernel", d / "kernel", argv, o.timeout_s});
     }
     const int slots = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
@@ -291,25 +336,27 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     // 2. YADE discharges each bed
     jobs.clear();
     ids.clear();
-    for (double theta : o.thetas) {
-        const fs::path d = root / theta_name(theta);
-        if (!fs::exists(d / "bed.json") || !fs::exists(d / "kernel" / "summary.json")) continue;
-        const json bed = analytics::read_json_input(d / "bed.json", "bed");
-        const json params = yade_params(bed, o, yade_material);
-        fs::create_directories(d / "yade");
-        orchestrator::write_text_file_atomically(d / "yade" / "params.json", params.dump(1) + "\n");
-        orchestrator::write_text_file_atomically(d / "yade" / "silo.py", script_text);
-        orchestrator::write_text_file_atomically(d / "yade" / "run_clean.py", orchestrator::read_text_file(wrapper));
-        const std::string id = "yade silo.py " + orchestrator::sha256_hex(script_text) + "\nparams " + params.dump() +
-                               "\nbed " + orchestrator::sha256_hex(orchestrator::read_text_file(d / "bed.json"));
-        const std::string name = theta_name(theta) + " yade";
-        ids[name] = id;
-        if (reusable(d / "yade" / "result.json", d / "yade", id)) continue;
-        fs::remove(d / "yade" / "result.json");
-        jobs.push_back({name, d / "yade",
-                        {yade, "-n", "-j1", "-x", "run_clean.py", "silo.py", "params.json", "result.json"},
-                        o.timeout_s});
-    }
+    for (double theta : o.thetas)
+        for (const YadeRunKind& kind : yade_runs(o.fill)) {
+            const fs::path d = root / theta_name(theta), run = d / kind.folder;
+            if (!fs::exists(d / kind.bed_file) || !fs::exists(d / "kernel" / "summary.json")) continue;
+            const json bed = analytics::read_json_input(d / kind.bed_file, "bed");
+            const json params = yade_params(bed, o, yade_material, kind);
+            fs::create_directories(run);
+            orchestrator::write_text_file_atomically(run / "params.json", params.dump(1) + "\n");
+            orchestrator::write_text_file_atomically(run / "silo.py", script_text);
+            orchestrator::write_text_file_atomically(run / "run_clean.py", orchestrator::read_text_file(wrapper));
+            const std::string id = "yade silo.py " + orchestrator::sha256_hex(script_text) + "\nparams " +
+                                   params.dump() + "\nbed " +
+                                   orchestrator::sha256_hex(orchestrator::read_text_file(d / kind.bed_file));
+            const std::string name = theta_name(theta) + " " + kind.folder;
+            ids[name] = id;
+            if (reusable(run / "result.json", run, id)) continue;
+            fs::remove(run / "result.json");
+            jobs.push_back({name, run,
+                            {yade, "-n", "-j1", "-x", "run_clean.py", "silo.py", "params.json", "result.json"},
+                            o.timeout_s});
+        }
     if (!run_jobs(jobs, ids)) {
         std::cout << "interrupted: run the same command again to continue\n";
         return 130;
@@ -330,15 +377,17 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
           "YADE empty [s] | kernel pattern (wall/axis) | YADE pattern (wall/axis) | largest curve gap [% of fill] | "
           "kernel CPU [s] | YADE CPU [s] | YADE / kernel CPU |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     bool complete = true, all_agree = true, all_patterns_agree = true, all_patterns_determined = true;
+    const YadeRunKind primary = yade_runs(o.fill).front();
+    std::ostringstream own_fill_md;  // --fill both: the filling's share, a table of its own
     for (double theta : o.thetas) {
         const fs::path d = root / theta_name(theta);
-        if (!fs::exists(d / "kernel" / "summary.json") || !fs::exists(d / "yade" / "result.json")) {
+        if (!fs::exists(d / "kernel" / "summary.json") || !fs::exists(d / primary.folder / "result.json")) {
             md << "| " << theta << " | (a run failed: see " << d.string() << ") ||||||||||\n";
             complete = false;
             continue;
         }
         const json k = analytics::read_json_input(d / "kernel" / "summary.json", "kernel summary");
-        const json y = analytics::read_json_input(d / "yade" / "result.json", "yade result");
+        const json y = analytics::read_json_input(d / primary.folder / "result.json", "yade result");
         const double kr = k.at("rate").at("rate_kg_s").get<double>(), yr = y.at("rate").at("rate_kg_s").get<double>();
         const auto kc = kernel_curve(d / "kernel" / "discharge.csv");
         const auto yc = yade_curve(y);
@@ -346,7 +395,8 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
         const double gap = largest_gap(kc, yc, filled);
         const double kcpu = k.at("cpu_s").get<double>(), ycpu = y.at("cpu_time_s").get<double>();
         const json& pattern = k.at("flow_pattern");
-        const json yade_pattern = yade_flow_pattern(d, analytics::read_json_input(d / "bed.json", "bed"), y);
+        const json yade_pattern =
+            yade_flow_pattern(d / primary.folder, analytics::read_json_input(d / primary.bed_file, "bed"), y);
         const bool agree = std::abs(yr / kr - 1) <= o.tolerance;
         // compared only where both codes determined a pattern (too few grains leave a hopper height without samples)
         const bool patterns_determined =
@@ -381,15 +431,54 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
                                               {"stop_reason", y.at("stop_reason")},
                                               {"flow_pattern", yade_pattern},
                                               {"cpu_s", ycpu},
-                                              {"wall_s", y.at("wall_time_s")}}},
+                                              {"wall_s", y.at("wall_time_s")},
+                                              {"started_from", primary.label}}},
                                     {"rate_ratio_yade_over_kernel", yr / kr},
                                     {"rates_agree", agree},
                                     {"patterns_agree", patterns_determined ? json(patterns_agree) : json(nullptr)},
                                     {"yade_material_as_bed", y.value("material_as_bed", true)},
                                     {"largest_curve_gap_of_filled_mass", gap},
                                     {"cpu_ratio_yade_over_kernel", ycpu / kcpu}});
+        std::vector<CurvePoint> own_curve;
+        if (o.fill == FillMode::both) {
+            const fs::path own = d / kYadeOwnFill.folder / "result.json";
+            if (!fs::exists(own)) {
+                own_fill_md << "| " << theta << " | (YADE's own filling failed: see " << own.parent_path().string()
+                            << ") ||||||||\n";
+                complete = false;
+            } else {
+                const json yo = analytics::read_json_input(own, "yade own-fill result");
+                const double yor = yo.at("rate").at("rate_kg_s").get<double>();
+                own_curve = yade_curve(yo);
+                const json& yf = yo.at("fill");
+                const json& kf = k.at("fill");
+                // the filling's share of the rate difference: what YADE's own bed adds to the ratio of the same bed
+                const double share = yor / kr - yr / kr;
+                const json own_pattern = yade_flow_pattern(
+                    d / kYadeOwnFill.folder, analytics::read_json_input(d / kYadeOwnFill.bed_file, "cloud"), yo);
+                own_fill_md << "| " << theta << " | " << g(kr * 1e3) << " | " << g(yor * 1e3) << " | "
+                            << g(yor / kr, 4) << " | " << g(yr / kr, 4) << " | " << std::showpos << g(100 * share, 2)
+                            << std::noshowpos << " | " << g(kf.at("time_s").get<double>(), 3) << " / "
+                            << g(yf.at("time_s").get<double>(), 3) << " | "
+                            << g(kf.at("height_m").get<double>() * 1e3, 4) << " / "
+                            << g(yf.at("bed_height_m").get<double>() * 1e3, 4) << " | "
+                            << own_pattern.value("pattern", "?") << " ("
+                            << g(own_pattern.value("wall_to_axis_velocity_ratio", 0.0), 2) << ") | "
+                            << g(yo.at("cpu_time_s").get<double>(), 3) << " |\n";
+                report["angles"].back()["yade_own_fill"] = {
+                    {"rate_kg_s", yor},
+                    {"rate_ratio_yade_over_kernel", yor / kr},
+                    {"filling_share_of_rate_ratio", share},
+                    {"fill", yf},
+                    {"kernel_fill", kf},
+                    {"time_to_empty_s", yo.at("discharge_time_s")},
+                    {"flow_pattern", own_pattern},
+                    {"cpu_s", yo.at("cpu_time_s")},
+                    {"largest_curve_gap_of_filled_mass", largest_gap(kc, own_curve, filled)}};
+            }
+        }
         try {
-            write_curve_plot(d, theta, kc, yc, o.plot_format);
+            write_curve_plot(d, theta, kc, yc, own_curve, o.plot_format);
         } catch (const std::exception& e) {
             std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
         }
@@ -406,6 +495,16 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
                                             "the others).")
        << "\n\nDifferences YADE cannot remove (yade_scripts/README.md):\n";
     for (const char* d : kKnownDifferences) md << "- " << d << "\n";
+    if (o.fill == FillMode::both)
+        md << "\n## Each code fills on its own\n\nYADE fills the silo itself from the kernel's generated cloud (the same "
+              "grains, positions and orientations before the first filling step; the kernel's rest rule), then "
+              "discharges. The filling's share of the difference is YADE's own-fill rate over the kernel's minus the "
+              "same-bed ratio.\n\n| theta [deg] | kernel rate [g/s] | YADE own fill [g/s] | YADE own fill / kernel | "
+              "YADE same bed / kernel | filling's share [% of the kernel's rate] | fill time kernel / YADE [s] | "
+              "bed height kernel / YADE [mm] | YADE own fill pattern (wall/axis) | YADE own fill CPU [s] |\n"
+              "|---|---|---|---|---|---|---|---|---|---|\n"
+           << own_fill_md.str();
+    report["fill_mode"] = o.fill == FillMode::same_bed ? "same-bed" : o.fill == FillMode::own ? "own" : "both";
     report["rates_agree"] = all_agree;
     report["patterns_agree"] = all_patterns_agree;  // at every angle where both codes determined one
     report["patterns_determined"] = all_patterns_determined;
@@ -443,7 +542,13 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
     silo->add_option("--partition", o->partition, "SLURM partition (--executor slurm)");
     silo->add_option("--yade", o->yade, "YADE launcher");
     silo->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
-    silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (a guard against typos)")
+    silo->add_option("--fill", o->fill,
+                     "same-bed: YADE discharges the kernel's filled bed; own: YADE fills the silo itself from the "
+                     "kernel's generated cloud, then discharges; both: the two, and the filling's share of the "
+                     "difference")
+        ->transform(CLI::CheckedTransformer(kFillModes, CLI::ignore_case))
+        ->capture_default_str();
+    silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (3 with --fill both; a guard against typos)")
         ->check(integer_in(1, 1000000000))
         ->capture_default_str();
     silo->callback([o] {

@@ -73,6 +73,7 @@ struct SiloCli {
     double wall_limit = 0;
     std::string resume;
     std::string export_bed;  // the filled bed at the opening, for yade_scripts/silo.py
+    std::string export_cloud;  // the generated cloud before filling, for yade_scripts/silo.py to fill on its own
 };
 
 // Exit status of a run stopped at --wall-limit (EX_TEMPFAIL): not finished, resume it. A job script can loop on it.
@@ -485,8 +486,14 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk");
     if (!o.export_bed.empty()) {
         check_output_file(o.export_bed, "--export-bed");
-        s.at_opening = [file = o.export_bed, settings = s](const ks::OpenedBed& bed) {
-            write_silo_bed(file, bed, settings);
+        s.at_opening = [file = o.export_bed, settings = s](const ks::BedSnapshot& bed) {
+            write_silo_bed(file, bed, settings, BedMoment::opening, "export-bed");
+        };
+    }
+    if (!o.export_cloud.empty()) {
+        check_output_file(o.export_cloud, "--export-cloud");
+        s.at_generation = [file = o.export_cloud, settings = s](const ks::BedSnapshot& bed) {
+            write_silo_bed(file, bed, settings, BedMoment::generation, "export-cloud");
         };
     }
     if (o.check_only) {
@@ -750,6 +757,9 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--export-bed", o.export_bed,
                     "write the filled bed at the opening (every grain's centre, orientation, velocities; the clump, "
                     "materials, geometry) to this JSON file, for yade_scripts/silo.py");
+    sub->add_option("--export-cloud", o.export_cloud,
+                    "write the generated grains before the filling (the same format as --export-bed), for "
+                    "yade_scripts/silo.py to fill the silo on its own from the same cloud");
     sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o.checkpoint_every,
                     "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "
@@ -781,7 +791,7 @@ ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options,
         throw UserError("silo options of " + owner + ": " + e.what());
     }
     // what only a `demcal silo` run of its own has: its outputs, its sessions
-    for (const char* own : {"--out", "--vtk", "--vtk-every", "--export-bed", "--no-plots", "--checkpoint-every",
+    for (const char* own : {"--out", "--vtk", "--vtk-every", "--export-bed", "--export-cloud", "--no-plots", "--checkpoint-every",
                             "--no-checkpoint", "--check", "--wall-limit", "--resume"})
         if (parser.count(own))
             throw UserError(std::string("silo option ") + own + " does not apply to " + owner +

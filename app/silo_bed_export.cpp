@@ -66,14 +66,26 @@ json silo_geometry_json(const ks::SiloGeometry& g) {
     return j;
 }
 
-json silo_bed_json(const ks::OpenedBed& bed, const ks::SiloCaseSettings& s) {
+json silo_bed_json(const ks::BedSnapshot& bed, const ks::SiloCaseSettings& s, BedMoment moment) {
     json geometry = silo_geometry_json(s.geometry);
     geometry["wall_top_m"] = bed.wall_top;
+    const bool opening = moment == BedMoment::opening;
     return {{"schema", kSiloBedSchema},
-            {"note", "the kernel's bed at the opening of the outlet, before the first discharge step; SI units; "
-                     "orientation_wxyz: unit quaternion of the clump's principal frame (clump_template.frame) to the "
-                     "world; velocities on-step (velocity Verlet); sphere_centres_m: the kernel's own member centres, "
-                     "for checking an import"},
+            {"moment", opening ? "opening" : "generation"},
+            {"note", std::string(opening ? "the kernel's bed at the opening of the outlet, before the first discharge "
+                                           "step"
+                                         : "the kernel's generated cloud of grains, before the first filling step "
+                                           "(the outlet closed)") +
+                         "; SI units; orientation_wxyz: unit quaternion of the clump's principal frame "
+                         "(clump_template.frame) to the world; velocities on-step (velocity Verlet); "
+                         "sphere_centres_m: the kernel's own member centres, for checking an import"},
+            {"fill",
+             {{"rest_energy_per_grain_J", bed.rest_energy},
+              {"time_min_s", s.fill_time_min},
+              {"time_max_s", s.fill_time_max},
+              {"rule", "the filling ends at the first record interval after time_min_s where the mean kinetic "
+                       "energy per grain (translational and rotational) is below rest_energy_per_grain_J, or at "
+                       "time_max_s"}}},
             {"opening_time_s", bed.time},
             {"time_step_s", bed.time_step},
             {"time_step_fraction", s.time_step_fraction},
@@ -89,11 +101,12 @@ json silo_bed_json(const ks::OpenedBed& bed, const ks::SiloCaseSettings& s) {
             {"grains", grains_json(bed.grains)}};
 }
 
-void write_silo_bed(const std::filesystem::path& file, const ks::OpenedBed& bed, const ks::SiloCaseSettings& s) {
+void write_silo_bed(const std::filesystem::path& file, const ks::BedSnapshot& bed, const ks::SiloCaseSettings& s,
+                    BedMoment moment, const std::string& option) {
     try {
-        orchestrator::write_text_file_atomically(file, silo_bed_json(bed, s).dump() + "\n");
+        orchestrator::write_text_file_atomically(file, silo_bed_json(bed, s, moment).dump() + "\n");
     } catch (const std::exception& e) {
-        throw std::runtime_error("export-bed = '" + file.string() + "': cannot write the bed: " + e.what());
+        throw std::runtime_error(option + " = '" + file.string() + "': cannot write the bed: " + e.what());
     }
 }
 

@@ -16,13 +16,18 @@ inline constexpr const char* kSiloBedSchema = "demcal.silo_bed/1";
 /// the derived hopper height: one spelling for summary.json and the bed file.
 nlohmann::json silo_geometry_json(const kernel::silo::SiloGeometry& g);
 
-/// The bed with everything needed to rebuild the run elsewhere: geometry, materials as a --material file spells them
-/// (unscaled) and the stiffness scale, gravity, removal depth, time step, the clump template and every grain.
-nlohmann::json silo_bed_json(const kernel::silo::OpenedBed& bed, const kernel::silo::SiloCaseSettings& s);
+/// When a bed was taken: at the opening (the bed to discharge) or at the generation (the cloud to fill).
+enum class BedMoment { opening, generation };
+
+/// The bed with everything needed to rebuild the run elsewhere: the moment, geometry, materials as a --material file
+/// spells them (unscaled) and the stiffness scale, gravity, removal depth, time step, the filling's rest criterion,
+/// the flow-pattern sampling, the clump template and every grain.
+nlohmann::json silo_bed_json(const kernel::silo::BedSnapshot& bed, const kernel::silo::SiloCaseSettings& s,
+                             BedMoment moment);
 
 /// silo_bed_json written to `file` atomically (a temporary file renamed over it). Throws std::runtime_error naming
-/// the file when it cannot be written.
-void write_silo_bed(const std::filesystem::path& file, const kernel::silo::OpenedBed& bed,
-                    const kernel::silo::SiloCaseSettings& s);
+/// `option` and the file when it cannot be written.
+void write_silo_bed(const std::filesystem::path& file, const kernel::silo::BedSnapshot& bed,
+                    const kernel::silo::SiloCaseSettings& s, BedMoment moment, const std::string& option);
 
 }  // namespace demcal

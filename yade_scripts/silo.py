@@ -102,6 +102,10 @@ PARAM_SPECS = {
                                    "velocity) every ... (the kernel's frame interval); 0: none", default=0.0),
     "run.frames_file": text("if not empty: the flow-pattern frames go to this file (format in FlowFrames; demcal "
                             "classifies them with the kernel's own classifier)", default=""),
+    "run.fill": number("-", 0, 1, "0: the bed file holds a filled bed (moment 'opening') and discharges at once; 1: it "
+                       "holds the kernel's generated cloud (moment 'generation', demcal silo --export-cloud): YADE "
+                       "fills the silo against the closed outlet by the bed's fill rule first", default=0,
+                       integer=True),
     "run.readback_file": text("if not empty: write the bed as YADE holds it at t = 0 (before any step) to this file",
                               default=""),
 }
@@ -639,8 +643,9 @@ def import_bed(p, bed, contact):
 class DischargeRecord:
     """The discharged mass against time; grains below the removal plane counted and erased (the kernel's rule)."""
 
-    def __init__(self, p, bed, clumps, wall_top):
+    def __init__(self, p, bed, clumps, wall_top, t_open=0.0):
         self.p = p
+        self.t_open = t_open  # YADE's time at the opening: the record's times are since then
         self.mass_of = dict(clumps)
         self.grains = len(clumps)
         self.in_silo = set(self.mass_of)
@@ -667,6 +672,12 @@ class DischargeRecord:
                                  % (clump_id, pos[0], pos[1], pos[2], O.time))
         return leaving
 
+    def now(self):
+        return O.time - self.t_open
+
+    def remaining_clumps(self):
+        return [(c, self.mass_of[c]) for c in sorted(self.in_silo)]
+
     def sample(self):
         leaving = self.leaving_grains()
         for clump_id in leaving:
@@ -674,8 +685,8 @@ class DischargeRecord:
             self.in_silo.discard(clump_id)
             self.discharged_mass += self.mass_of[clump_id]
         if leaving:
-            self.last_out_time = O.time
-        self.times.append(O.time)
+            self.last_out_time = self.now()
+        self.times.append(self.now())
         self.masses.append(self.discharged_mass)
         self.counts.append(self.grains - len(self.in_silo))
 
@@ -686,10 +697,10 @@ class DischargeRecord:
             return "empty"
         if self.discharged_mass >= p["run.stop_fraction"] * self.initial_mass * (1 - 1e-12):
             return "stop fraction %g of the initial mass discharged" % p["run.stop_fraction"]
-        if O.time - self.last_out_time > p["run.stall_time_s"]:
+        if self.now() - self.last_out_time > p["run.stall_time_s"]:
             return "flow stopped: no grain left for %g s, %d grains remain" % (p["run.stall_time_s"],
                                                                                len(self.in_silo))
-        if O.time >= p["run.discharge_time_s"] * (1 - 1e-12):
+        if self.now() >= p["run.discharge_time_s"] * (1 - 1e-12):
             return "time limit %g s" % p["run.discharge_time_s"]
         return ""
 
@@ -722,7 +733,7 @@ class FlowFrames:
             self.file.write((FRAMES_SCHEMA + "\n").encode())
 
     def sample(self):
-        if self.file is None or O.time < self.next_time * (1 - 1e-12):
+        if self.file is None or self.record.now() < self.next_time * (1 - 1e-12):
             return
         self.next_time += self.interval
         if self.record.discharged_mass > STEADY_UPPER * self.record.initial_mass:
@@ -734,7 +745,7 @@ class FlowFrames:
                 values.extend((state.pos[0], state.pos[1], state.pos[2], state.vel[2]))
         if sys.byteorder != "little":
             values.byteswap()
-        self.file.write(struct.pack("<ddI", O.time, self.record.discharged_mass, len(values) // 4))
+        self.file.write(struct.pack("<ddI", self.record.now(), self.record.discharged_mass, len(values) // 4))
         values.tofile(self.file)
         self.frames += 1
 
@@ -746,6 +757,45 @@ class FlowFrames:
         self.file.close()
         os.replace(self.tmp, self.path)
         return {"file": self.path, "frames": self.frames, "interval_s": self.interval, "schema": FRAMES_SCHEMA}
+
+
+def mean_kinetic_energy(clump_ids):
+    """Mean kinetic energy per grain, translational and rotational (the kernel's rest measure) [J]."""
+    total = 0.0
+    for clump_id in clump_ids:
+        state = O.bodies[clump_id].state
+        spin = state.ori.conjugate() * state.angVel  # in the principal frame, where the inertia is diagonal
+        total += 0.5 * state.mass * state.vel.squaredNorm() + 0.5 * sum(state.inertia[k] * spin[k] ** 2
+                                                                         for k in range(3))
+    return total / len(clump_ids) if clump_ids else 0.0
+
+
+def fill(p, bed, clumps, contact, wall_top):
+    """The kernel's filling from its generated cloud, by the bed's rule: against the closed outlet, record interval
+    after record interval, until the mean kinetic energy per grain falls below the rest energy after time_min_s, or
+    time_max_s. Grains that fall below the removal plane (through a gap) are lost, as in the kernel. Returns the grains
+    left and a summary."""
+    rule = bed["fill"]
+    record = DischargeRecord(p, bed, clumps, wall_top)
+    chunk = max(1, int(round(p["run.sample_interval_s"] / contact.dt)))
+    while True:
+        O.run(chunk, True)
+        lost = record.leaving_grains()
+        for clump_id in lost:
+            O.bodies.erase(clump_id, True)
+            record.in_silo.discard(clump_id)
+        energy = mean_kinetic_energy(record.in_silo)
+        at_rest = O.time >= rule["time_min_s"] and energy < rule["rest_energy_per_grain_J"]
+        if at_rest or O.time >= rule["time_max_s"] * (1 - 1e-12):
+            break
+    remaining = record.remaining_clumps()
+    height = max(O.bodies[c].state.pos[2] for c, _ in remaining) if remaining else 0.0
+    summary = {"time_s": O.time, "steps": O.iter, "at_rest": at_rest, "kinetic_energy_per_grain_J": energy,
+               "rest_energy_per_grain_J": rule["rest_energy_per_grain_J"], "bed_height_m": height,
+               "grains_lost": len(clumps) - len(remaining), "filled_mass_kg": sum(m for _, m in remaining)}
+    print("filled: %.4f s, %s, bed height %.4g m, %d grains lost" % (O.time, "at rest" if at_rest else "time limit",
+                                                                     height, summary["grains_lost"]), flush=True)
+    return remaining, summary
 
 
 def discharge(p, record, frames, contact):
@@ -775,16 +825,31 @@ def main():
     p = read_params(params_path)
     bed = read_bed(p["bed_file"])
     check_bed_geometry(p, bed, p["bed_file"])
+    moment = bed.get("moment", "opening")  # beds written before the cloud export are beds at the opening
+    if moment != ("generation" if p["run.fill"] == 1 else "opening"):
+        refuse("bed_file", p["bed_file"], "holds the bed at the %s, but run.fill = %d needs %s" % (
+            moment, p["run.fill"], "a generated cloud (demcal silo --export-cloud)" if p["run.fill"] == 1
+            else "the bed at the opening (demcal silo --export-bed)"))
+    if p["run.fill"] == 1:
+        rule = bed.get("fill")
+        if not isinstance(rule, dict) or not all(isinstance(rule.get(k), (int, float)) and math.isfinite(rule[k])
+                                                 and rule[k] >= 0 for k in ("rest_energy_per_grain_J", "time_min_s",
+                                                                            "time_max_s")):
+            refuse("bed_file", p["bed_file"], "has no valid fill rule (fill.rest_energy_per_grain_J, time_min_s, "
+                   "time_max_s)")
 
     contact = Contact(p, bed)
     contact.install(bed["gravity_m_s2"])
     wall_top = max(bed["geometry"]["wall_top_m"], hopper_height(p) + p["geometry.body_height_m"])
     plate_ids = build_silo(p, wall_top, contact.wall_material)
     clumps, frame, errors = import_bed(p, bed, contact)
-    # the opening: the plate goes before the first step, as the kernel disables its plate at the opening
+    filling = None
+    if p["run.fill"] == 1:
+        clumps, filling = fill(p, bed, clumps, contact, wall_top)
+    # the opening: the plate goes before the first discharge step, as the kernel disables its plate at the opening
     for plate_id in plate_ids:
         O.bodies.erase(plate_id)
-    record = DischargeRecord(p, bed, clumps, wall_top)
+    record = DischargeRecord(p, bed, clumps, wall_top, t_open=O.time)
     frames = FlowFrames(p, record)
     stop_reason, stiffness = discharge(p, record, frames, contact)
     frames_written = frames.close()
@@ -801,11 +866,12 @@ def main():
         "grains_discharged": record.counts[-1],
         "grains_remaining": len(record.in_silo),
         "stop_reason": stop_reason,
-        "discharge_time_s": O.time,
+        "discharge_time_s": record.now(),
+        "fill": filling,
         "import_errors": errors,
         "flow_frames": frames_written,
         "yade_template_frame": {"centre_m": list(frame.centre), "orientation_wxyz": quaternion_wxyz(frame.orientation)},
-        "steps": O.iter,
+        "steps": O.iter,  # the filling's too with run.fill 1
         "time_step_s": contact.dt,
         "kernel_time_step_s": bed["time_step_s"],
         "wall_time_s": time.time() - WALL_CLOCK_START,
@@ -818,7 +884,7 @@ def main():
     }
     write_json_atomically(result_path, result)
     print("discharged %d of %d grains (%.6g of %.6g kg) in %.4f s (%s); rate %s; %d steps of %.4g s, wall %.1f s"
-          % (record.counts[-1], record.grains, record.discharged_mass, record.initial_mass, O.time, stop_reason,
+          % (record.counts[-1], record.grains, record.discharged_mass, record.initial_mass, record.now(), stop_reason,
              "%.6g kg/s" % fit["rate_kg_s"] if fit["ok"] else "not determined (%s)" % fit["message"], O.iter,
              contact.dt, result["wall_time_s"]), flush=True)
 

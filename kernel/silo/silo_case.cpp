@@ -395,6 +395,7 @@ public:
              << " s, skin " << sim_.skin() << " m";
         report("generated", note.str());
         maybe_vtk(true);
+        if (s_.at_generation) s_.at_generation(bed_snapshot());
     }
 
     SiloCaseResult run() {
@@ -589,8 +590,10 @@ private:
 
     // Filling against the closed plate until the grains are at rest (or the time limit). False: stopped at the
     // session's wall limit.
+    double rest_energy() const { return s_.rest_energy_factor * tmpl_.mass * s_.gravity * wheat_length; }
+
     bool fill() {
-        const double rest_energy = s_.rest_energy_factor * tmpl_.mass * s_.gravity * wheat_length;
+        const double rest_energy = this->rest_energy();
         auto below = [this](const BodyState& b) { return is_below_outlet(b); };
         while (true) {
             sim_.step(chunk());
@@ -640,7 +643,7 @@ private:
     }
 
     void open() {
-        if (s_.at_opening) s_.at_opening(opened_bed());
+        if (s_.at_opening) s_.at_opening(bed_snapshot());
         sim_.set_wall_enabled(plate_, false);
         t_open_ = sim_.time();
         if (bin_motion_) bin_motion_->open_at(t_open_);
@@ -650,12 +653,13 @@ private:
         phase_ = Phase::discharge;
     }
 
-    // The bed as it stands at the opening: every grain's rigid-body state and its spheres' centres.
-    OpenedBed opened_bed() const {
-        OpenedBed bed;
+    // The bed as it stands now: every grain's rigid-body state and its spheres' centres.
+    BedSnapshot bed_snapshot() const {
+        BedSnapshot bed;
         bed.time = sim_.time();
         bed.time_step = r_.time_step;
         bed.wall_top = wall_top_;
+        bed.rest_energy = rest_energy();
         bed.grain = tmpl_;
         bed.grains.resize(sim_.num_bodies());
         for (size_t i = 0; i < sim_.num_bodies(); ++i) {

@@ -29,12 +29,14 @@ struct BedGrain {
     std::vector<Eigen::Vector3d> spheres;  // the centres of its spheres as the kernel placed them [m] (any order)
 };
 
-// The bed at the moment the outlet opens, before the first discharge step: what another code needs to start the
-// same discharge (demcal silo --export-bed).
-struct OpenedBed {
-    double time = 0;       // simulated time of the opening [s]
+// The bed at a moment of the run: what another code needs to go on from there. At the opening, before the first
+// discharge step, to discharge the same bed (demcal silo --export-bed); at the generation, before the first filling
+// step, to fill the same cloud of grains on its own (demcal silo --export-cloud).
+struct BedSnapshot {
+    double time = 0;       // simulated time of the moment [s]
     double time_step = 0;  // [s]
     double wall_top = 0;   // the body wall's top [m]: above the silo's top when the generation column was taller
+    double rest_energy = 0;  // the filling's rest criterion: mean kinetic energy per grain below this [J]
     ClumpTemplate grain;   // mass, principal inertia, member offsets (principal frame) and radii
     std::vector<BedGrain> grains;
 };
@@ -89,11 +91,14 @@ struct SiloCaseSettings {
     std::function<std::string()> stop_request;
     // Called once with the filled bed when the outlet opens (demcal silo --export-bed). Not stored: a run resumed
     // from a checkpoint written after the opening does not call it again.
-    std::function<void(const OpenedBed&)> at_opening;
+    std::function<void(const BedSnapshot&)> at_opening;
+    // Called once with the generated cloud before the first filling step (demcal silo --export-cloud). Not stored,
+    // as at_opening.
+    std::function<void(const BedSnapshot&)> at_generation;
 };
 // A new setting that changes the run must also be listed in for_each_setting (silo_case.cpp): the checkpoint stores
-// the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit, stop_request and at_opening are
-// not stored: a resumed run takes them from its caller.
+// the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit, stop_request, at_opening and
+// at_generation are not stored: a resumed run takes them from its caller.
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions, the vibration).
 void validate(const SiloCaseSettings& s);

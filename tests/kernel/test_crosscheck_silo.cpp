@@ -2,7 +2,8 @@
 // discharges the same bed; the report holds both rates (within 25 % of each other on 300 grains), the curve gap, the
 // costs; the same command again reuses both runs (nothing started); a deliberate mismatch of the grains' friction is
 // flagged; a bad angle is refused before anything runs. YADE's flow pattern is measured by the kernel's classifier on
-// YADE's frames: on 600 grains in a 20 deg hopper both codes give mass flow.
+// YADE's frames: on 600 grains in a 20 deg hopper both codes give mass flow. --fill both: YADE also fills the silo
+// itself from the kernel's generated cloud, to the kernel's rest rule, and discharges that bed.
 #include "slurm_for_test.hpp"
 #include "test_files.hpp"
 
@@ -74,12 +75,13 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     fs::remove_all(dir);
 }
 
-TEST_CASE("crosscheck silo classifies YADE's flow pattern with the kernel's classifier", "[yade]") {
+TEST_CASE("crosscheck silo classifies YADE's flow pattern with the kernel's classifier, and YADE fills on its own",
+          "[yade]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-xsilo-pattern-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     const std::string args = "crosscheck silo --theta 20 --particles 600 --stiffness-scale 1e-3 --geometry '" +
                              (fs::path(DEMCAL_SOURCE_DIR) / "examples/silo/reduced_conical_70deg.json").string() +
-                             "' --max-time 3 --jobs 1 -c '" + (dir / "c").string() + "'";
+                             "' --max-time 3 --jobs 1 --fill both -c '" + (dir / "c").string() + "'";
     REQUIRE(run_demcal(args, dir.string() + ".log") == 0);
     const auto report = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
     const auto& a = report["angles"][0];
@@ -98,6 +100,20 @@ TEST_CASE("crosscheck silo classifies YADE's flow pattern with the kernel's clas
     CHECK(a["patterns_agree"] == true);
     CHECK(report["patterns_agree"] == true);
     CHECK(read_file(dir / "c" / "crosscheck_silo.md").find("YADE pattern (wall/axis)") != std::string::npos);
+    // YADE's own filling: the same cloud, the kernel's rest rule; a bed like the kernel's that discharges like it
+    const auto& own = a["yade_own_fill"];
+    REQUIRE(own.is_object());
+    CHECK(own["fill"]["at_rest"] == true);
+    CHECK(own["fill"]["grains_lost"] == 0);
+    CHECK(own["fill"]["bed_height_m"].get<double>() ==
+          Approx(own["kernel_fill"]["height_m"].get<double>()).epsilon(0.1));
+    CHECK(own["rate_ratio_yade_over_kernel"].get<double>() > 0.8);
+    CHECK(own["rate_ratio_yade_over_kernel"].get<double>() < 1.25);
+    CHECK(own["filling_share_of_rate_ratio"].get<double>() ==
+          Approx(own["rate_ratio_yade_over_kernel"].get<double>() - a["rate_ratio_yade_over_kernel"].get<double>()));
+    CHECK(own["flow_pattern"]["pattern"] == "mass");
+    CHECK(fs::exists(dir / "c" / "theta_20" / "cloud.json"));
+    CHECK(read_file(dir / "c" / "crosscheck_silo.md").find("Each code fills on its own") != std::string::npos);
     fs::remove_all(dir);
     fs::remove(dir.string() + ".log");
 }

@@ -180,7 +180,9 @@ TEST_CASE("silo.py: bad params exit 2 naming the field", "[yade][silo]") {
                           Case{"/run/time_step_fraction", 0.0, "run.time_step_fraction=0.0 outside (0, 1]"},
                           Case{"/run/rolling_moment", 1, "run.rolling_moment=1 needs run.hertzian_facets 0"},
                           Case{"/run/discharge_time", 1.0, "run.discharge_time=1.0 unknown field"},
-                          Case{"/bed_file", "missing.json", "bed_file=\"missing.json\" cannot be read"}}) {
+                          Case{"/bed_file", "missing.json", "bed_file=\"missing.json\" cannot be read"},
+                          Case{"/run/fill", 1, "bed_file=\"bed.json\" holds the bed at the opening, but run.fill = 1 "
+                                               "needs a generated cloud"}}) {
         INFO(c.pointer);
         json params = silo_params(bed, 0.1);
         params[json::json_pointer(c.pointer)] = c.value;
