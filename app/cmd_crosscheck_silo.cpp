@@ -60,6 +60,7 @@ struct SiloCrosscheckOptions {
     std::string plot_format = "png";
     long max_runs = 10000;
     FillMode fill = FillMode::same_bed;
+    std::string fill_text = "same-bed";  // as given; `fill` holds its meaning
 };
 
 // A YADE run of one angle: its folder, the bed file it starts from, and whether it fills first.
@@ -542,11 +543,12 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
     silo->add_option("--partition", o->partition, "SLURM partition (--executor slurm)");
     silo->add_option("--yade", o->yade, "YADE launcher");
     silo->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
-    silo->add_option("--fill", o->fill,
+    silo->add_option("--fill", o->fill_text,
                      "same-bed: YADE discharges the kernel's filled bed; own: YADE fills the silo itself from the "
                      "kernel's generated cloud, then discharges; both: the two, and the filling's share of the "
                      "difference")
-        ->transform(CLI::CheckedTransformer(kFillModes, CLI::ignore_case))
+        ->check(CLI::IsMember({"same-bed", "own", "both"}))
+        ->each([o](const std::string& text) { o->fill = kFillModes.at(text); })
         ->capture_default_str();
     silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (3 with --fill both; a guard against typos)")
         ->check(integer_in(1, 1000000000))
