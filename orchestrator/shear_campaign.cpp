@@ -8,8 +8,6 @@
 #include "orchestrator/slurm_executor.hpp"
 
 #include <optional>
-#include <fcntl.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -276,50 +274,12 @@ std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
 }  // namespace
 
 ShearCampaignRunner::ShearCampaignRunner(const fs::path& dir, ExecutionOptions options)
-    : dir_(fs::absolute(dir).lexically_normal()), options_(std::move(options)) {
-    std::error_code ec;
-    fs::create_directories(dir_, ec);  // the first thing a campaign writes: a folder it cannot make is bad input
-    if (ec || !fs::is_directory(dir_))
-        throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +
-                                    "': cannot create the campaign folder" + (ec ? ": " + ec.message() : std::string()));
-    const fs::path lock = dir_ / ".lock";
-    // O_CLOEXEC: YADE children must not inherit the lock, or a resume right after kill -9 of the orchestrator finds
-    // the directory "in use" until the last orphan has died.
-    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (lock_fd_ < 0) throw std::runtime_error("cannot open " + lock.string());
-    // flock is released by the kernel when the process dies, even by kill -9: no stale locks.
-    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-        ::close(lock_fd_);
-        throw std::runtime_error("campaign directory " + dir_.string() + " is in use by another demcal process");
-    }
-    store_ = std::make_unique<CampaignStore>(dir_ / "campaign.sqlite");
-    recover_stale_runs();
-}
+    : directory_(dir, [](const RunRecord& r) { return finished_result(r.run_dir); }),
+      dir_(directory_.dir()),
+      options_(std::move(options)),
+      store_(&directory_.store()) {}
 
-ShearCampaignRunner::~ShearCampaignRunner() {
-    store_.reset();
-    if (lock_fd_ >= 0) ::close(lock_fd_);
-}
-
-void ShearCampaignRunner::recover_stale_runs() {
-    // We hold the directory's lock, so any run still marked running belongs to a demcal that died.
-    for (const auto& r : store_->runs_in_state(RunState::running)) {
-        const auto attempts = store_->attempts(r.hash);
-        const std::string executor = attempts.empty() ? "local" : attempts.back().executor;
-        if (executor == "slurm")
-            cancel_stale_slurm_task(r.pgid);
-        else
-            kill_stale_process_group(r.pgid, r.run_dir);
-        // A run that wrote its result just before the orchestrator died is finished: keep it. The file is removed
-        // before every attempt and the script writes it atomically as its last act, so it is this attempt's, whole.
-        if (const auto result = finished_result(r.run_dir)) {
-            store_->mark_done(r.hash, *result, 0, result->value("wall_time_s", 0.0), 0.0);
-            continue;
-        }
-        store_->reset_to_pending(r.hash, "the orchestrator (pid " + std::to_string(r.owner_pid) +
-                                             ") stopped while the run was running");
-    }
-}
+ShearCampaignRunner::~ShearCampaignRunner() = default;
 
 ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, const ProgressCallback& progress) {
     validate_shear_spec(spec_in);

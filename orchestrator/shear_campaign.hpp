@@ -4,6 +4,7 @@
 // is already done in the store is reused, never computed twice (unless forced), and a campaign killed at any moment
 // resumes by running this again (or resume_shear_campaigns) on the same directory.
 #pragma once
+#include "orchestrator/campaign_directory.hpp"
 #include "orchestrator/campaign_store.hpp"
 #include "orchestrator/executor.hpp"
 
@@ -123,11 +124,10 @@ public:
     const std::filesystem::path& dir() const { return dir_; }
 
 private:
+    CampaignDirectory directory_;  // the lock and the store, stale runs recovered
     std::filesystem::path dir_;
     ExecutionOptions options_;
-    std::unique_ptr<CampaignStore> store_;
-    int lock_fd_ = -1;
-    void recover_stale_runs();
+    CampaignStore* store_;
 };
 
 // Summary of a campaign directory without running anything (for `demcal status`): opens the store read-only-ish.

@@ -1,0 +1,62 @@
+#include "orchestrator/campaign_directory.hpp"
+
+#include "analytics/number_text.hpp"
+#include "orchestrator/executor.hpp"
+#include "orchestrator/slurm_executor.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <stdexcept>
+
+namespace demcal::orchestrator {
+
+namespace fs = std::filesystem;
+
+CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& finished)
+    : dir_(fs::absolute(dir).lexically_normal()) {
+    std::error_code ec;
+    fs::create_directories(dir_, ec);  // the first thing a campaign writes: a folder it cannot make is bad input
+    if (ec || !fs::is_directory(dir_))
+        throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +
+                                    "': cannot create the campaign folder" + (ec ? ": " + ec.message() : std::string()));
+    const fs::path lock = dir_ / ".lock";
+    // O_CLOEXEC: children must not inherit the lock, or a resume right after kill -9 of the orchestrator finds the
+    // directory "in use" until the last orphan has died.
+    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd_ < 0) throw std::runtime_error("cannot open " + lock.string());
+    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+        ::close(lock_fd_);
+        throw std::runtime_error("campaign directory " + dir_.string() + " is in use by another demcal process");
+    }
+    try {
+        store_ = std::make_unique<CampaignStore>(dir_ / "campaign.sqlite");
+    } catch (...) {
+        ::close(lock_fd_);
+        throw;
+    }
+    for (const auto& r : store_->runs_in_state(RunState::running)) {
+        const auto attempts = store_->attempts(r.hash);
+        const std::string executor = attempts.empty() ? "local" : attempts.back().executor;
+        if (executor == "slurm")
+            cancel_stale_slurm_task(r.pgid);
+        else
+            kill_stale_process_group(r.pgid, r.run_dir);
+        // A run that wrote its result just before the orchestrator died is finished: keep it. The file is removed
+        // before every attempt and written atomically as the run's last act, so it is this attempt's, whole.
+        if (const auto result = finished(r)) {
+            store_->mark_done(r.hash, *result, 0, result->value("wall_time_s", 0.0), 0.0);
+            continue;
+        }
+        store_->reset_to_pending(r.hash, "the orchestrator (pid " + std::to_string(r.owner_pid) +
+                                             ") stopped while the run was running");
+    }
+}
+
+CampaignDirectory::~CampaignDirectory() {
+    store_.reset();
+    if (lock_fd_ >= 0) ::close(lock_fd_);
+}
+
+}  // namespace demcal::orchestrator

@@ -1,0 +1,38 @@
+// A campaign directory held by one demcal at a time: its lock (flock on DIR/.lock, released by the kernel when the
+// holder dies, even by kill -9) and its store (DIR/campaign.sqlite), with the runs a dead holder left "running"
+// recovered on opening. Shared by the shear campaigns and the jobs of other campaigns kept in the store (the silo
+// cross-check).
+#pragma once
+#include "orchestrator/campaign_store.hpp"
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+
+namespace demcal::orchestrator {
+
+// The result a run left in its folder if it finished (written atomically as its last act), else nothing.
+using FinishedResult = std::function<std::optional<nlohmann::json>(const RunRecord& run)>;
+
+class CampaignDirectory {
+public:
+    // Creates the folder if needed (std::invalid_argument naming it when it cannot be made), takes its lock
+    // (std::runtime_error when another demcal holds it), opens the store and recovers stale runs: a run marked running
+    // belongs to a demcal that died (we hold the lock); its process group or SLURM task is stopped, and it is done if
+    // `finished` finds its result, else back to pending.
+    CampaignDirectory(const std::filesystem::path& dir, const FinishedResult& finished);
+    ~CampaignDirectory();
+    CampaignDirectory(const CampaignDirectory&) = delete;
+    CampaignDirectory& operator=(const CampaignDirectory&) = delete;
+
+    const std::filesystem::path& dir() const { return dir_; }
+    CampaignStore& store() { return *store_; }
+
+private:
+    std::filesystem::path dir_;
+    int lock_fd_ = -1;
+    std::unique_ptr<CampaignStore> store_;
+};
+
+}  // namespace demcal::orchestrator
