@@ -4,8 +4,9 @@
 // wall and CPU time of each code and their ratio, and the differences YADE cannot remove with their expected effect.
 // --fill own / both: YADE fills the silo itself from the kernel's generated cloud (--export-cloud) instead / as well,
 // so the filling's share of the difference is measured. Runs are subprocesses of the orchestrator's local pool
-// (timeouts, kill on Ctrl-C) or SLURM array tasks; a run whose inputs did not change is reused from its folder
-// (IDENTITY beside its result), so the same command continues an interrupted check.
+// (timeouts, kill on Ctrl-C) or SLURM array tasks, kept in the campaign store DIR/campaign.sqlite (state, result,
+// timings, every attempt; `demcal status DIR` lists them): a run whose inputs did not change is reused, so the same
+// command continues an interrupted check.
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/silo_material.hpp"
@@ -13,10 +14,12 @@
 #include "app/silo_settings.hpp"
 #include "app/gnuplot.hpp"
 #include "analytics/user_input.hpp"
+#include "orchestrator/campaign_directory.hpp"
 #include "orchestrator/executor.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
 #include "orchestrator/slurm_executor.hpp"
+#include "orchestrator/stored_jobs.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -107,12 +110,6 @@ std::string theta_name(double theta) {
     std::ostringstream o;
     o << "theta_" << theta;
     return o.str();
-}
-
-// A job is reused when its folder holds a result and the IDENTITY of the inputs that made it.
-bool reusable(const fs::path& result, const fs::path& dir, const std::string& identity) {
-    const fs::path id = dir / "IDENTITY";
-    return fs::exists(result) && fs::exists(id) && orchestrator::read_text_file(id) == identity;
 }
 
 std::vector<std::string> kernel_argv(const SiloCrosscheckOptions& o, double theta, const fs::path& out,
@@ -279,64 +276,71 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     if (!o.geometry.empty()) analytics::read_json_input(o.geometry, "geometry");
     const json yade_material = o.yade_material.empty() ? json() : analytics::read_json_input(o.yade_material, "yade-material");
     for (double theta : o.thetas) check_kernel_run(o, theta);
-    const fs::path root = fs::absolute(o.dir).lexically_normal();
-    fs::create_directories(root);
+    // the campaign directory: its lock and its store (runs, states, results, attempts), stale runs recovered
+    orchestrator::CampaignDirectory campaign(o.dir, orchestrator::stored_job_result);
+    const fs::path root = campaign.dir();
+    orchestrator::CampaignStore& store = campaign.store();
+    const json spec = {{"thetas", o.thetas},
+                       {"particles", o.particles},
+                       {"stiffness_scale", o.stiffness_scale},
+                       {"seed", o.seed},
+                       {"max_time_s", o.max_time},
+                       {"material", o.material},
+                       {"geometry", o.geometry},
+                       {"yade_material", o.yade_material},
+                       {"fill", o.fill_text}};
+    const std::int64_t campaign_id =
+        store.ensure_campaign("crosscheck-silo-" + orchestrator::sha256_hex(spec.dump()).substr(0, 12),
+                              "crosscheck_silo", spec)
+            .id;
     // the kernel runs start a copy of this program kept in the campaign: a rebuild while they run (or wait in a SLURM
     // queue) neither fails them nor mixes two builds
     const std::string program = orchestrator::pinned_program(self, root / ".program");
     const std::string script_text = orchestrator::read_text_file(script);
+    const int slots = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+    const auto executor = orchestrator::make_executor(o.executor, slots, root / "slurm", o.partition);
+    auto run_stage = [&](const std::vector<orchestrator::StoredJob>& jobs) {
+        const auto out = orchestrator::run_stored_jobs(
+            store, campaign_id, jobs, *executor,
+            [](const std::string& event, const orchestrator::StoredJob& job, const std::string& detail) {
+                std::cout << std::left << std::setw(9) << event << job.name
+                          << (detail.empty() ? "" : " (" + detail + ")") << std::endl;
+            });
+        return !out.interrupted;
+    };
+    auto file_hash = [](const std::string& file) {
+        return file.empty() ? std::string() : orchestrator::sha256_hex(orchestrator::read_text_file(file));
+    };
 
-    // 1. the kernel fills and discharges at every angle, writing its bed at the opening
-    std::deque<orchestrator::Job> jobs;
-    std::map<double, std::string> kernel_identity;
+    // 1. the kernel fills and discharges at every angle, writing its generated cloud and its bed at the opening
+    std::vector<orchestrator::StoredJob> jobs;
     for (double theta : o.thetas) {
         const fs::path d = root / theta_name(theta);
         fs::create_directories(d / "kernel");
-        const auto argv = kernel_argv(o, theta, d / "kernel", d / "bed.json", program);
-        std::string id = "demcal silo (bed with flow_pattern_sampling)";
-        for (std::size_t i = 1; i < argv.size(); ++i) id += " " + argv[i];
-        if (!o.material.empty()) id += "\nmaterial " + orchestrator::sha256_hex(orchestrator::read_text_file(o.material));
-        if (!o.geometry.empty()) id += "\ngeometry " + orchestrator::sha256_hex(orchestrator::read_text_file(o.geometry));
-        kernel_identity[theta] = id;
-        if (reusable(d / "kernel" / "summary.json", d / "kernel", id) && fs::exists(d / "bed.json") &&
-            fs::exists(d / "cloud.json"))
-            continue;
-        fs::remove(d / "kernel" / "summary.json");
-        fs::remove(d / "bed.json");
-        fs::remove(d / "cloud.json");
-        jobs.push_back({theta_name(theta) + " kernel", d / "kernel", argv, o.timeout_s});
+        // the identity: what the run computes, without paths (a campaign moved elsewhere keeps its runs)
+        const json params = {{"code", "kernel"},
+                             {"what", "demcal silo, its bed at the opening and its generated cloud exported"},
+                             {"theta_deg", theta},
+                             {"particles", o.particles},
+                             {"stiffness_scale", o.stiffness_scale},
+                             {"seed", o.seed},
+                             {"max_time_s", o.max_time},
+                             {"material_sha256", file_hash(o.material)},
+                             {"geometry_sha256", file_hash(o.geometry)}};
+        auto job = orchestrator::stored_job(theta_name(theta) + " kernel", params,
+                                            {{"theta_deg", theta}, {"code", "kernel"}}, d / "kernel",
+                                            kernel_argv(o, theta, d / "kernel", d / "bed.json", program),
+                                            "summary.json", o.timeout_s);
+        job.outputs = {d / "bed.json", d / "cloud.json"};
+        jobs.push_back(std::move(job));
     }
-    const int slots = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
-    auto run_jobs = [&](std::deque<orchestrator::Job> queue, const std::map<std::string, std::string>& identities) {
-        const auto executor = orchestrator::make_executor(o.executor, slots, root / "slurm", o.partition);
-        orchestrator::ExecutorEvents events;
-        events.started = [](const orchestrator::Job& j, long) { std::cout << "started  " << j.id << std::endl; };
-        events.finished = [&](const orchestrator::Job& j, const orchestrator::JobOutcome& r) {
-            std::cout << (r.succeeded() ? "done     " : "FAILED   ") << j.id << " (" << g(r.wall_s, 3) << " s"
-                      << (r.succeeded() ? "" : ", " + r.failure_cause + ": " + r.message) << ")" << std::endl;
-            if (r.succeeded()) orchestrator::write_text_file_atomically(j.dir / "IDENTITY", identities.at(j.id));
-        };
-        orchestrator::InterruptGuard guard;
-        executor->run(
-            [&]() -> std::optional<orchestrator::Job> {
-                if (queue.empty()) return std::nullopt;
-                auto j = queue.front();
-                queue.pop_front();
-                return j;
-            },
-            events);
-        return !orchestrator::interrupted();
-    };
-    std::map<std::string, std::string> ids;
-    for (double theta : o.thetas) ids[theta_name(theta) + " kernel"] = kernel_identity[theta];
-    if (!run_jobs(jobs, ids)) {
+    if (!run_stage(jobs)) {
         std::cout << "interrupted: run the same command again to continue\n";
         return 130;
     }
 
-    // 2. YADE discharges each bed
+    // 2. YADE discharges each bed (and, with --fill own/both, fills the silo from the kernel's cloud first)
     jobs.clear();
-    ids.clear();
     for (double theta : o.thetas)
         for (const YadeRunKind& kind : yade_runs(o.fill)) {
             const fs::path d = root / theta_name(theta), run = d / kind.folder;
@@ -347,20 +351,30 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
             orchestrator::write_text_file_atomically(run / "params.json", params.dump(1) + "\n");
             orchestrator::write_text_file_atomically(run / "silo.py", script_text);
             orchestrator::write_text_file_atomically(run / "run_clean.py", orchestrator::read_text_file(wrapper));
-            const std::string id = "yade silo.py " + orchestrator::sha256_hex(script_text) + "\nparams " +
-                                   params.dump() + "\nbed " +
-                                   orchestrator::sha256_hex(orchestrator::read_text_file(d / kind.bed_file));
-            const std::string name = theta_name(theta) + " " + kind.folder;
-            ids[name] = id;
-            if (reusable(run / "result.json", run, id)) continue;
-            fs::remove(run / "result.json");
-            jobs.push_back({name, run,
-                            {yade, "-n", "-j1", "-x", "run_clean.py", "silo.py", "params.json", "result.json"},
-                            o.timeout_s});
+            const json identity = {{"code", "yade"},
+                                   {"run", kind.folder},
+                                   {"script_sha256", orchestrator::sha256_hex(script_text)},
+                                   {"params", params},
+                                   {"bed_sha256", file_hash((d / kind.bed_file).string())}};
+            jobs.push_back(orchestrator::stored_job(
+                theta_name(theta) + " " + kind.folder, identity, {{"theta_deg", theta}, {"code", kind.folder}}, run,
+                {yade, "-n", "-j1", "-x", "run_clean.py", "silo.py", "params.json", "result.json"}, "result.json",
+                o.timeout_s));
         }
-    if (!run_jobs(jobs, ids)) {
+    if (!run_stage(jobs)) {
         std::cout << "interrupted: run the same command again to continue\n";
         return 130;
+    }
+
+    {
+        const auto runs = store.campaign_runs(campaign_id);
+        const bool all_done = std::all_of(runs.begin(), runs.end(), [](const orchestrator::RunRecord& r) {
+            return r.state == orchestrator::RunState::done;
+        });
+        const bool any_failed = std::any_of(runs.begin(), runs.end(), [](const orchestrator::RunRecord& r) {
+            return r.state == orchestrator::RunState::failed;
+        });
+        store.set_campaign_status(campaign_id, all_done ? "complete" : any_failed ? "failed" : "open");
     }
 
     // 3. side by side

@@ -89,7 +89,7 @@ void write_outputs(const calibration::EnlargementStudy& study, const ScaleCli& o
             plot_enlargement(stem + "_laws.json", study.law_radii, study.law_young_moduli, study.law_poisson_ratios,
                              *study.young_law, *study.poisson_law, o.campaign.plot_format);
         } else {  // a resumed study whose laws are no longer fitted must not leave the last run's picture of them
-            for (const std::string suffix : {"_laws" + ext, std::string("_laws.dat")}) fs::remove(stem + suffix);
+            for (const std::string& suffix : {"_laws" + ext, std::string("_laws.dat")}) fs::remove(stem + suffix);
         }
     } catch (const std::exception& e) {
         std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";

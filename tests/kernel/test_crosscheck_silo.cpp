@@ -1,6 +1,7 @@
 // demcal crosscheck silo end to end with real YADE: the kernel fills and discharges a tiny reduced silo, YADE
 // discharges the same bed; the report holds both rates (within 25 % of each other on 300 grains), the curve gap, the
-// costs; the same command again reuses both runs (nothing started); a deliberate mismatch of the grains' friction is
+// costs; the same command again reuses both runs (nothing started: they are in the campaign store, which `demcal
+// status` lists; a run whose output is gone runs again, alone); a deliberate mismatch of the grains' friction is
 // flagged; a bad angle is refused before anything runs. YADE's flow pattern is measured by the kernel's classifier on
 // YADE's frames: on 600 grains in a 20 deg hopper both codes give mass flow. --fill both: YADE also fills the silo
 // itself from the kernel's generated cloud, to the kernel's rest rule, and discharges that bed.
@@ -53,6 +54,15 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     // the same command again: both runs reused
     REQUIRE(run_demcal(args, dir / "second.log") == 0);
     CHECK(read_file(dir / "second.log").find("started") == std::string::npos);
+    // the runs live in the campaign store: status lists them
+    REQUIRE(run_demcal("status '" + (dir / "c").string() + "'", dir / "status.log") == 0);
+    CHECK_THAT(read_file(dir / "status.log"), Catch::Contains("[complete] crosscheck_silo: 2 runs, 2 done"));
+    // a run's output gone: that run again, and only it (the kernel rebuilds the same bed bit for bit, so YADE's run
+    // of it is still the one in the store)
+    fs::remove(dir / "c" / "theta_45" / "bed.json");
+    REQUIRE(run_demcal(args, dir / "again.log") == 0);
+    CHECK_THAT(read_file(dir / "again.log"), Catch::Contains("started  theta_45 kernel"));
+    CHECK(read_file(dir / "again.log").find("started  theta_45 yade") == std::string::npos);
     CHECK(report["rates_agree"] == true);
     // a deliberate mismatch (YADE's grains far more frictional) on the same bed: flagged
     auto material = nlohmann::json::parse(

@@ -1,0 +1,96 @@
+// Jobs kept in the campaign store that are not shear runs (orchestrator/stored_jobs): a finished job is reused while
+// its outputs are there, a job refused for its input (exit 2) fails for good, any other failure is tried again by the
+// next call, and a run left "running" by a dead orchestrator is recovered by CampaignDirectory (done when its result
+// is in its folder). Real processes (sh) through the local executor, a real SQLite store.
+#include "orchestrator/campaign_directory.hpp"
+#include "orchestrator/stored_jobs.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+using namespace demcal::orchestrator;
+namespace fs = std::filesystem;
+
+namespace {
+
+StoredJob shell_job(const fs::path& root, const std::string& name, const std::string& script) {
+    fs::create_directories(root / name);
+    return stored_job(name, {{"script", script}}, {{"job", name}}, root / name, {"sh", "-c", script}, "result.json",
+                      60);
+}
+
+std::map<std::string, std::string> run_all(CampaignDirectory& d, const std::vector<StoredJob>& jobs,
+                                           StoredJobsOutcome& out) {
+    std::map<std::string, std::string> events;
+    LocalExecutor executor(2);
+    const auto id = d.store().ensure_campaign("test", "test_jobs", nlohmann::json::object()).id;
+    out = run_stored_jobs(d.store(), id, jobs, executor,
+                          [&](const std::string& e, const StoredJob& j, const std::string&) { events[j.name] = e; });
+    return events;
+}
+
+}  // namespace
+
+TEST_CASE("stored jobs: reuse, failure for good on exit 2, retry of other failures, outputs checked", "[store]") {
+    const fs::path root = fs::temp_directory_path() / ("demcal-test-stored-jobs-" + std::to_string(::getpid()));
+    fs::remove_all(root);
+    std::vector<StoredJob> jobs = {shell_job(root, "good", "echo '{\"x\": 1}' > result.json && touch other.out"),
+                                   shell_job(root, "refused", "exit 2"),
+                                   shell_job(root, "flaky", "if [ -e ../flaky.ok ]; then echo '{}' > result.json; "
+                                                            "else exit 1; fi")};
+    jobs[0].outputs = {root / "good" / "other.out"};
+    {
+        CampaignDirectory d(root, stored_job_result);
+        StoredJobsOutcome out;
+        auto events = run_all(d, jobs, out);
+        CHECK(events["good"] == "done");
+        CHECK(events["refused"] == "failed");
+        CHECK(events["flaky"] == "retry later");
+        CHECK(out.executed == 1);
+        CHECK(out.failed == 1);
+        CHECK(out.pending == 1);
+        const auto good = d.store().run(jobs[0].hash);
+        REQUIRE(good);
+        CHECK(good->state == RunState::done);
+        CHECK(good->result["x"] == 1);
+        CHECK(d.store().run(jobs[1].hash)->state == RunState::failed);
+        CHECK(d.store().run(jobs[2].hash)->state == RunState::pending);
+        CHECK(d.store().run(jobs[2].hash)->attempts == 1);
+    }
+    std::ofstream(root / "flaky.ok") << "";
+    fs::remove(root / "good" / "other.out");  // an output gone: the job runs again
+    {
+        CampaignDirectory d(root, stored_job_result);
+        StoredJobsOutcome out;
+        auto events = run_all(d, jobs, out);
+        CHECK(events["good"] == "done");
+        CHECK(events.count("refused") == 0);  // failed for good: not started again
+        CHECK(events["flaky"] == "done");
+        CHECK(d.store().run(jobs[2].hash)->attempts == 2);
+    }
+    {
+        CampaignDirectory d(root, stored_job_result);
+        StoredJobsOutcome out;
+        auto events = run_all(d, jobs, out);
+        CHECK(events.empty());  // all reused or failed for good
+        CHECK(out.reused == 2);
+        // a run marked running by an orchestrator that died after the job wrote its result: done on reopening
+        d.store().mark_running(jobs[0].hash, 999999, 999999, "local");
+    }
+    {
+        CampaignDirectory d(root, stored_job_result);
+        CHECK(d.store().run(jobs[0].hash)->state == RunState::done);
+        d.store().mark_running(jobs[2].hash, 999999, 999999, "local");
+        fs::remove(root / "flaky" / "result.json");
+    }
+    CampaignDirectory d(root, stored_job_result);  // ... and without its result: back to pending
+    CHECK(d.store().run(jobs[2].hash)->state == RunState::pending);
+    CHECK_THROWS_AS(CampaignDirectory(root, stored_job_result), std::runtime_error);  // the lock is held
+    fs::remove_all(root);
+}
