@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Hostile-input sweep of the commands added since the last hardening pass (issue 23): shear-run, shear --engine
-# kernel, crosscheck shear, crosscheck silo, scale, cutoff, vibration, silo --export-bed and the --vibration-* options.
+# kernel, crosscheck shear, crosscheck silo (--fill), scale, cutoff, vibration, silo --export-bed/--export-cloud and the
+# --vibration-* options.
 # Each case runs the real demcal under `timeout` in a scratch folder and checks:
 #   - the exit code (2 for bad input unless the case says otherwise), never a signal (>= 128) nor a timeout (124);
 #   - the message names the option or field (EXPECT) and is short (a huge value is shortened, stderr < 4 kB);
@@ -160,6 +161,9 @@ run_case crosscheck-silo/campaign-readonly 2 "campaign" "$ro" -- crosscheck silo
 run_case crosscheck-silo/campaign-file 2 "campaign"      -- crosscheck silo --theta 30 --particles 100 --campaign "$tiny"
 run_case crosscheck-silo/timeout-subnormal 2 "--timeout" -- "${S[@]}" --theta 30 --timeout 1e-320
 run_case crosscheck-silo/yade-folder 2 "yade"            -- "${S[@]}" --theta 30 --yade "$work/folder.json"
+run_case crosscheck-silo/fill-unknown 2 "--fill"         -- "${S[@]}" --theta 30 --fill none
+run_case crosscheck-silo/fill-empty  2 "--fill"           -- "${S[@]}" --theta 30 --fill ""
+run_case crosscheck-silo/fill-number 2 "--fill"           -- "${S[@]}" --theta 30 --fill 1
 
 # ---- demcal scale ---------------------------------------------------------------------------------------------------
 R=(scale "$tiny" --dir camp -s 5e3,1e4,2e4)
@@ -232,6 +236,10 @@ run_case silo/export-bed-no-folder   2 "--export-bed"    -- "${L[@]}" --export-b
 run_case silo/export-bed-readonly    2 "--export-bed" "$ro" -- "${L[@]}" --export-bed "$ro/b.json"
 run_case silo/export-bed-empty       2 "--export-bed"    -- "${L[@]}" --export-bed ""
 run_case silo/export-bed-resume      2 "--export-bed"    -- silo --resume somewhere --export-bed b.json
+run_case silo/export-cloud-folder    2 "--export-cloud"  -- "${L[@]}" --export-cloud "$work/folder.json"
+run_case silo/export-cloud-no-folder 2 "--export-cloud"  -- "${L[@]}" --export-cloud /no/such/c.json
+run_case silo/export-cloud-readonly  2 "--export-cloud" "$ro" -- "${L[@]}" --export-cloud "$ro/c.json"
+run_case silo/export-cloud-resume    2 "--export-cloud"  -- silo --resume somewhere --export-cloud c.json
 run_case silo/out-readonly           2 "out"     "$ro"   -- "${L[@]}" --out "$ro/o"
 run_case silo/out-file               2 "out"             -- "${L[@]}" --out "$tiny"
 run_case silo/vtk-readonly           2 "vtk"     "$ro"   -- "${L[@]}" --vtk "$ro/v"
