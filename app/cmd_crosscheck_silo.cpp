@@ -130,17 +130,17 @@ json yade_params(const json& bed, const SiloCrosscheckOptions& o, const json& ya
     json geometry = json::object();
     for (const char* k : {"shape", "theta_deg", "outlet_m", "D_m", "body_height_m"}) geometry[k] = bed.at("geometry").at(k);
     json params = {{"bed_file", std::string("../") + kind.bed_file},
-            {"geometry", geometry},
-            {"material", yade_material.is_null() ? bed.at("material") : yade_material},
-            {"run",
-             {{"stiffness_scale", bed.at("stiffness_scale")},
-              {"time_step_fraction", bed.at("time_step_fraction")},
-              {"discharge_time_s", o.max_time},
-              {"sample_interval_s", bed.at("record_interval_s")},
-              {"removal_depth_m", bed.at("removal_depth_m")},
-              // YADE's flow-pattern frames at the kernel's interval, classified here by the kernel's classifier
-              {"frame_interval_s", bed.at("flow_pattern_sampling").at("frame_interval_s")},
-              {"frames_file", kYadeFramesFile}}}};
+                   {"geometry", geometry},
+                   {"material", yade_material.is_null() ? bed.at("material") : yade_material},
+                   {"run",
+                    {{"stiffness_scale", bed.at("stiffness_scale")},
+                     {"time_step_fraction", bed.at("time_step_fraction")},
+                     {"discharge_time_s", o.max_time},
+                     {"sample_interval_s", bed.at("record_interval_s")},
+                     {"removal_depth_m", bed.at("removal_depth_m")},
+                     // YADE's flow-pattern frames at the kernel's interval, classified here by the kernel's classifier
+                     {"frame_interval_s", bed.at("flow_pattern_sampling").at("frame_interval_s")},
+                     {"frames_file", kYadeFramesFile}}}};
     if (kind.fills) params["run"]["fill"] = 1;  // silo.py's default is 0: a same-bed run's params stay as they were
     return params;
 }
