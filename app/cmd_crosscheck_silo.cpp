@@ -62,8 +62,8 @@ struct SiloCrosscheckOptions {
     std::string yade = "yade";
     std::string plot_format = "png";
     long max_runs = 10000;
-    FillMode fill = FillMode::same_bed;
-    std::string fill_text = "same-bed";  // as given; `fill` holds its meaning
+    std::string fill_text = "same-bed";  // same-bed | own | both (checked by the option)
+    FillMode fill() const { return kFillModes.at(fill_text); }
 };
 
 // A YADE run of one angle: its folder, the bed file it starts from, and whether it fills first.
@@ -256,7 +256,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
         if (std::find(o.thetas.begin(), o.thetas.begin() + i, t) != o.thetas.begin() + i)
             throw UserError("theta = " + g(t) + " deg is given twice");
     }
-    const double runs_per_angle = 1.0 + static_cast<double>(yade_runs(o.fill).size());
+    const double runs_per_angle = 1.0 + static_cast<double>(yade_runs(o.fill()).size());
     orchestrator::check_run_count(runs_per_angle * static_cast<double>(o.thetas.size()), o.max_runs,
                                   "crosscheck silo: " + std::to_string(o.thetas.size()) + " angles x " +
                                       g(runs_per_angle) + " runs");
@@ -344,7 +344,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     // 2. YADE discharges each bed (and, with --fill own/both, fills the silo from the kernel's cloud first)
     jobs.clear();
     for (double theta : o.thetas)
-        for (const YadeRunKind& kind : yade_runs(o.fill)) {
+        for (const YadeRunKind& kind : yade_runs(o.fill())) {
             const fs::path d = root / theta_name(theta), run = d / kind.folder;
             if (!fs::exists(d / kind.bed_file) || !fs::exists(d / "kernel" / "summary.json")) continue;
             const json bed = analytics::read_json_input(d / kind.bed_file, "bed");
@@ -394,7 +394,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
           "YADE empty [s] | kernel pattern (wall/axis) | YADE pattern (wall/axis) | largest curve gap [% of fill] | "
           "kernel CPU [s] | YADE CPU [s] | YADE / kernel CPU |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     bool complete = true, all_agree = true, all_patterns_agree = true, all_patterns_determined = true;
-    const YadeRunKind primary = yade_runs(o.fill).front();
+    const YadeRunKind primary = yade_runs(o.fill()).front();
     std::ostringstream own_fill_md;  // --fill both: the filling's share, a table of its own
     for (double theta : o.thetas) {
         const fs::path d = root / theta_name(theta);
@@ -457,7 +457,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
                                     {"largest_curve_gap_of_filled_mass", gap},
                                     {"cpu_ratio_yade_over_kernel", ycpu / kcpu}});
         std::vector<CurvePoint> own_curve;
-        if (o.fill == FillMode::both) {
+        if (o.fill() == FillMode::both) {
             const fs::path own = d / kYadeOwnFill.folder / "result.json";
             if (!fs::exists(own)) {
                 own_fill_md << "| " << theta << " | (YADE's own filling failed: see " << own.parent_path().string()
@@ -512,7 +512,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
                                             "the others).")
        << "\n\nDifferences YADE cannot remove (yade_scripts/README.md):\n";
     for (const char* d : kKnownDifferences) md << "- " << d << "\n";
-    if (o.fill == FillMode::both)
+    if (o.fill() == FillMode::both)
         md << "\n## Each code fills on its own\n\nYADE fills the silo itself from the kernel's generated cloud (the same "
               "grains, positions and orientations before the first filling step; the kernel's rest rule), then "
               "discharges. The filling's share of the difference is YADE's own-fill rate over the kernel's minus the "
@@ -521,7 +521,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
               "bed height kernel / YADE [mm] | YADE own fill pattern (wall/axis) | YADE own fill CPU [s] |\n"
               "|---|---|---|---|---|---|---|---|---|---|\n"
            << own_fill_md.str();
-    report["fill_mode"] = o.fill == FillMode::same_bed ? "same-bed" : o.fill == FillMode::own ? "own" : "both";
+    report["fill_mode"] = o.fill_text;
     report["rates_agree"] = all_agree;
     report["patterns_agree"] = all_patterns_agree;  // at every angle where both codes determined one
     report["patterns_determined"] = all_patterns_determined;
@@ -564,7 +564,6 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
                      "kernel's generated cloud, then discharges; both: the two, and the filling's share of the "
                      "difference")
         ->check(CLI::IsMember({"same-bed", "own", "both"}))
-        ->each([o](const std::string& text) { o->fill = kFillModes.at(text); })
         ->capture_default_str();
     silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (3 with --fill both; a guard against typos)")
         ->check(integer_in(1, 1000000000))
