@@ -74,9 +74,13 @@ void refuse_empty_values(CLI::App& app) {
     // An option's type as CLI11 names it: every number option follows the number rule and every integer option the
     // integer rule, whatever checks its command adds (one place: an option registered without a check was read by
     // CLI11 alone, which lets NaN, subnormals and 1e308 through and echoes a 100 kB value in full).
-    const CLI::Validator any_number = number_check("a number", [](double) { return true; });
-    const CLI::Validator any_integer = integer_in(std::numeric_limits<long long>::min(),
-                                                  std::numeric_limits<long long>::max());
+    // No description: the type name says it, and "an integer between -9223372036854775808 and ..." in every
+    // option's help says nothing a user needs.
+    CLI::Validator any_number = number_check("a number", [](double) { return true; });
+    CLI::Validator any_integer = integer_in(std::numeric_limits<long long>::min(),
+                                            std::numeric_limits<long long>::max());
+    any_number.description("");
+    any_integer.description("");
     for (CLI::Option* opt : app.get_options()) {
         if (opt->get_type_size_max() <= 0) continue;  // a flag takes no value
         opt->check(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); }, ""));

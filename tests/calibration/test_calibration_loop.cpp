@@ -6,6 +6,7 @@
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 
 #include <cmath>
 #include <stdexcept>
@@ -233,6 +234,42 @@ TEST_CASE("a bound reached where the simulated interval still holds the target i
     CHECK(result.status == CalibrationStatus::not_converged);
     CHECK(result.message.find("too noisy to tell whether the target is in reach") != std::string::npos);
     CHECK(result.message.find("best so far, evaluation #") != std::string::npos);
+}
+
+TEST_CASE("a bound reached within the noise of the target's own line is noise, not unreachable", "[calibration]") {
+    // The unreachable target again, on the clean box: at the bound the simulated line misses each target by d, more
+    // than its own half-width h. Given as measured lines whose own half-width H is a little below d (so the target's
+    // interval alone does not accept the bound either) but with hypot(h, H) >= d, the miss is within the noise of the
+    // difference of two independent lines: the verdict must be "too noisy", not "out of reach".
+    test::SyntheticShearBox clean;
+    const auto first = calibrate_unreachable_target(clean);
+    REQUIRE(first.status == CalibrationStatus::unreachable);
+    const auto at_bound = std::find_if(first.iterations.begin(), first.iterations.end(), [](const auto& it) {
+        return it.values.at("friction_coefficient") == 0.75;
+    });
+    REQUIRE(at_bound != first.iterations.end());
+    std::vector<MacroTarget> targets{{"mu_b", 0.95, std::nullopt}, {"tau_c", 900, std::nullopt}};
+    bool any_widened = false;
+    for (auto& t : targets) {
+        const double v = t.quantity == "mu_b" ? at_bound->mu_b : at_bound->tau_c;
+        const double h = t.quantity == "mu_b" ? at_bound->mu_b_half_width : at_bound->tau_c_half_width;
+        const double d = std::fabs(v - t.value);
+        if (d <= h) continue;
+        t.half_width = 1.01 * std::sqrt(d * d - h * h);
+        INFO(t.quantity << ": d " << d << ", h " << h << ", H " << *t.half_width);
+        REQUIRE(*t.half_width < d);
+        any_widened = true;
+    }
+    REQUIRE(any_widened);
+    const auto base = test::synthetic_base_material();
+    const auto study = run_sensitivity_study(base, clean.evaluator(), study_options());
+    CalibrationOptions options;
+    options.accept_simulated_interval = false;
+    const auto result =
+        calibrate(base, targets, choose_controls(study, targets, 0.02), &study, clean.evaluator(), options);
+    INFO(result.message);
+    CHECK(result.status == CalibrationStatus::not_converged);
+    CHECK(result.message.find("too noisy to tell whether the target is in reach") != std::string::npos);
 }
 
 TEST_CASE("an acceptance that rests only on a wide simulated interval says so", "[calibration]") {
