@@ -1,0 +1,377 @@
+#include "app/crosscheck_silo_report.hpp"
+
+#include "app/gnuplot.hpp"
+#include "app/silo_flow_pattern.hpp"
+#include "analytics/user_input.hpp"
+#include "kernel/silo/silo_geometry.hpp"
+#include "orchestrator/run_identity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace demcal::crosscheck_silo {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string theta_name(double theta) {
+    std::ostringstream o;
+    o << "theta_" << theta;
+    return o.str();
+}
+
+namespace {
+
+// The differences between the two codes' set-ups that YADE cannot remove (yade_scripts/README.md measures them).
+const char* const kKnownDifferences[] = {
+    "rolling friction: YADE has no EDEM-type constant directional torque; its elastic-plastic rolling moment "
+    "(run.rolling_moment) is a different law (measured on a 30 deg bed: +2.6 % on the rate against none). YADE runs "
+    "without rolling resistance by default: at 10 deg (4000 grains) YADE / kernel was 1.064 and 1.087 on two beds, "
+    "1.032 with rolling friction 0 in both codes (examples/crosscheck/README.md)",
+    "tangential spring: YADE's Mindlin law is incremental, the kernel's a rotated history spring (same stiffness)",
+    "YADE clips the normal force at zero in a separating contact; the kernel does not (a very small effect at "
+    "restitution 0.5-0.6)",
+    "integrators: YADE's leapfrog with its aspherical rotation for clumps, the kernel's velocity Verlet with a "
+    "Richardson quaternion update",
+    "walls: YADE's cone and cylinder are facet polygons (72 sides), the kernel's are exact surfaces of revolution",
+};
+
+std::string g(double v, int digits = 4) {
+    std::ostringstream o;
+    o << std::setprecision(digits) << v;
+    return o.str();
+}
+
+// ---- mass-time curves ----
+
+struct CurvePoint {
+    double t, mass;
+};
+using Curve = std::vector<CurvePoint>;
+
+Curve kernel_curve(const fs::path& csv) {
+    Curve c;
+    std::ifstream f(csv);
+    std::string line;
+    std::getline(f, line);  // header
+    while (std::getline(f, line)) {
+        std::istringstream s(line);
+        double t = 0, m = 0;
+        char comma = 0;
+        if (s >> t >> comma >> m) c.push_back({t, m});
+    }
+    return c;
+}
+
+Curve yade_curve(const json& result) {
+    Curve c;
+    const auto& t = result.at("curve").at("time_s");
+    const auto& m = result.at("curve").at("discharged_mass_kg");
+    for (std::size_t i = 0; i < t.size(); ++i) c.push_back({t[i].get<double>(), m[i].get<double>()});
+    return c;
+}
+
+double mass_at(const Curve& c, double t) {
+    if (c.empty()) return 0;
+    if (t <= c.front().t) return c.front().mass;
+    if (t >= c.back().t) return c.back().mass;
+    const auto it = std::lower_bound(c.begin(), c.end(), t, [](const CurvePoint& p, double x) { return p.t < x; });
+    const CurvePoint& b = *it;
+    const CurvePoint& a = *(it - 1);
+    return a.mass + (b.mass - a.mass) * (t - a.t) / (b.t - a.t);
+}
+
+// The largest gap between the curves at the kernel's recorded times, as a fraction of the filled mass.
+double largest_gap(const Curve& k, const Curve& y, double filled) {
+    double gap = 0;
+    const double t_end = std::min(k.empty() ? 0 : k.back().t, y.empty() ? 0 : y.back().t);
+    for (const auto& p : k)
+        if (p.t <= t_end) gap = std::max(gap, std::abs(p.mass - mass_at(y, p.t)));
+    return filled > 0 ? gap / filled : 0;
+}
+
+void write_curve_data(const fs::path& file, const Curve& c) {
+    std::ofstream f(file);
+    for (const auto& p : c) f << p.t << " " << p.mass * 1e3 << "\n";
+}
+
+// `own`: YADE's discharge of the bed it filled itself (--fill both), drawn when not empty.
+void write_curve_plot(const fs::path& dir, double theta, const Curve& k, const Curve& y, const Curve& own,
+                      const std::string& format) {
+    const fs::path data_k = dir / "curve_kernel.dat", data_y = dir / "curve_yade.dat",
+                   data_own = dir / "curve_yade_own_fill.dat";
+    write_curve_data(data_k, k);
+    write_curve_data(data_y, y);
+    if (!own.empty()) write_curve_data(data_own, own);
+    std::ostringstream s;
+    s << "set title 'Discharged mass, cone half angle " << theta << " deg'\n"
+      << "set xlabel 'time since opening [s]'\nset ylabel 'discharged mass [g]'\nset key top left\nset grid\n"
+      << "plot " << gnuplot_quote(data_k) << " using 1:2 with lines lw 2 title 'demcal kernel', "
+      << gnuplot_quote(data_y) << " using 1:2 with lines lw 2 dt 2 title 'YADE 2023.02a'";
+    if (!own.empty())
+        s << ", " << gnuplot_quote(data_own) << " using 1:2 with lines lw 2 dt 3 title 'YADE, its own filling'";
+    s << "\n";
+    render_gnuplot(dir / ("mass_time." + format), s.str());
+}
+
+// ---- one angle's runs ----
+
+// YADE's flow pattern: its frames through the kernel's classifier with the kernel's sampling (from the bed).
+json yade_flow_pattern(const fs::path& dir, const json& bed, const json& yade_result) {  // dir: the YADE run's
+    try {
+        const FlowPatternSampling sampling =
+            flow_pattern_sampling_from_json(bed.at("flow_pattern_sampling"), "bed of " + dir.string());
+        const json& geometry = bed.at("geometry");
+        const auto silo = kernel::silo::SiloGeometry::conical(
+            geometry.at("theta_deg").get<double>(), geometry.at("outlet_m").get<double>(),
+            geometry.at("D_m").get<double>(), geometry.at("body_height_m").get<double>());
+        return flow_pattern_json(flow_pattern_of_frames(dir / kYadeFramesFile, silo, sampling,
+                                                        yade_result.at("initial_mass_kg").get<double>(),
+                                                        yade_result.at("discharged_mass_kg").get<double>()));
+    } catch (const std::exception& e) {
+        return {{"pattern", "undetermined"}, {"wall_to_axis_velocity_ratio", 0.0}, {"message", e.what()}};
+    }
+}
+
+struct KernelSide {
+    json summary;  // demcal silo's summary.json
+    double rate = 0, filled = 0, cpu = 0;
+    Curve curve;
+};
+
+KernelSide read_kernel_side(const fs::path& angle_dir) {
+    KernelSide k;
+    k.summary = analytics::read_json_input(angle_dir / "kernel" / "summary.json", "kernel summary");
+    k.rate = k.summary.at("rate").at("rate_kg_s").get<double>();
+    k.filled = k.summary.at("filled_mass_kg").get<double>();
+    k.cpu = k.summary.at("cpu_s").get<double>();
+    k.curve = kernel_curve(angle_dir / "kernel" / "discharge.csv");
+    return k;
+}
+
+struct YadeSide {
+    json result;  // silo.py's result.json
+    double rate = 0, cpu = 0;
+    Curve curve;
+    json pattern;
+};
+
+YadeSide read_yade_side(const fs::path& angle_dir, const YadeRunKind& kind) {
+    YadeSide y;
+    y.result = analytics::read_json_input(angle_dir / kind.folder / "result.json",
+                                          kind.fills ? "yade own-fill result" : "yade result");
+    y.rate = y.result.at("rate").at("rate_kg_s").get<double>();
+    y.cpu = y.result.at("cpu_time_s").get<double>();
+    y.curve = yade_curve(y.result);
+    y.pattern = yade_flow_pattern(angle_dir / kind.folder,
+                                  analytics::read_json_input(angle_dir / kind.bed_file, kind.fills ? "cloud" : "bed"),
+                                  y.result);
+    return y;
+}
+
+// The kernel's and one YADE run's discharge of an angle, compared.
+struct Comparison {
+    double theta = 0;
+    double ratio = 0;  // YADE / kernel rate
+    double gap = 0;    // largest gap between the curves, fraction of the filled mass
+    bool agree = false;
+    bool patterns_determined = false;  // both codes determined a pattern (too few grains may leave one undetermined)
+    bool patterns_agree = false;
+};
+
+Comparison compare(double theta, const KernelSide& k, const YadeSide& y, double tolerance) {
+    Comparison c;
+    c.theta = theta;
+    c.ratio = y.rate / k.rate;
+    c.gap = largest_gap(k.curve, y.curve, k.filled);
+    c.agree = std::abs(c.ratio - 1) <= tolerance;
+    const json& pattern = k.summary.at("flow_pattern");
+    c.patterns_determined = pattern.value("pattern", "undetermined") != "undetermined" &&
+                            y.pattern.value("pattern", "undetermined") != "undetermined";
+    c.patterns_agree = c.patterns_determined && pattern.value("pattern", "") == y.pattern.value("pattern", "");
+    return c;
+}
+
+std::string pattern_cell(const json& pattern) {
+    return pattern.value("pattern", "?") + " (" + g(pattern.value("wall_to_axis_velocity_ratio", 0.0), 2) + ")";
+}
+
+std::string comparison_row(const Comparison& c, const KernelSide& k, const YadeSide& y) {
+    const bool marked = c.patterns_determined && !c.patterns_agree;
+    std::ostringstream md;
+    md << "| " << c.theta << " | " << g(k.rate * 1e3) << " ("
+       << g(k.summary["rate"].value("rate_batch_se_kg_s", 0.0) * 1e3, 2) << ") | " << g(y.rate * 1e3) << " ("
+       << g(y.result["rate"].value("rate_se_kg_s", 0.0) * 1e3, 2) << ") | " << g(c.ratio, 4) << " | "
+       << (c.agree ? "agree" : "**DIFFER**") << " | " << g(k.summary.at("discharge").at("time_s").get<double>(), 3)
+       << " | " << g(y.result.at("discharge_time_s").get<double>(), 3) << " | "
+       << pattern_cell(k.summary.at("flow_pattern")) << " | " << (marked ? "**" : "") << pattern_cell(y.pattern)
+       << (marked ? "**" : "") << " | " << g(100 * c.gap, 2) << " | " << g(k.cpu, 3) << " | " << g(y.cpu, 3)
+       << " | " << g(y.cpu / k.cpu, 3) << " |\n";
+    return md.str();
+}
+
+json comparison_json(const Comparison& c, const KernelSide& k, const YadeSide& y, const YadeRunKind& kind) {
+    return {{"theta_deg", c.theta},
+            {"kernel", {{"rate_kg_s", k.rate},
+                        {"rate_batch_se_kg_s", k.summary["rate"].value("rate_batch_se_kg_s", 0.0)},
+                        {"time_to_empty_s", k.summary.at("discharge").at("time_s")},
+                        {"flow_pattern", k.summary.at("flow_pattern")},
+                        {"cpu_s", k.cpu},
+                        {"wall_s", k.summary.at("wall_s")}}},
+            {"yade", {{"rate_kg_s", y.rate},
+                      {"rate_se_kg_s", y.result["rate"].value("rate_se_kg_s", 0.0)},
+                      {"time_to_empty_s", y.result.at("discharge_time_s")},
+                      {"stop_reason", y.result.at("stop_reason")},
+                      {"flow_pattern", y.pattern},
+                      {"cpu_s", y.cpu},
+                      {"wall_s", y.result.at("wall_time_s")},
+                      {"started_from", kind.label}}},
+            {"rate_ratio_yade_over_kernel", c.ratio},
+            {"rates_agree", c.agree},
+            {"patterns_agree", c.patterns_determined ? json(c.patterns_agree) : json(nullptr)},
+            {"yade_material_as_bed", y.result.value("material_as_bed", true)},
+            {"largest_curve_gap_of_filled_mass", c.gap},
+            {"cpu_ratio_yade_over_kernel", y.cpu / k.cpu}};
+}
+
+// --fill both: YADE's discharge of the bed it filled itself, beside the same-bed ratio. The filling's share of the
+// rate difference is what YADE's own bed adds to the ratio of the same bed.
+double filling_share(const KernelSide& k, const YadeSide& own, const Comparison& same_bed) {
+    return own.rate / k.rate - same_bed.ratio;
+}
+
+std::string own_fill_row(const Comparison& same_bed, const KernelSide& k, const YadeSide& own) {
+    const json& yf = own.result.at("fill");
+    const json& kf = k.summary.at("fill");
+    std::ostringstream md;
+    md << "| " << same_bed.theta << " | " << g(k.rate * 1e3) << " | " << g(own.rate * 1e3) << " | "
+       << g(own.rate / k.rate, 4) << " | " << g(same_bed.ratio, 4) << " | " << std::showpos
+       << g(100 * filling_share(k, own, same_bed), 2) << std::noshowpos << " | "
+       << g(kf.at("time_s").get<double>(), 3) << " / " << g(yf.at("time_s").get<double>(), 3) << " | "
+       << g(kf.at("height_m").get<double>() * 1e3, 4) << " / " << g(yf.at("bed_height_m").get<double>() * 1e3, 4)
+       << " | " << pattern_cell(own.pattern) << " | " << g(own.cpu, 3) << " |\n";
+    return md.str();
+}
+
+json own_fill_json(const Comparison& same_bed, const KernelSide& k, const YadeSide& own) {
+    return {{"rate_kg_s", own.rate},
+            {"rate_ratio_yade_over_kernel", own.rate / k.rate},
+            {"filling_share_of_rate_ratio", filling_share(k, own, same_bed)},
+            {"fill", own.result.at("fill")},
+            {"kernel_fill", k.summary.at("fill")},
+            {"time_to_empty_s", own.result.at("discharge_time_s")},
+            {"flow_pattern", own.pattern},
+            {"cpu_s", own.result.at("cpu_time_s")},
+            {"largest_curve_gap_of_filled_mass", largest_gap(k.curve, own.curve, k.filled)}};
+}
+
+// ---- the whole report ----
+
+constexpr const char* kComparisonHeader =
+    "| theta [deg] | kernel rate [g/s] (batch SE) | YADE rate [g/s] (slope SE) | YADE / kernel | rates | kernel empty "
+    "[s] | YADE empty [s] | kernel pattern (wall/axis) | YADE pattern (wall/axis) | largest curve gap [% of fill] | "
+    "kernel CPU [s] | YADE CPU [s] | YADE / kernel CPU |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+
+constexpr const char* kOwnFillSection =
+    "\n## Each code fills on its own\n\nYADE fills the silo itself from the kernel's generated cloud (the same "
+    "grains, positions and orientations before the first filling step; the kernel's rest rule), then discharges. The "
+    "filling's share of the difference is YADE's own-fill rate over the kernel's minus the same-bed ratio.\n\n| theta "
+    "[deg] | kernel rate [g/s] | YADE own fill [g/s] | YADE own fill / kernel | YADE same bed / kernel | filling's "
+    "share [% of the kernel's rate] | fill time kernel / YADE [s] | bed height kernel / YADE [mm] | YADE own fill "
+    "pattern (wall/axis) | YADE own fill CPU [s] |\n|---|---|---|---|---|---|---|---|---|---|\n";
+
+// What holds over all angles, for the closing lines.
+struct Verdict {
+    bool all_agree = true, all_patterns_agree = true, all_patterns_determined = true;
+    void add(const Comparison& c) {
+        all_agree = all_agree && c.agree;
+        all_patterns_agree = all_patterns_agree && (c.patterns_agree || !c.patterns_determined);
+        all_patterns_determined = all_patterns_determined && c.patterns_determined;
+    }
+};
+
+std::string closing_text(const ReportSettings& s, const Verdict& v) {
+    std::ostringstream md;
+    md << "\nRates agree when YADE / kernel lies within 1 +/- " << g(s.tolerance)
+       << (v.all_agree ? ": they do at every angle." : ": **they do not at every angle**.");
+    if (!s.yade_material.is_null())
+        md << " YADE ran a different material on purpose (--yade-material " << s.yade_material_file << ").";
+    md << " Flow patterns: YADE's frames (at the kernel's frame interval) classified by the kernel's own "
+          "classifier with the kernel's settings; "
+       << (!v.all_patterns_agree        ? "**not the same at every angle** (marked)."
+           : v.all_patterns_determined  ? "the same at every angle."
+                                        : "the same wherever both were determined (see each report's message for "
+                                          "the others).")
+       << "\n\nDifferences YADE cannot remove (yade_scripts/README.md):\n";
+    for (const char* d : kKnownDifferences) md << "- " << d << "\n";
+    return md.str();
+}
+
+}  // namespace
+
+Report write_report(const fs::path& root, const ReportSettings& s) {
+    json report = {{"thetas", s.thetas},
+                   {"particles", s.particles},
+                   {"stiffness_scale", s.stiffness_scale},
+                   {"seed", s.seed},
+                   {"angles", json::array()},
+                   {"known_differences", json::array()}};
+    for (const char* d : kKnownDifferences) report["known_differences"].push_back(d);
+    report["tolerance"] = s.tolerance;
+    if (!s.yade_material.is_null()) report["yade_material"] = s.yade_material;
+    const YadeRunKind& primary = s.yade_runs.front();
+    const bool own_fill_too = s.yade_runs.size() > 1;
+    Report out;
+    std::ostringstream md, own_fill_md;
+    md << kComparisonHeader;
+    Verdict verdict;
+    for (double theta : s.thetas) {
+        const fs::path d = root / theta_name(theta);
+        if (!fs::exists(d / "kernel" / "summary.json") || !fs::exists(d / primary.folder / "result.json")) {
+            md << "| " << theta << " | (a run failed: see " << d.string() << ") ||||||||||\n";
+            out.complete = false;
+            continue;
+        }
+        const KernelSide k = read_kernel_side(d);
+        const YadeSide y = read_yade_side(d, primary);
+        const Comparison c = compare(theta, k, y, s.tolerance);
+        verdict.add(c);
+        md << comparison_row(c, k, y);
+        report["angles"].push_back(comparison_json(c, k, y, primary));
+        Curve own_curve;
+        if (own_fill_too) {
+            const YadeRunKind& own_kind = s.yade_runs[1];
+            if (!fs::exists(d / own_kind.folder / "result.json")) {
+                own_fill_md << "| " << theta << " | (YADE's own filling failed: see " << (d / own_kind.folder).string()
+                            << ") ||||||||\n";
+                out.complete = false;
+            } else {
+                const YadeSide own = read_yade_side(d, own_kind);
+                own_fill_md << own_fill_row(c, k, own);
+                report["angles"].back()["yade_own_fill"] = own_fill_json(c, k, own);
+                own_curve = own.curve;
+            }
+        }
+        try {
+            write_curve_plot(d, theta, k.curve, y.curve, own_curve, s.plot_format);
+        } catch (const std::exception& e) {
+            std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
+        }
+    }
+    md << closing_text(s, verdict);
+    if (own_fill_too) md << kOwnFillSection << own_fill_md.str();
+    report["fill_mode"] = s.fill_text;
+    report["rates_agree"] = verdict.all_agree;
+    report["patterns_agree"] = verdict.all_patterns_agree;  // at every angle where both codes determined one
+    report["patterns_determined"] = verdict.all_patterns_determined;
+    orchestrator::write_text_file_atomically(root / "crosscheck_silo.json", report.dump(2) + "\n");
+    orchestrator::write_text_file_atomically(root / "crosscheck_silo.md", md.str());
+    out.markdown = md.str();
+    return out;
+}
+
+}  // namespace demcal::crosscheck_silo

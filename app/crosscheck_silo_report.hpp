@@ -1,0 +1,53 @@
+// The report of `demcal crosscheck silo`: the kernel's and YADE's runs of each angle, read from the campaign folder,
+// side by side (rates with their uncertainty, time to empty, flow patterns by the kernel's classifier, the largest gap
+// between the mass-time curves, CPU times), the filling's share with --fill both, and the differences YADE cannot
+// remove. Written as JSON, a Markdown table and one mass-time plot per angle.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace demcal::crosscheck_silo {
+
+// A YADE run of one angle: its folder, the bed file it starts from, and whether it fills first.
+struct YadeRunKind {
+    const char* folder;
+    const char* bed_file;
+    bool fills;
+    const char* label;
+};
+inline constexpr YadeRunKind kYadeSameBed{"yade", "bed.json", false, "YADE from the kernel's filled bed"};
+inline constexpr YadeRunKind kYadeOwnFill{"yade-own-fill", "cloud.json", true,
+                                          "YADE filling on its own from the kernel's generated cloud"};
+
+// yade_scripts/silo.py writes its flow-pattern frames here, in its run folder.
+inline constexpr const char* kYadeFramesFile = "frames.bin";
+
+// The folder of one angle's runs in the campaign: theta_<deg>.
+std::string theta_name(double theta);
+
+struct ReportSettings {
+    std::vector<double> thetas;
+    int particles = 0;
+    double stiffness_scale = 0;
+    long seed = 0;
+    double tolerance = 0;                // rates agree when YADE / kernel lies within 1 +/- this
+    nlohmann::json yade_material;        // null: YADE ran the bed's material
+    std::string yade_material_file;      // its file, for the report's note
+    std::string fill_text;               // same-bed | own | both
+    std::vector<YadeRunKind> yade_runs;  // the first is compared with the kernel; a second is YADE's own filling
+    std::string plot_format = "png";
+};
+
+struct Report {
+    std::string markdown;
+    bool complete = true;  // every angle's runs gave results
+};
+
+// Reads the runs of every angle under `root`, writes root/crosscheck_silo.{json,md} and root/<theta>/mass_time.<fmt>.
+Report write_report(const std::filesystem::path& root, const ReportSettings& settings);
+
+}  // namespace demcal::crosscheck_silo
