@@ -74,6 +74,7 @@ struct SiloCli {
     std::string resume;
     std::string export_bed;  // the filled bed at the opening, for yade_scripts/silo.py
     std::string export_cloud;  // the generated cloud before filling, for yade_scripts/silo.py to fill on its own
+    bool forget_contact_history = false;  // at the opening, as a bed imported into YADE starts
 };
 
 // Exit status of a run stopped at --wall-limit (EX_TEMPFAIL): not finished, resume it. A job script can loop on it.
@@ -349,6 +350,8 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.stop_fraction = o.stop_fraction;
     s.skin = o.skin;
     s.vibration = vibration_from(o, sub);
+    s.contacts_at_opening =
+        o.forget_contact_history ? ks::ContactsAtOpening::forget_history : ks::ContactsAtOpening::keep_history;
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
     try {
@@ -658,6 +661,9 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"stop_fraction", s.stop_fraction},
                      {"skin_m", s.skin},
                      {"removal_depth_m", s.removal_depth},
+                     {"contacts_at_opening", s.contacts_at_opening == ks::ContactsAtOpening::forget_history
+                                                 ? "forget_history"
+                                                 : "keep_history"},
                      // as a --material file gives it (silo_material.cpp), unscaled: demcal silo --material reads it back
                      {"material", silo_material_json(s.materials)},
                      {"contact_law", r.contact_law}};
@@ -760,6 +766,9 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--export-cloud", o.export_cloud,
                     "write the generated grains before the filling (the same format as --export-bed), for "
                     "yade_scripts/silo.py to fill the silo on its own from the same cloud");
+    sub->add_flag("--forget-contact-history", o.forget_contact_history,
+                  "at the opening every contact forgets its past (tangential springs at zero), as the bed does when "
+                  "YADE's silo.py imports it: measures that one difference of a cross-check");
     sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o.checkpoint_every,
                     "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "

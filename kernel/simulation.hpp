@@ -103,6 +103,10 @@ class BasicSimulation {
   int add_wall(const Wall& w);
   /// Enables/disables a wall (e.g. opens the outlet plate). A disabled wall exerts no force.
   void set_wall_enabled(int id, bool enabled);
+  /// Forgets every contact's memory, of sphere pairs and wall contacts alike (tangential springs, a JKR contact's
+  /// touched flag): each contact goes on as if it had just formed. A bed imported into another code starts so (YADE
+  /// creates its interactions afresh); demcal silo --forget-contact-history measures what that changes.
+  void forget_contact_history();
   /// YADE's non-viscous local damping (NewtonIntegrator(damping = d)), d in [0, 1); default 0 (none). For matching
   /// YADE's quasi-static tests; it is not a physical dissipation.
   void set_local_damping(double damping);

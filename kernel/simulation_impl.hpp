@@ -115,6 +115,14 @@ void BasicSimulation<Law>::set_wall_enabled(int id, bool enabled) {
 }
 
 template <class Law>
+void BasicSimulation<Law>::forget_contact_history() {
+  std::fill(nl_.hist.begin(), nl_.hist.end(), 0.0);
+  std::fill(wall_slot_s_.begin(), wall_slot_s_.end(), 0.0);
+  forces_valid_ = false;
+  rekick_on_refresh_ = false;  // (the state itself changed: the forces of the next step are those of fresh contacts)
+}
+
+template <class Law>
 void BasicSimulation<Law>::set_wall_velocity(int id, const Vec3& velocity) {
   Wall& w = walls_.at(id);
   if (w.motion) throw std::logic_error("set_wall_velocity: wall " + std::to_string(id) + " follows a motion law");

@@ -229,6 +229,10 @@ void validate(const SiloCaseSettings& s) {
     if (!(s.time_step_fraction > 0 && s.time_step_fraction <= 1))
         reject_setting("dt_fraction", s.time_step_fraction, "must lie in (0, 1] (of the Rayleigh time step)");
     validate(s.vibration);
+    if (s.contacts_at_opening != ContactsAtOpening::keep_history &&
+        s.contacts_at_opening != ContactsAtOpening::forget_history)
+        reject_setting("contacts_at_opening", static_cast<double>(s.contacts_at_opening),
+                       "must be keep_history (0) or forget_history (1)");
     if (s.vibration.vibrates()) {
         // a period resolved by fewer steps would alias: the walls jump rather than oscillate
         constexpr double kStepsPerPeriod = 20;
@@ -274,7 +278,8 @@ namespace {
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 5;
+constexpr int kCheckpointVersion = 6;
+constexpr int kCheckpointVersionWithoutHistoryChoice = 5;  // contacts_at_opening: keep_history
 constexpr int kCheckpointVersionWithoutCohesion = 4;
 
 // Every setting that shapes the run, named once: the checkpoint stores the settings through this list.
@@ -335,6 +340,8 @@ void for_each_setting(S& s, F&& f) {
     // since version 5 (read_settings leaves them at 0 in a version 4 checkpoint)
     f("surface_energy", s.materials.wheat_wheat.surface_energy);
     f("surface_energy", s.materials.wheat_steel.surface_energy);
+    // since version 6 (keep_history before)
+    f("contacts_at_opening", s.contacts_at_opening);
 }
 
 void write_settings(StateWriter& w, const SiloCaseSettings& s) {
@@ -348,6 +355,8 @@ SiloCaseSettings read_settings(StateReader& r, int version) {
     SiloCaseSettings s;
     for_each_setting(s, [&](const char* name, auto& v) {
         if (version <= kCheckpointVersionWithoutCohesion && std::string_view(name) == "surface_energy") return;
+        if (version <= kCheckpointVersionWithoutHistoryChoice && std::string_view(name) == "contacts_at_opening")
+            return;
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
         else r.value(v, name);
     });
@@ -644,6 +653,7 @@ private:
 
     void open() {
         if (s_.at_opening) s_.at_opening(bed_snapshot());
+        if (s_.contacts_at_opening == ContactsAtOpening::forget_history) sim_.forget_contact_history();
         sim_.set_wall_enabled(plate_, false);
         t_open_ = sim_.time();
         if (bin_motion_) bin_motion_->open_at(t_open_);
@@ -815,6 +825,8 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string current = prefix + std::to_string(kCheckpointVersion);
     if (tag == current) {
         version = kCheckpointVersion;
+    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutHistoryChoice)) {
+        version = kCheckpointVersionWithoutHistoryChoice;
     } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutCohesion)) {
         version = kCheckpointVersionWithoutCohesion;
     } else if (tag == prefix + "1" || tag == prefix + "2" || tag == prefix + "3") {

@@ -41,6 +41,11 @@ struct BedSnapshot {
     std::vector<BedGrain> grains;
 };
 
+// What the contacts keep of their past when the outlet opens. forget_history: every contact restarts as if just
+// formed (its tangential spring at zero), as a bed imported into a code without the kernel's contact history does
+// (YADE's silo.py creates its interactions afresh): the cross-check's switch for that one difference.
+enum class ContactsAtOpening : std::uint8_t { keep_history = 0, forget_history = 1 };
+
 struct SiloCaseSettings {
     SiloGeometry geometry;
     WheatMaterials materials;
@@ -66,6 +71,7 @@ struct SiloCaseSettings {
     // The whole bin (every wall: hopper, body, outlet plate) vibrates from vibration.start_after_opening after the
     // opening; still while it fills. Default: still.
     BinVibration vibration;
+    ContactsAtOpening contacts_at_opening = ContactsAtOpening::keep_history;
     // Verlet skin [m]; 0: automatic, 40 dt x 1 m/s within [0.2 mm, 1 mm] (grains leave the outlet at ~1 m/s: the list
     // then lasts tens of steps; measured on the reduced 70 deg case, dt = 66 us: 1 mm ran 1.7 times faster than the
     // kernel's default 0.1 r; at the seed's dt = 2.1 us a 0.2 mm skin keeps fewer pairs in the list).

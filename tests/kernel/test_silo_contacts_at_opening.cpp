@@ -1,0 +1,54 @@
+// The silo case's ContactsAtOpening switch (demcal silo --forget-contact-history): the contacts' memory is forgotten
+// at the opening and only then, as in a bed another code imports; the run resumes from checkpoints bit for bit, the
+// choice stored in them.
+#include "kernel/silo/silo_case.hpp"
+#include "silo_resume_check.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace demcal::kernel::silo;
+
+namespace {
+
+SiloCaseSettings tiny_case() {
+    SiloCaseSettings s;
+    s.geometry = SiloGeometry::conical(30, 0.03, 0.07, 0.15);
+    s.particles = 600;
+    s.materials.stiffness_scale = 1e-3;
+    s.fill_time_max = 0.3;
+    s.max_time = 0.2;
+    s.threads = 1;
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("silo case: forgetting the contact history at the opening leaves the filling and changes the discharge",
+          "[silo]") {
+    SiloCaseSettings s = tiny_case();
+    const SiloCaseResult kept = run_silo_case(s);
+    s.contacts_at_opening = ContactsAtOpening::forget_history;
+    const SiloCaseResult forgotten = run_silo_case(s);
+    // the same filled bed: the switch acts at the opening
+    CHECK(forgotten.fill_steps == kept.fill_steps);
+    CHECK(forgotten.fill_kinetic_energy == kept.fill_kinetic_energy);
+    CHECK(forgotten.filled_mass == kept.filled_mass);
+    // and then the grains move otherwise
+    CHECK_FALSE(demcal::test::same_discharge(forgotten, kept));
+    CHECK(forgotten.grains_discharged > 0);
+}
+
+TEST_CASE("silo case: a run forgetting its contact history at the opening resumes bit for bit",
+          "[silo][checkpoint]") {
+    SiloCaseSettings s = tiny_case();
+    s.contacts_at_opening = ContactsAtOpening::forget_history;
+    // killed while filling (before the opening: the resumed session must still forget), then after it
+    const SiloCaseSettings stored = demcal::test::check_resumes_bit_for_bit(s, "forget-history", 0.05);
+    CHECK(stored.contacts_at_opening == ContactsAtOpening::forget_history);
+}
+
+TEST_CASE("silo case: a contacts-at-opening value that is not a choice is refused by name", "[silo]") {
+    SiloCaseSettings s = tiny_case();
+    s.contacts_at_opening = static_cast<ContactsAtOpening>(7);
+    CHECK_THROWS_WITH(validate(s), Catch::Contains("contacts_at_opening") && Catch::Contains("7"));
+}
