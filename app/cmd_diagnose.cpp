@@ -281,7 +281,7 @@ struct DiagnoseArgs {
 
 // Options that only the silo-dem model takes, refused (named) with an analytical model.
 const char* const kSiloDemOptions[] = {"--material", "--campaign", "--jobs", "--seeds", "--first-seed", "--grid-points",
-                                       "--refine-steps", "--executor", "--partition", "--candidates"};
+                                       "--refine-steps", "--executor", "--partition", "--candidates", "--max-runs"};
 // Options of the analytical search that silo-dem does not use (one effect from its table, no regimes or outliers yet):
 // refused rather than ignored.
 const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column", "--effective-friction-deg",
@@ -416,6 +416,11 @@ void add_discharge_commands(CLI::App& app) {
     diagnose->add_option("--refine-steps", dem.refine_steps, "silo-dem: refinement proposals after the bracket")
         ->capture_default_str()
         ->check(integer_in(0, 20));
+    diagnose->add_option("--max-runs", dem.max_runs,
+                         "silo-dem: most kernel runs the search may take (conditions x seeds x (1 + candidates x "
+                         "(grid points + refine steps)), at most; a guard against typos), refused before any run")
+        ->capture_default_str()
+        ->check(integer_in(1, 1000000000));
     diagnose->add_option("--candidates", dem.candidates,
                          "silo-dem: the DEM effects to try, by name (default: all of rolling_friction, wall_friction, "
                          "restitution, cohesion; e.g. wall_friction,cohesion)")

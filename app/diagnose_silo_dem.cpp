@@ -7,6 +7,7 @@
 #include "app/gnuplot.hpp"
 #include "app/silo_campaign.hpp"
 #include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_campaign.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -305,6 +306,22 @@ std::string markdown(const SiloDemArgs& a, const an::SiloMeasurements& data, con
     return md.str();
 }
 
+// The most kernel runs the search can take: every condition and seed for the declared material, then for each
+// candidate that can be tried its bracket and refinement values (fewer when the campaign's cache holds some, or the
+// refinement stops early). Refused by name (--max-runs) before the campaign folder exists.
+void check_planned_runs(const SiloDemArgs& a, const an::SiloMeasurements& data, const json& declared,
+                        const std::vector<an::DemEffectCandidate>& candidates) {
+    std::size_t tried = 0;
+    for (const auto& spec : candidates) tried += declared_value(declared, spec).second.empty() ? 1 : 0;
+    const double per_material = static_cast<double>(data.conditions.size()) * a.seeds;
+    const double materials = 1.0 + static_cast<double>(tried) * (a.grid_points + a.refine_steps);
+    orchestrator::check_run_count(per_material * materials, a.max_runs,
+                                  "diagnose silo-dem: " + std::to_string(data.conditions.size()) + " conditions x " +
+                                      std::to_string(a.seeds) + " seeds x (1 declared + " + std::to_string(tried) +
+                                      " candidates x (" + std::to_string(a.grid_points) + " grid points + " +
+                                      std::to_string(a.refine_steps) + " refine steps)) materials");
+}
+
 }  // namespace
 
 std::string default_silo_dem_campaign(const std::string& data_path) {
@@ -340,6 +357,7 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
     const auto defects = an::candidate_table_defects(an::dem_effect_candidates());
     if (!defects.empty()) throw std::logic_error("the DEM candidate table: " + defects.front());
     const auto candidates = chosen_candidates(a.candidates);
+    check_planned_runs(a, data, declared, candidates);
     SiloDemCampaign campaign(a, data, declared);
     campaign.check_settings();  // silo's own checks of every condition and the material, nothing written
     const json settings{{"command", "diagnose --model silo-dem"}, {"silo_args", a.silo_args},

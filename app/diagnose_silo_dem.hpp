@@ -16,6 +16,7 @@ struct SiloDemArgs {
     int seeds = 1;            // prediction seeds per condition and material
     long long first_seed = 1;
     int grid_points = 5, refine_steps = 3;
+    long max_runs = 10000;    // most kernel runs the plan may hold (a guard against typos), refused before any run
     double alpha = 0.01, min_cv_gain = 0.05;
     bool no_plots = false;
     std::vector<std::string> silo_args;  // after --: options of every demcal silo run

@@ -163,7 +163,13 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
          "--candidates: no DEM effect 'moisture' (known: rolling_friction, wall_friction, restitution, cohesion)"},
         {"--model silo-dem" + data + campaign + material + " --candidates cohesion,cohesion -- " + kTinySilo,
          "--candidates: 'cohesion' named twice"},
+        // 3 conditions x 20 seeds x (1 + 4 candidates x (30 + 20)) = 12060 runs
+        {"--model silo-dem" + data + campaign + material + " --seeds 20 --grid-points 30 --refine-steps 20 -- " +
+             kTinySilo,
+         "diagnose silo-dem: 3 conditions x 20 seeds x (1 declared + 4 candidates x (30 grid points + 20 refine "
+         "steps)) materials = 12060 simulations, more than the limit --max-runs = 10000"},
         {"--model oldal" + data + material, "--material: only --model silo-dem"},
+        {"--model oldal" + data + " --max-runs 5", "--max-runs: only --model silo-dem"},
         {"--model silo-dem" + data + campaign + material + " --drop-outliers -- " + kTinySilo,
          "--drop-outliers: the analytical models take it"},
         {"--model oldal --data '" + std::string(DEMCAL_SOURCE_DIR) + "/examples/diagnose/oldal_clean.csv' --json '" +
