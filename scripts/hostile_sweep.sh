@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Hostile-input sweep of the commands added since the last hardening pass (issue 23): shear-run, shear --engine
-# kernel, crosscheck shear, crosscheck silo (--fill), scale, cutoff, vibration, silo --export-bed/--export-cloud and the
-# --vibration-* options.
+# kernel, crosscheck shear, crosscheck silo (--fill), scale, cutoff, vibration, silo --export-bed/--export-cloud,
+# --forget-contact-history and the --vibration-* options, diagnose silo-dem --max-runs.
 # Each case runs the real demcal under `timeout` in a scratch folder and checks:
 #   - the exit code (2 for bad input unless the case says otherwise), never a signal (>= 128) nor a timeout (124);
 #   - the message names the option or field (EXPECT) and is short (a huge value is shortened, stderr < 4 kB);
@@ -240,6 +240,8 @@ run_case silo/export-cloud-folder    2 "--export-cloud"  -- "${L[@]}" --export-c
 run_case silo/export-cloud-no-folder 2 "--export-cloud"  -- "${L[@]}" --export-cloud /no/such/c.json
 run_case silo/export-cloud-readonly  2 "--export-cloud" "$ro" -- "${L[@]}" --export-cloud "$ro/c.json"
 run_case silo/export-cloud-resume    2 "--export-cloud"  -- silo --resume somewhere --export-cloud c.json
+run_case silo/forget-history-value   2 "--forget-contact-history" -- "${L[@]}" --forget-contact-history=maybe
+run_case silo/forget-history-resume  2 "--forget-contact-history" -- silo --resume somewhere --forget-contact-history
 run_case silo/out-readonly           2 "out"     "$ro"   -- "${L[@]}" --out "$ro/o"
 run_case silo/out-file               2 "out"             -- "${L[@]}" --out "$tiny"
 run_case silo/vtk-readonly           2 "vtk"     "$ro"   -- "${L[@]}" --vtk "$ro/v"
@@ -262,6 +264,15 @@ run_case silo/vtk-every-tiny         2 "--vtk-every"     -- "${L[@]}" --vtk v --
 run_case silo/particles-huge         2 "particles"       -- "${L[@]}" --particles 99999999999999
 run_case silo/material-deep          2 "nest"            -- "${L[@]}" --material "$work/deep.json"
 run_case silo/geometry-folder        2 "folder.json"     -- "${L[@]}" --geometry "$work/folder.json"
+
+# ---- demcal diagnose --model silo-dem: the run-count guard -----------------------------------------------------------
+printf 'theta_deg,rate_g_s\n30,160\n30,162\n50,120\n70,100\n' > "$work/rates.csv"
+D=(diagnose --model silo-dem --data "$work/rates.csv" --material "$wheat" --campaign camp)
+run_case diagnose-dem/max-runs-0     2 "--max-runs"      -- "${D[@]}" --max-runs 0 -- --particles 200
+run_case diagnose-dem/max-runs-nan   2 "--max-runs"      -- "${D[@]}" --max-runs nan -- --particles 200
+run_case diagnose-dem/max-runs-huge  2 "--max-runs"      -- "${D[@]}" --max-runs "$huge" -- --particles 200
+run_case diagnose-dem/plan-too-big   2 "--max-runs = 100" -- "${D[@]}" --max-runs 100 --seeds 20 -- --particles 200
+run_case diagnose-dem/max-runs-oldal 2 "--max-runs"      -- diagnose --model oldal --data "$work/rates.csv" --max-runs 5
 
 echo
 echo "hostile sweep: $pass passed, $fail failed"
