@@ -8,32 +8,25 @@
 
 #include <cmath>
 
-#include "kernel/simulation.hpp"
+#include "incline_scene.hpp"
 
 using namespace demcal::kernel;
 
 namespace {
+
+constexpr double kFriction = 0.5;
 
 struct Stack {
   Simulation sim;
   double dt = 0;
 };
 
-// Settled stack on an incline 4 deg below the friction angle; body 0 below, body 1 on top of it.
+// Settled stack on the incline; body 0 below, body 1 on top of it.
 void settle(Stack& st, double alpha) {
   Simulation& sim = st.sim;
-  const double mu = 0.5;
-  const int a = sim.add_material({1e8, 0.3, 1000, ""});
-  const int w = sim.add_material({2e11, 0.3, 7800, ""});
-  sim.set_pair(a, a, {{0.5}, {mu}, {0.0}});
-  sim.set_pair(a, w, {{0.5}, {mu}, {0.0}});
-  sim.set_gravity(9.81 * Vec3(std::sin(alpha), 0, -std::cos(alpha)));
-  sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, w));
-  const double r = 1e-3, h = 2e-3;
-  const int tmpl = sim.add_clump_template(
-      make_clump_template({{-h, -h, 0}, {h, -h, 0}, {-h, h, 0}, {h, h, 0}}, {r, r, r, r}, 1000, 80));
-  sim.add_clump(tmpl, a, {0, 0, r}, Quat::Identity());
-  sim.add_clump(tmpl, a, {0, 0, 3 * r}, Quat::Identity());  // each upper sphere on a lower one
+  const auto scene = demcal::test::make_incline(sim, alpha, kFriction);
+  sim.add_clump(scene.block, scene.grain, {0, 0, scene.r}, Quat::Identity());
+  sim.add_clump(scene.block, scene.grain, {0, 0, 3 * scene.r}, Quat::Identity());  // each upper sphere on a lower one
   sim.set_timestep(0.2 * sim.rayleigh_timestep());
   st.dt = sim.timestep();
   sim.step(long(0.05 / st.dt));
@@ -50,7 +43,7 @@ std::pair<double, double> next_step_acceleration(Stack& st) {
 
 TEST_CASE("forgotten contact histories: a stack held by friction on an incline starts at g sin(alpha), then rests again",
           "[kernel][contact]") {
-  const double alpha = (std::atan(0.5) * 180 / M_PI - 4.0) * M_PI / 180, free_fall = 9.81 * std::sin(alpha);
+  const double alpha = std::atan(kFriction) - 4.0 * M_PI / 180, free_fall = 9.81 * std::sin(alpha);
   Stack kept, forgotten;
   settle(kept, alpha);
   settle(forgotten, alpha);

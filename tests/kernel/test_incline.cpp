@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "kernel/simulation.hpp"
+#include "incline_scene.hpp"
 
 using namespace demcal::kernel;
 
@@ -16,17 +16,8 @@ struct Slide {
 
 Slide run(double alpha_deg, double mu) {
   Simulation sim;
-  const int a = sim.add_material({1e8, 0.3, 1000, ""});
-  const int w = sim.add_material({2e11, 0.3, 7800, ""});
-  sim.set_pair(a, a, {{0.5}, {mu}, {0.0}});
-  sim.set_pair(a, w, {{0.5}, {mu}, {0.0}});
-  const double alpha = alpha_deg * M_PI / 180.0;
-  sim.set_gravity(9.81 * Vec3(std::sin(alpha), 0, -std::cos(alpha)));
-  sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, w));
-  const double r = 1e-3, h = 2e-3;
-  const int tmpl = sim.add_clump_template(
-      make_clump_template({{-h, -h, 0}, {h, -h, 0}, {-h, h, 0}, {h, h, 0}}, {r, r, r, r}, 1000, 80));
-  sim.add_clump(tmpl, a, {0, 0, r}, Quat::Identity());
+  const auto scene = demcal::test::make_incline(sim, alpha_deg * M_PI / 180.0, mu);
+  sim.add_clump(scene.block, scene.grain, {0, 0, scene.r}, Quat::Identity());
   sim.set_timestep(0.2 * sim.rayleigh_timestep());
   const long settle = long(0.05 / sim.timestep()), window = long(0.1 / sim.timestep());
   sim.step(settle);  // bounce and settle

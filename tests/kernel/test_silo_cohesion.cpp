@@ -9,6 +9,8 @@
 #include "kernel/silo/silo_case.hpp"
 #include "silo_resume_check.hpp"
 
+#include "tiny_silo.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -18,16 +20,11 @@ using namespace demcal::kernel::silo;
 namespace {
 
 SiloCaseSettings tiny_case(double surface_energy) {
-    SiloCaseSettings s;
-    s.geometry = SiloGeometry::conical(30, 0.03, 0.07, 0.15);
-    s.particles = 600;
-    s.materials.stiffness_scale = 1e-3;
+    SiloCaseSettings s = demcal::test::tiny_silo_case();
     s.materials.wheat_wheat.surface_energy = surface_energy;
     s.materials.wheat_steel.surface_energy = surface_energy;
-    s.fill_time_max = 0.3;
     s.max_time = 0.4;
     s.stop_fraction = 0.5;
-    s.threads = 1;
     return s;
 }
 

@@ -4,22 +4,15 @@
 #include "kernel/silo/silo_case.hpp"
 #include "silo_resume_check.hpp"
 
+#include "tiny_silo.hpp"
+
 #include <catch2/catch.hpp>
 
 using namespace demcal::kernel::silo;
 
 namespace {
 
-SiloCaseSettings tiny_case() {
-    SiloCaseSettings s;
-    s.geometry = SiloGeometry::conical(30, 0.03, 0.07, 0.15);
-    s.particles = 600;
-    s.materials.stiffness_scale = 1e-3;
-    s.fill_time_max = 0.3;
-    s.max_time = 0.2;
-    s.threads = 1;
-    return s;
-}
+SiloCaseSettings tiny_case() { return demcal::test::tiny_silo_case(); }
 
 }  // namespace
 
