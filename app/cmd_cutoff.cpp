@@ -94,6 +94,38 @@ kc::CutoffSearch search_from(const CutoffCli& o) {
     return search;
 }
 
+// One seed's own bracket in words: "arched up to 50 Hz, flows from 100 Hz".
+std::string seed_bracket_text(const kc::SeedBracket& b) {
+    const auto hz = [](double f) { return kernel::silo::setting_text(f) + " Hz"; };
+    std::string text = !b.flows_from    ? "arched at every frequency run (up to " + hz(b.arched_up_to.value_or(0)) + ")"
+                       : !b.arched_up_to ? "flowed at every frequency run (from " + hz(*b.flows_from) + ")"
+                                         : "arched up to " + hz(*b.arched_up_to) + ", flows from " + hz(*b.flows_from);
+    if (b.inconsistent) text += "; it also arched above a frequency at which it flowed";
+    return text;
+}
+
+// Each seed's own bracket, printed and added to the report; a note where the seeds' brackets do not meet the
+// majority's (the cut-off then differs from bed to bed by more than the tolerance).
+void report_seed_brackets(const kc::CutoffResult& res, nlohmann::json& out) {
+    const auto brackets = kc::seed_brackets(res.runs);
+    out["seeds"] = nlohmann::json::array();
+    bool all_overlap = true;
+    for (const auto& b : brackets) {
+        const bool overlap = !res.found || kc::overlaps(b, res.lo, res.hi);
+        all_overlap = all_overlap && overlap;
+        std::printf("  seed %u on its own: %s\n", b.seed, seed_bracket_text(b).c_str());
+        out["seeds"].push_back({{"seed", b.seed},
+                                {"arched_up_to_hz", b.arched_up_to ? nlohmann::json(*b.arched_up_to) : nullptr},
+                                {"flows_from_hz", b.flows_from ? nlohmann::json(*b.flows_from) : nullptr},
+                                {"inconsistent", b.inconsistent},
+                                {"overlaps_cutoff", overlap}});
+    }
+    out["seeds_agree"] = all_overlap;
+    if (!all_overlap)
+        std::printf("note: the seeds' own brackets do not all meet the cut-off's: it is the majority's (at least half "
+                    "of the seeds flowing), and the cut-off differs from bed to bed by more than the tolerance\n");
+}
+
 // The search's result, printed and added to the JSON report; the exit status.
 int conclude(const kc::CutoffResult& res, nlohmann::json out, const std::string& json_file) {
     if (res.found) {
@@ -104,6 +136,7 @@ int conclude(const kc::CutoffResult& res, nlohmann::json out, const std::string&
         out["reason"] = res.reason;
         std::printf("no cut-off found: %s\n", res.reason);
     }
+    if (res.runs.size() > 0) report_seed_brackets(res, out);
     if (!json_file.empty()) orchestrator::write_text_file_atomically(json_file, out.dump(1) + "\n");
     return res.found ? 0 : 1;
 }

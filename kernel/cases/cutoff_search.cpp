@@ -1,6 +1,8 @@
 #include "kernel/cases/cutoff_search.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -22,12 +24,16 @@ void validate(const CutoffSearch& s) {
 
 CutoffResult find_cutoff(const CutoffSearch& s, const std::function<bool(double, unsigned)>& flows) {
   validate(s);
+  CutoffResult r;
   auto flows_at = [&](double f) {
     std::size_t flowing = 0;
-    for (unsigned seed : s.seeds) flowing += flows(f, seed);
+    for (unsigned seed : s.seeds) {
+      const bool answer = flows(f, seed);
+      r.runs.push_back({f, seed, answer});
+      flowing += answer;
+    }
     return 2 * flowing >= s.seeds.size();
   };
-  CutoffResult r;
   double lo = s.lo, hi = s.hi;
   if (flows_at(lo)) { r.reason = "flows at the low end of the bracket"; return r; }
   if (!flows_at(hi)) { r.reason = "arched at the high end of the bracket"; return r; }
@@ -39,6 +45,31 @@ CutoffResult find_cutoff(const CutoffSearch& s, const std::function<bool(double,
   r.lo = lo;
   r.hi = hi;
   return r;
+}
+
+std::vector<SeedBracket> seed_brackets(const std::vector<CutoffRun>& runs) {
+  std::vector<SeedBracket> out;
+  for (const CutoffRun& run : runs) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const SeedBracket& b) { return b.seed == run.seed; });
+    if (it == out.end()) it = out.insert(out.end(), SeedBracket{run.seed, std::nullopt, std::nullopt, false});
+    if (run.flows && (!it->flows_from || run.frequency < *it->flows_from)) it->flows_from = run.frequency;
+  }
+  for (SeedBracket& b : out)
+    for (const CutoffRun& run : runs) {
+      if (run.seed != b.seed || run.flows) continue;
+      if (b.flows_from && run.frequency > *b.flows_from) {
+        b.inconsistent = true;
+        continue;
+      }
+      if (!b.arched_up_to || run.frequency > *b.arched_up_to) b.arched_up_to = run.frequency;
+    }
+  return out;
+}
+
+bool overlaps(const SeedBracket& b, double lo, double hi) {
+  const double own_lo = b.arched_up_to.value_or(-std::numeric_limits<double>::infinity());
+  const double own_hi = b.flows_from.value_or(std::numeric_limits<double>::infinity());
+  return own_lo < hi && own_hi > lo;
 }
 
 }  // namespace demcal::kernel::cases

@@ -3,6 +3,7 @@
 // the silo): it answers "does the bed flow at this frequency with this seed" by its own stated criterion.
 #pragma once
 #include <functional>
+#include <optional>
 #include <vector>
 
 namespace demcal::kernel::cases {
@@ -12,11 +13,35 @@ struct CutoffSearch {
   std::vector<unsigned> seeds{1};     ///< repeats: each frequency runs once per seed
 };
 
+/// One run of the search: a frequency, a seed and its answer.
+struct CutoffRun {
+  double frequency = 0;
+  unsigned seed = 0;
+  bool flows = false;
+};
+
+/// What the runs of one seed say on their own: the highest frequency at which it arched below the lowest at which it
+/// flowed (its own bracket), either missing when no run gave it. inconsistent: it arched at some frequency above one
+/// at which it flowed (the bed's answer is not monotone in the frequency there).
+struct SeedBracket {
+  unsigned seed = 0;
+  std::optional<double> arched_up_to, flows_from;
+  bool inconsistent = false;
+};
+
 struct CutoffResult {
   bool found = false;
   double lo = 0, hi = 0;    ///< the bracket: arched at lo, flows at hi [Hz]
   const char* reason = "";  ///< when not found: which end failed
+  std::vector<CutoffRun> runs;  ///< in the order run
 };
+
+/// Each seed's own bracket from the runs (in the order of first appearance). The search's bracket is the majority's:
+/// where the seeds' own brackets do not overlap it, the cut-off differs from bed to bed by more than the tolerance.
+std::vector<SeedBracket> seed_brackets(const std::vector<CutoffRun>& runs);
+
+/// True when the seed's own bracket overlaps [lo, hi] (a bound it did not reach counts as open).
+bool overlaps(const SeedBracket& b, double lo, double hi);
 
 /// Bisections that halve HI - LO down to the tolerance at most: below 2^-30 of the bracket the frequencies no longer
 /// differ in any digit a run could resolve, and near 2^-52 the midpoint equals an end and the search never ends.

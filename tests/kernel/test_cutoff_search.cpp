@@ -67,3 +67,36 @@ TEST_CASE("cut-off search: a bed that flows at the low end or holds at the high 
     s.hi = 100;
     CHECK_THROWS_AS(find_cutoff(s, [](double, unsigned) { return true; }), std::invalid_argument);
 }
+
+TEST_CASE("cut-off search: each seed's own bracket from the runs, and whether it meets the majority's",
+          "[kernel][cohesion][cutoff]") {
+    // seed 1 flows from 100 Hz, seed 2 from 300 Hz, seed 3 only at 400 Hz: the majority from 300 Hz
+    const std::map<unsigned, double> threshold{{1, 100}, {2, 300}, {3, 400}};
+    CutoffSearch s;
+    s.seeds = {1, 2, 3};
+    const CutoffResult r = find_cutoff(s, [&](double f, unsigned seed) { return f >= threshold.at(seed); });
+    REQUIRE(r.found);
+    CHECK(r.runs.size() == 3 * (2 + 4));  // every run recorded: both ends and four bisections, three seeds each
+    const auto brackets = seed_brackets(r.runs);
+    REQUIRE(brackets.size() == 3);
+    CHECK(brackets[0].seed == 1);
+    CHECK(*brackets[0].arched_up_to < 100);
+    CHECK(*brackets[0].flows_from >= 100);
+    CHECK_FALSE(overlaps(brackets[0], r.lo, r.hi));  // seed 1's cut-off lies well below the majority's
+    CHECK(overlaps(brackets[1], r.lo, r.hi));        // seed 2 decides the majority
+    CHECK(*brackets[2].arched_up_to >= r.hi);        // seed 3 arched at every frequency but the top
+    CHECK(*brackets[2].flows_from == 400);
+    for (const auto& b : brackets) CHECK_FALSE(b.inconsistent);
+
+    // a seed that arched above a frequency at which it flowed is marked; its own bracket ends below that
+    const auto odd = seed_brackets({{100, 7, false}, {200, 7, true}, {300, 7, false}, {400, 7, true}});
+    REQUIRE(odd.size() == 1);
+    CHECK(odd[0].inconsistent);
+    CHECK(*odd[0].arched_up_to == 100);
+    CHECK(*odd[0].flows_from == 200);
+    // never flowed: no upper end, which overlaps any bracket above what it ran
+    const auto never = seed_brackets({{0, 2, false}, {50, 2, false}});
+    CHECK_FALSE(never[0].flows_from);
+    CHECK(overlaps(never[0], 25, 60));
+    CHECK_FALSE(overlaps(never[0], 10, 40));
+}
