@@ -21,10 +21,7 @@
 #include "orchestrator/stored_jobs.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <deque>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
