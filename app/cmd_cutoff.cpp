@@ -3,7 +3,7 @@
 // with a cohesive material (kernel/silo/silo_case.hpp); measured cases in examples/cohesive_arch/README.md.
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
-#include "app/silo_campaign.hpp"  // refuse_owned_silo_options
+#include "app/silo_campaign.hpp"
 #include "app/silo_settings.hpp"
 #include "kernel/cases/cohesive_hopper.hpp"
 #include "analytics/number_text.hpp"
@@ -14,7 +14,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <iomanip>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -29,6 +32,7 @@ namespace demcal {
 namespace {
 
 namespace kc = kernel::cases;
+namespace fs = std::filesystem;
 
 struct CutoffCli {
     kc::CohesiveHopperCase base;
@@ -38,6 +42,11 @@ struct CutoffCli {
     std::string json;
     long max_runs = 10000;
     std::vector<std::string> silo_args;  // after --: the silo case (demcal silo's options) instead of the small hopper
+    // the silo search's runs: a campaign of demcal silo subprocesses (default folder: campaigns/cutoff-<hash of the
+    // settings>), the seeds of a frequency side by side
+    std::string campaign;
+    int jobs = 1;
+    std::string executor = "local", partition;
 };
 
 // The silo options a cut-off search sets for every run itself.
@@ -46,6 +55,8 @@ const std::vector<std::string> kOwnedSiloOptions{"--seed", "--vibration-frequenc
                                                  "--max-time"};
 // The small hopper's own options, which a silo search does not use (the silo options after -- say the case).
 constexpr const char* kHopperOptions[] = {"--bond-number", "--theta", "--grains"};
+// The silo search's own options (its campaign), which the small hopper (run in this process) does not use.
+constexpr const char* kSiloSearchOptions[] = {"--campaign", "--jobs", "--executor", "--partition"};
 
 // The stated criterion, as for the small hopper: the bed flows when half of its mass leaves within the window.
 constexpr double kFlowingFraction = 0.5;
@@ -156,6 +167,57 @@ kernel::silo::SiloCaseSettings silo_run_settings(kernel::silo::SiloCaseSettings 
     return s;
 }
 
+// The same run as demcal silo's options, for the campaign (silo_run_settings is what they parse to); named by its
+// frequency and seed, the rest being the campaign's settings.
+SiloRunPlan silo_run_plan(const CutoffCli& o, double frequency, unsigned seed) {
+    std::vector<std::string> a = o.silo_args;
+    if (std::find(a.begin(), a.end(), "--no-plots") == a.end()) a.push_back("--no-plots");  // a search reads numbers
+    a.insert(a.end(), {"--seed", std::to_string(seed), "--stop-fraction", silo_number(kFlowingFraction), "--max-time",
+                       silo_number(o.base.window)});
+    if (frequency > 0 && o.base.amplitude > 0)
+        a.insert(a.end(), {"--vibration-frequency", silo_number(frequency), "--vibration-amplitude",
+                           silo_number(o.base.amplitude)});
+    std::ostringstream name;
+    name << "f" << std::setprecision(12) << frequency << "_seed" << seed;
+    return {name.str(), a};
+}
+
+// What every run of a silo search shares: the campaign's identity. Searches that differ only by bracket, tolerance
+// or seeds share a campaign and reuse each other's runs.
+nlohmann::json silo_campaign_settings(const CutoffCli& o) {
+    return {{"command", "cutoff"},         {"silo_args", o.silo_args},     {"amplitude_m", o.base.amplitude},
+            {"direction", "x"},            {"window_s", o.base.window},    {"flowing_fraction", kFlowingFraction}};
+}
+
+struct SearchStopped {};  // a signal or a suspended run stopped the campaign: the same command continues it
+
+// One finished run of the campaign, read from its summary.json: the line printed and the JSON entry; whether it
+// flows. A run that failed ends the search (its log named).
+bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double frequency, unsigned seed, double gravity,
+                     double amplitude, nlohmann::json& runs) {
+    const auto summary = silo_run_summary(dir, plan.name);
+    if (!summary)
+        throw std::runtime_error("the silo run " + plan.name + " failed or left no summary: see " +
+                                 (dir / "runs" / plan.name / "silo.log").string());
+    const double filled = summary->at("filled_mass_kg").get<double>();
+    const auto& discharge = summary->at("discharge");
+    const double fraction = filled > 0 ? discharge.at("discharged_mass_kg").get<double>() / filled : 0;
+    const bool flows = fraction >= kFlowingFraction * (1 - 1e-12);
+    const double omega = 2 * M_PI * frequency;
+    const double peak_g = frequency > 0 ? amplitude * omega * omega / gravity : 0.0;
+    const std::string stop_reason = discharge.at("stop_reason").get<std::string>();
+    const double cpu = summary->at("cpu_s").get<double>();
+    std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% of %.1f g out in %.2f s -> %s  [%s; %.1f s CPU]\n",
+                frequency, peak_g, seed, 100 * fraction, 1e3 * filled, discharge.at("time_s").get<double>(),
+                flows ? "flows" : "arched", stop_reason.c_str(), cpu);
+    std::fflush(stdout);
+    runs.push_back({{"frequency_hz", frequency}, {"seed", seed}, {"run", plan.name}, {"peak_acceleration_g", peak_g},
+                    {"discharged_fraction", fraction}, {"filled_mass_kg", filled},
+                    {"bulk_density_kg_m3", summary->at("bulk_density_kg_m3")}, {"discharge_time_s", discharge.at("time_s")},
+                    {"stop_reason", stop_reason}, {"flows", flows}, {"cpu_s", cpu}, {"wall_s", summary->at("wall_s")}});
+    return flows;
+}
+
 int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     namespace ks = kernel::silo;
     for (const char* option : kHopperOptions)
@@ -173,33 +235,41 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
+    const nlohmann::json settings = silo_campaign_settings(o);
+    const fs::path dir = o.campaign.empty()
+                             ? fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(settings.dump()).substr(0, 12))
+                             : fs::path(o.campaign);
+    check_output_folder(dir.string(), "--campaign");
     if (!base.materials.cohesive())
         std::printf("note: the material has no cohesion (surface_energy_J_m2 = 0): a cohesionless bed rarely arches\n");
+    open_silo_campaign(dir, settings, "cutoff");
     const std::string amount = base.fill_mass > 0 ? ks::setting_text(base.fill_mass) + " kg of grain"
                                                    : std::to_string(base.particles) + " grains";
     std::printf("cut-off search in the silo: %s, %s, stiffness scale %g; %s; A = %g m along x; bracket "
-                "[%g, %g] Hz to %g Hz, %zu seed(s); flows = half the mass out within %g s of the opening\n",
+                "[%g, %g] Hz to %g Hz, %zu seed(s); flows = half the mass out within %g s of the opening; runs in %s\n",
                 base.geometry.describe().c_str(), amount.c_str(), base.materials.stiffness_scale,
                 ks::contact_law_name(base.materials).c_str(), o.base.amplitude, search.lo, search.hi, search.tol,
-                search.seeds.size(), o.base.window);
+                search.seeds.size(), o.base.window, dir.string().c_str());
     std::fflush(stdout);
     nlohmann::json runs = nlohmann::json::array();
-    const kc::CutoffResult res = kc::find_cutoff(search, [&](double f, unsigned seed) {
-        const ks::SiloCaseSettings s = silo_run_settings(base, f, seed, o.base.amplitude, o.base.window);
-        const ks::SiloCaseResult r = ks::run_silo_case(s);
-        const double fraction = r.filled_mass > 0 ? r.discharge.back().mass / r.filled_mass : 0;
-        const bool flows = fraction >= kFlowingFraction * (1 - 1e-12);
-        const double peak_g = s.vibration.peak_acceleration() / s.gravity;
-        std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% of %.1f g out in %.2f s -> %s  [%s; %.1f s CPU]\n",
-                    f, peak_g, seed, 100 * fraction, 1e3 * r.filled_mass, r.discharge_time,
-                    flows ? "flows" : "arched", r.stop_reason.c_str(), r.cpu_s);
-        std::fflush(stdout);
-        runs.push_back({{"frequency_hz", f}, {"seed", seed}, {"peak_acceleration_g", peak_g},
-                        {"discharged_fraction", fraction}, {"filled_mass_kg", r.filled_mass},
-                        {"bulk_density_kg_m3", r.bulk_density}, {"discharge_time_s", r.discharge_time},
-                        {"stop_reason", r.stop_reason}, {"flows", flows}, {"cpu_s", r.cpu_s}, {"wall_s", r.wall_s}});
-        return flows;
-    });
+    kc::CutoffResult res;
+    try {
+        res = kc::find_cutoff_batched(search, [&](double f, const std::vector<unsigned>& seeds) {
+            std::vector<SiloRunPlan> plans;
+            for (unsigned seed : seeds) plans.push_back(silo_run_plan(o, f, seed));
+            const SiloCampaignOutcome outcome =
+                run_silo_campaign(dir, plans, o.silo_args, o.jobs, "cutoff", {o.executor, o.partition});
+            if (outcome.stopped) throw SearchStopped{};
+            std::vector<bool> answers;
+            for (std::size_t k = 0; k < seeds.size(); ++k)
+                answers.push_back(read_search_run(dir, plans[k], f, seeds[k], base.gravity, o.base.amplitude, runs));
+            return answers;
+        });
+    } catch (const SearchStopped&) {
+        std::printf("stopped; the same command continues the search in %s (finished runs kept)\n",
+                    dir.string().c_str());
+        return kExitResumeLater;
+    }
     nlohmann::json out = {{"case", "silo"},
                           {"geometry", base.geometry.describe()},
                           {"silo_options", o.silo_args},
@@ -207,6 +277,7 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
                           {"amplitude_m", o.base.amplitude},
                           {"direction", "x"},
                           {"window_s", o.base.window},
+                          {"campaign", dir.string()},
                           {"criterion", "flows: at least half of the filled mass out within window_s of the opening, "
                                         "in at least half of the seeds"},
                           {"runs", runs}};
@@ -215,6 +286,10 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
 
 int run(const CutoffCli& o, CLI::App& sub) {
     if (!o.silo_args.empty()) return run_silo_search(o, sub);
+    for (const char* option : kSiloSearchOptions)
+        if (sub.count(option))
+            throw UserError(std::string(option) + " applies to the silo search (silo options after --); the small "
+                            "hopper runs in this process");
     if (!o.json.empty()) check_output_file(o.json, "--json");
     const kc::CutoffSearch search = search_from(o);
     nlohmann::json runs = nlohmann::json::array();
@@ -274,6 +349,17 @@ void add_cutoff_command(CLI::App& app) {
     sub->add_option("--max-runs", o->max_runs, "most runs the search may make (a guard against typos)")
         ->check(integer_in(1, 1000000000))
         ->capture_default_str();
+    sub->add_option("--campaign", o->campaign,
+                    "silo search: the folder of its runs (default campaigns/cutoff-<hash of the silo options, "
+                    "amplitude and window>); the same command continues a stopped search, and searches of the same "
+                    "settings (another bracket, tolerance or seeds) reuse each other's runs");
+    sub->add_option("--jobs,-j", o->jobs, "silo search: runs at once (the seeds of a frequency side by side)")
+        ->check(integer_in(1, 256))
+        ->capture_default_str();
+    sub->add_option("--executor", o->executor, "silo search: local (processes of this machine) or slurm (job arrays)")
+        ->check(CLI::IsMember({"local", "slurm"}))
+        ->capture_default_str();
+    sub->add_option("--partition", o->partition, "silo search: SLURM partition (--executor slurm)");
     sub->add_option("silo_args", o->silo_args,
                     "after --: search in the silo case instead, with these demcal silo options (a cohesive --material, "
                     "--theta, --geometry, --particles, --stiffness-scale, ...)");

@@ -612,6 +612,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                  {"steps", r.fill_steps},
                  {"wall_s", r.fill_wall_s}};
     j["discharge"] = {{"time_s", r.discharge_time},
+                      {"discharged_mass_kg", r.discharge.empty() ? 0.0 : r.discharge.back().mass},
                       {"grains_discharged", r.grains_discharged},
                       {"grains_left", r.grains_in_silo},
                       {"emptied", r.emptied},

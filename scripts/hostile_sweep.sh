@@ -214,6 +214,11 @@ run_case cutoff/silo-dt-fraction     2 "--dt-fraction"   -- cutoff -- --material
 run_case cutoff/silo-particles-nan   2 "--particles"     -- cutoff -- --material "$meal" --theta 30 --particles nan
 run_case cutoff/silo-stiffness-sub   2 "--stiffness-scale" -- cutoff -- --material "$meal" --theta 30 --stiffness-scale 1e-320
 run_case cutoff/silo-out             2 "--out"           -- cutoff -- --material "$meal" --theta 30 --out o
+run_case cutoff/campaign-readonly    2 "campaign" "$ro"  -- cutoff --campaign "$ro/c" -- --material "$meal" --theta 30
+run_case cutoff/campaign-file        2 "campaign"        -- cutoff --campaign "$tiny" -- --material "$meal" --theta 30
+run_case cutoff/jobs-0               2 "--jobs"          -- cutoff --jobs 0 -- --material "$meal" --theta 30
+run_case cutoff/jobs-hopper          2 "--jobs"          -- cutoff --bond-number 10 --jobs 2
+run_case cutoff/executor-unknown     2 "--executor"      -- cutoff --executor cloud -- --material "$meal" --theta 30
 
 # ---- demcal vibration -----------------------------------------------------------------------------------------------
 V=(vibration --campaign camp --theta 30 --frequency 0,50 --amplitude 1e-4)

@@ -23,14 +23,25 @@ void validate(const CutoffSearch& s) {
 }
 
 CutoffResult find_cutoff(const CutoffSearch& s, const std::function<bool(double, unsigned)>& flows) {
+  return find_cutoff_batched(s, [&](double f, const std::vector<unsigned>& seeds) {
+    std::vector<bool> answers;
+    for (unsigned seed : seeds) answers.push_back(flows(f, seed));
+    return answers;
+  });
+}
+
+CutoffResult find_cutoff_batched(const CutoffSearch& s, const FlowsAtFrequency& flows) {
   validate(s);
   CutoffResult r;
   auto flows_at = [&](double f) {
+    const std::vector<bool> answers = flows(f, s.seeds);
+    if (answers.size() != s.seeds.size())
+      throw std::logic_error("find_cutoff_batched: " + std::to_string(answers.size()) + " answers for " +
+                             std::to_string(s.seeds.size()) + " seeds");
     std::size_t flowing = 0;
-    for (unsigned seed : s.seeds) {
-      const bool answer = flows(f, seed);
-      r.runs.push_back({f, seed, answer});
-      flowing += answer;
+    for (std::size_t k = 0; k < answers.size(); ++k) {
+      r.runs.push_back({f, s.seeds[k], answers[k]});
+      flowing += answers[k];
     }
     return 2 * flowing >= s.seeds.size();
   };

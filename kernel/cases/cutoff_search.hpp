@@ -55,4 +55,9 @@ void validate(const CutoffSearch& s);
 /// `flows(frequency, seed)` runs the case once.
 CutoffResult find_cutoff(const CutoffSearch& s, const std::function<bool(double frequency, unsigned seed)>& flows);
 
+/// The same search with every seed of a frequency asked at once (`flows_at(frequency, seeds)` answers in the seeds'
+/// order), so that a caller can run them side by side.
+using FlowsAtFrequency = std::function<std::vector<bool>(double frequency, const std::vector<unsigned>& seeds)>;
+CutoffResult find_cutoff_batched(const CutoffSearch& s, const FlowsAtFrequency& flows_at);
+
 }  // namespace demcal::kernel::cases

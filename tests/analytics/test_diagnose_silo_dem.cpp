@@ -3,6 +3,7 @@
 // raised get wall_friction named with an interval holding the truth; rates made with the declared material get nothing.
 // Real kernel runs through the demcal binary (300 grains, short windows).
 #include "analytics/dem_diagnosis.hpp"
+#include "demcal_cli.hpp"
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -39,11 +40,7 @@ std::string refusal(const std::string& csv) {
     return "(accepted)";
 }
 
-int demcal_run(const std::string& args, const fs::path& log) {
-    const std::string cmd = std::string("'") + DEMCAL_BINARY + "' " + args + " > '" + log.string() + "' 2>&1";
-    const int status = std::system(cmd.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int demcal_run(const std::string& args, const fs::path& log) { return demcal::test::run_demcal_command(args, log); }
 
 // The tiny silo of the CI: 300 grains in the reduced 70 mm silo, 1000 times softer contacts, 0.2 s of discharge.
 const std::string kTinySilo = "--geometry '" + std::string(DEMCAL_SOURCE_DIR) +

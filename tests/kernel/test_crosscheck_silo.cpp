@@ -6,6 +6,7 @@
 // YADE's frames: on 600 grains in a 20 deg hopper both codes give mass flow. --fill both: YADE also fills the silo
 // itself from the kernel's generated cloud, to the kernel's rest rule, and discharges that bed.
 #include "slurm_for_test.hpp"
+#include "demcal_cli.hpp"
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -24,11 +25,7 @@ namespace fs = std::filesystem;
 using demcal::test::read_file;
 
 namespace {
-int run_demcal(const std::string& args, const fs::path& log) {
-    const std::string cmd = std::string("'") + DEMCAL_BINARY + "' " + args + " > '" + log.string() + "' 2>&1";
-    const int status = std::system(cmd.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int run_demcal(const std::string& args, const fs::path& log) { return demcal::test::run_demcal_command(args, log); }
 }  // namespace
 
 TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both", "[yade]") {

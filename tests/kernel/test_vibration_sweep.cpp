@@ -12,17 +12,14 @@
 #include <string>
 
 #include "slurm_for_test.hpp"
+#include "demcal_cli.hpp"
 #include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-int demcal_run(const std::string& args, const fs::path& log) {
-  const std::string cmd = std::string("'") + DEMCAL_BINARY + "' " + args + " > '" + log.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int demcal_run(const std::string& args, const fs::path& log) { return demcal::test::run_demcal_command(args, log); }
 
 const std::string kTiny = "--geometry '" + std::string(DEMCAL_SOURCE_DIR) +
                           "/examples/silo/reduced_conical_70deg.json' --particles 300 --stiffness-scale 0.001 "
