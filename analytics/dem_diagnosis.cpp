@@ -430,14 +430,38 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
         if (!c.stops_flow.empty()) {
             // the flowing side of the declared value: up to the last flowing value before the nearest stop
             double upper = c.spec.upper, lower = c.spec.lower;
-            for (double v : c.stops_flow) {
-                if (v > c.declared) upper = std::min(upper, v);
-                if (v < c.declared) lower = std::max(lower, v);
+            auto find_stops = [&] {
+                for (double v : c.stops_flow) {
+                    if (v > c.declared) upper = std::min(upper, v);
+                    if (v < c.declared) lower = std::max(lower, v);
+                }
+            };
+            auto beyond_a_stop = [&](double v) {
+                return (v >= upper && upper < c.spec.upper) || (v <= lower && lower > c.spec.lower);
+            };
+            find_stops();
+            // Fewer than 3 flowing values (a coarse grid whose first step past the declared value already stops the
+            // flow): the gaps between them and toward each stop are halved, a few rounds, before the candidate is
+            // given up (at 2000 grains the cohesion grid 0, 0.1, 0.2, 0.3 J/m^2 stopped from 0.2 and was not tried).
+            constexpr int kFillRounds = 3;
+            for (int round = 0; round < kFillRounds; ++round) {
+                std::vector<double> edges;  // the flowing values and the stops around them, ascending
+                if (lower > c.spec.lower) edges.push_back(lower);
+                for (const auto& [v, rates] : runs)
+                    if (!beyond_a_stop(v)) edges.push_back(v);
+                const std::size_t flowing = edges.size() - (lower > c.spec.lower ? 1 : 0);
+                if (flowing >= 3) break;
+                if (upper < c.spec.upper) edges.push_back(upper);
+                std::vector<double> halves;
+                for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
+                    const double a = edges[k], b = edges[k + 1];
+                    const bool geometric = c.spec.scale == ParameterScale::log && a > 0 && b > 0;
+                    halves.push_back(run_value(geometric ? std::sqrt(a * b) : 0.5 * (a + b)));
+                }
+                run(halves);
+                find_stops();
             }
-            for (auto it = runs.begin(); it != runs.end();)
-                it = (it->first >= upper && upper < c.spec.upper) || (it->first <= lower && lower > c.spec.lower)
-                         ? runs.erase(it)
-                         : std::next(it);
+            for (auto it = runs.begin(); it != runs.end();) it = beyond_a_stop(it->first) ? runs.erase(it) : std::next(it);
             if (runs.size() < 3) {
                 c.available = false;
                 c.unavailable = "the flow stops at " + number_text(upper < c.spec.upper ? upper : lower) +
