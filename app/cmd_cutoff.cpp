@@ -193,8 +193,10 @@ struct SearchStopped {};  // a signal or a suspended run stopped the campaign: t
 
 // One finished run of the campaign, read from its summary.json: the line printed and the JSON entry; whether it
 // flows. A run that failed ends the search (its log named).
-bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double frequency, unsigned seed, double gravity,
-                     double amplitude, nlohmann::json& runs) {
+// `run`: its settings (silo_run_settings), whose vibration gives the peak acceleration.
+bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double frequency,
+                     const kernel::silo::SiloCaseSettings& run, nlohmann::json& runs) {
+    const unsigned seed = static_cast<unsigned>(run.seed);
     const auto summary = silo_run_summary(dir, plan.name);
     if (!summary)
         throw std::runtime_error("the silo run " + plan.name + " failed or left no summary: see " +
@@ -203,8 +205,7 @@ bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double freque
     const auto& discharge = summary->at("discharge");
     const double fraction = filled > 0 ? discharge.at("discharged_mass_kg").get<double>() / filled : 0;
     const bool flows = fraction >= kFlowingFraction * (1 - 1e-12);
-    const double omega = 2 * M_PI * frequency;
-    const double peak_g = frequency > 0 ? amplitude * omega * omega / gravity : 0.0;
+    const double peak_g = run.vibration.peak_acceleration() / run.gravity;
     const std::string stop_reason = discharge.at("stop_reason").get<std::string>();
     const double cpu = summary->at("cpu_s").get<double>();
     std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% of %.1f g out in %.2f s -> %s  [%s; %.1f s CPU]\n",
@@ -262,7 +263,8 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
             if (outcome.stopped) throw SearchStopped{};
             std::vector<bool> answers;
             for (std::size_t k = 0; k < seeds.size(); ++k)
-                answers.push_back(read_search_run(dir, plans[k], f, seeds[k], base.gravity, o.base.amplitude, runs));
+                answers.push_back(read_search_run(
+                    dir, plans[k], f, silo_run_settings(base, f, seeds[k], o.base.amplitude, o.base.window), runs));
             return answers;
         });
     } catch (const SearchStopped&) {
