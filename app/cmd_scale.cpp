@@ -99,7 +99,11 @@ void write_outputs(const calibration::EnlargementStudy& study, const ScaleCli& o
 void print_summary(const calibration::EnlargementStudy& study, const ScaleCli& o) {
     std::cout << "\n" << study.markdown() << "\n"
               << study.evaluations << " failure lines, " << study.simulations_run << " simulations run now, "
-              << study.simulations_reused << " reused; CPU " << cpu_duration(study.cpu_s) << "\nresults: "
+              << study.simulations_reused << " reused; CPU " << cpu_duration(study.cpu_s) << "\n";
+    if (study.simulations_failed > 0)
+        std::cout << study.simulations_failed << " runs failed (left out of their lines); "
+                  << study.replacement_rounds << " rounds of fresh packings replaced them where a line could not be fitted\n";
+    std::cout << "results: "
               << output_of(o).string() << " (Markdown: .md; plots: _macro, _cost, _laws)" << std::endl;
     for (const auto& w : study.warnings) std::cerr << "demcal: warning: " << w << "\n";
 }

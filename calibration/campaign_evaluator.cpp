@@ -19,7 +19,19 @@ orchestrator::ShearCampaignSpec CampaignSettings::spec_for(const nlohmann::json&
 FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runner, CampaignSettings settings,
                                         orchestrator::ProgressCallback progress) {
     return [&runner, settings = std::move(settings), progress = std::move(progress)](const nlohmann::json& material) {
-        auto ev = evaluate_failure_line(runner, settings.spec_for(material), progress);
+        auto spec = settings.spec_for(material);
+        auto ev = evaluate_failure_line(runner, spec, progress);
+        const std::string label = spec.label;
+        for (int round = 1; round <= kMaxReplacementRounds && (!ev.peak || !ev.residual) &&
+                            ev.simulations_failed > 0 && !ev.outcome.interrupted &&
+                            ev.outcome.infrastructure_failure.empty();
+             ++round) {
+            spec.base_seed += spec.replicates;  // the next unused seeds
+            spec.label = label + (label.empty() ? "" : " ") + "replacement " + std::to_string(round);
+            const int rounds_before = ev.replacement_rounds;
+            ev = failure_lines_of(merged_outcome(ev.outcome, runner.run(spec, progress)));
+            ev.replacement_rounds = rounds_before + 1;
+        }
         if (ev.outcome.interrupted)
             throw std::runtime_error("interrupted; every finished run is stored: run the same command again to resume");
         if (!ev.outcome.infrastructure_failure.empty())

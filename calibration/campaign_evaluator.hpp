@@ -23,8 +23,16 @@ struct CampaignSettings {
     orchestrator::ShearCampaignSpec spec_for(const nlohmann::json& material) const;
 };
 
-// Evaluates materials through `runner` (which must outlive the evaluator). Throws std::runtime_error when the campaign
-// was interrupted (Ctrl-C: run the command again to resume) or when too few runs finished for a line.
+// Most rounds of replacement packings for one failure line (see campaign_evaluator).
+inline constexpr int kMaxReplacementRounds = 2;
+
+// Evaluates materials through `runner` (which must outlive the evaluator). A run that fails for a physical reason
+// (a packing the lid servo cannot hold, say) fails again whenever it is rerun, so a line left with too few runs to fit
+// would stop a study or a calibration for good, resumed or not: such a line gets up to kMaxReplacementRounds rounds of
+// fresh packings (the same stresses and replicate count, seeds after the ones already used), a campaign each, and is
+// fitted to every run that finished (FailureLineEvaluation::replacement_rounds says how many rounds it took). Which
+// rounds run follows from the stored runs alone, so a resumed study makes the same choice. Throws std::runtime_error
+// when the campaign was interrupted (Ctrl-C: run the command again to resume) or when the simulator cannot start.
 FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runner, CampaignSettings settings,
                                         orchestrator::ProgressCallback progress = {});
 

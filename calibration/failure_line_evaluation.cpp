@@ -27,6 +27,18 @@ FailureLineEvaluation failure_lines_of(const orchestrator::ShearCampaignOutcome&
     return ev;
 }
 
+orchestrator::ShearCampaignOutcome merged_outcome(orchestrator::ShearCampaignOutcome first,
+                                                  const orchestrator::ShearCampaignOutcome& more) {
+    first.runs.insert(first.runs.end(), more.runs.begin(), more.runs.end());
+    first.executed += more.executed;
+    first.reused += more.reused;
+    first.failed += more.failed;
+    first.cpu_s += more.cpu_s;
+    first.interrupted = first.interrupted || more.interrupted;
+    if (first.infrastructure_failure.empty()) first.infrastructure_failure = more.infrastructure_failure;
+    return first;
+}
+
 FailureLineEvaluation evaluate_failure_line(orchestrator::ShearCampaignRunner& runner,
                                             const orchestrator::ShearCampaignSpec& spec,
                                             const orchestrator::ProgressCallback& progress) {

@@ -15,8 +15,13 @@ struct FailureLineEvaluation {
     int simulations_reused = 0;                      // found in the store
     int simulations_failed = 0;
     double cpu_s = 0;                                // CPU seconds of the runs behind the fit
-    orchestrator::ShearCampaignOutcome outcome;
+    int replacement_rounds = 0;                      // rounds of fresh packings added after failed runs
+    orchestrator::ShearCampaignOutcome outcome;      // (with replacement rounds: every round's runs, in order)
 };
+
+// The runs of `more` after those of `first`, the counts summed: one line's packings over several campaigns.
+orchestrator::ShearCampaignOutcome merged_outcome(orchestrator::ShearCampaignOutcome first,
+                                                  const orchestrator::ShearCampaignOutcome& more);
 
 // Fits both failure lines to the finished runs of a campaign outcome (failed runs are left out, and counted).
 FailureLineEvaluation failure_lines_of(const orchestrator::ShearCampaignOutcome& outcome);

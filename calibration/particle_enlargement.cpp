@@ -87,7 +87,11 @@ public:
         ++study_.evaluations;
         study_.simulations_run += ev.simulations_run;
         study_.simulations_reused += ev.simulations_reused;
-        if (counted_.insert(material.dump()).second) study_.cpu_s += ev.cpu_s;
+        if (counted_.insert(material.dump()).second) {
+            study_.cpu_s += ev.cpu_s;
+            study_.simulations_failed += ev.simulations_failed;
+            study_.replacement_rounds += ev.replacement_rounds;
+        }
         return ev;
     }
     FailureLineEvaluator as_function() {
@@ -518,6 +522,8 @@ nlohmann::json EnlargementStudy::to_json() const {
             {"evaluations", evaluations},
             {"simulations_run", simulations_run},
             {"simulations_reused", simulations_reused},
+            {"simulations_failed", simulations_failed},
+            {"replacement_rounds", replacement_rounds},
             {"cpu_s", cpu_s}};
 }
 

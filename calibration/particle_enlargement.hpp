@@ -119,6 +119,7 @@ struct EnlargementStudy {
     std::vector<std::string> problems;                    // fits not converged or not determined, with the reason
     std::vector<std::string> warnings;                    // box ratios below the bounds
     int evaluations = 0, simulations_run = 0, simulations_reused = 0;
+    int simulations_failed = 0, replacement_rounds = 0;   // over the distinct failure lines (campaign_evaluator)
     double cpu_s = 0;
     nlohmann::json to_json() const;
     std::string markdown() const;  // the per-radius data and the constants as Markdown tables

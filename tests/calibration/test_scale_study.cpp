@@ -1,8 +1,9 @@
-// `demcal scale` end to end over real YADE runs: the reduced study of examples/materials/sand-scale-tiny.json
-// (radii 3.5, 4 and 4.5 mm, three normal stresses, one packing, E and nu studied at 3 levels, 2 evaluations per
-// calibration aiming at the reference's values within 5 % (--point-targets --strict: the tiny box's own interval
-// would accept any start and skip the study and the search): about 50 runs of about 3 s CPU), then the same command
-// again, which must compute nothing.
+// `demcal scale` end to end, on each engine: the reduced study of examples/materials/sand-scale-tiny.json (radii
+// 3.5, 4 and 4.5 mm, three normal stresses, one packing, E and nu studied at 3 levels, 2 evaluations per calibration
+// aiming at the reference's values within 5 % (--point-targets --strict: the tiny box's own interval would accept any
+// start and skip the study and the search): about 50 runs of about 3 s CPU on YADE, 0.2-0.4 s on the kernel engine),
+// then the same command again, which must compute nothing. With one packing per stress, a failed run leaves a line
+// unfit: the study goes on with fresh packings (test_replacement_packings.cpp) instead of stopping.
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -18,23 +19,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-int run_scale(const fs::path& dir, const std::string& log) {
+int run_scale(const fs::path& dir, const std::string& log, const std::string& engine) {
     const std::string cmd = std::string(DEMCAL_BINARY) + " scale " + DEMCAL_SOURCE_DIR +
                             "/examples/materials/sand-scale-tiny.json --radii 3.5e-3,4e-3,4.5e-3"
                             " --normal-stress 4e3,6e3,8e3 --levels 3 --span 0.3 --max-evaluations 2 --point-targets --strict"
-                            " --jobs 2 --dir " +
+                            " --jobs 2 --engine " + engine + " --dir " +
                             dir.string() + " > " + (dir / log).string() + " 2>&1";
     return WEXITSTATUS(std::system(cmd.c_str()));
 }
 
-}  // namespace
-
-TEST_CASE("a reduced scale study on real YADE runs writes every per-radius number and resumes computing nothing",
-          "[yade]") {
-    const fs::path dir = fs::temp_directory_path() / ("demcal-test-scale-yade-" + std::to_string(getpid()));
+void check_reduced_study(const std::string& engine) {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-scale-" + engine + "-" + std::to_string(getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
-    const int rc = run_scale(dir, "first.log");
+    const int rc = run_scale(dir, "first.log", engine);
     INFO(demcal::test::read_file(dir / "first.log"));
     // 0: every fit determined; 1: some fit not (reported); never 2 (bad input) or a crash
     REQUIRE((rc == 0 || rc == 1));
@@ -45,7 +43,7 @@ TEST_CASE("a reduced scale study on real YADE runs writes every per-radius numbe
     REQUIRE(radii.size() == 3);
     for (std::size_t i = 0; i < radii.size(); ++i) {
         const auto& cost = radii[i].at("cost");
-        CHECK(cost.at("runs").get<int>() == 3);
+        CHECK(cost.at("runs").get<int>() >= 3);  // more where a failed packing was replaced
         CHECK(cost.at("cpu_s_per_run").get<double>() > 0);
         CHECK(cost.at("steps").get<double>() > 0);
         CHECK(std::isfinite(radii[i].at("base_line").at("mu_b").get<double>()));
@@ -56,14 +54,15 @@ TEST_CASE("a reduced scale study on real YADE runs writes every per-radius numbe
                                 radii[i - 1].at("cost").at("timestep_s").get<double>();
         const double r_ratio = radii[i].at("radius").get<double>() / radii[i - 1].at("radius").get<double>();
         CHECK(dt_ratio == Approx(r_ratio).epsilon(0.1));
-        // every radius above the reference was calibrated: accepted at its start, or searched after its own study of
-        // E and nu
+        // every radius above the reference was calibrated: accepted at its start (no study), or searched after its
+        // own study of E and nu (the search may stall at its start)
         REQUIRE(radii[i].contains("calibration"));
         const auto& calibration = radii[i].at("calibration");
-        if (calibration.at("evaluations").get<int>() > 1)
-            CHECK(calibration.at("study").at("parameters").size() == 2);
-        else
+        CHECK(calibration.at("evaluations").get<int>() >= 1);
+        if (calibration.at("study").is_null())
             CHECK(calibration.at("status") == "converged");
+        else
+            CHECK(calibration.at("study").at("parameters").size() == 2);
     }
     // 4.5 mm spheres in a 4 cm box: 4 particle lengths across, below ASTM D3080's 10
     CHECK_FALSE(radii[2].at("box_ratio").at("adequate").get<bool>());
@@ -74,9 +73,11 @@ TEST_CASE("a reduced scale study on real YADE runs writes every per-radius numbe
     CHECK(fs::exists(dir / "scale_cost.png"));
     const int run_first = j.at("simulations_run").get<int>();
     CHECK(run_first > 0);
+    CHECK(j.at("replacement_rounds").get<int>() <= 2 * j.at("evaluations").get<int>());
+    if (j.at("replacement_rounds").get<int>() > 0) CHECK(j.at("simulations_failed").get<int>() > 0);
 
     // The same command again: every failure line comes from the store.
-    const int rc_again = run_scale(dir, "second.log");
+    const int rc_again = run_scale(dir, "second.log", engine);
     INFO(demcal::test::read_file(dir / "second.log"));
     CHECK(rc_again == rc);
     const auto again = nlohmann::json::parse(demcal::test::read_file(dir / "scale.json"));
@@ -84,4 +85,15 @@ TEST_CASE("a reduced scale study on real YADE runs writes every per-radius numbe
     CHECK(again.at("evaluations") == j.at("evaluations"));
     CHECK(again.at("per_radius").at(1).at("base_line") == radii[1].at("base_line"));
     fs::remove_all(dir);
+}
+
+}  // namespace
+
+TEST_CASE("a reduced scale study on real YADE runs writes every per-radius number and resumes computing nothing",
+          "[yade]") {
+    check_reduced_study("yade");
+}
+
+TEST_CASE("a reduced scale study on the kernel engine writes every per-radius number and resumes computing nothing") {
+    check_reduced_study("kernel");
 }
