@@ -238,6 +238,15 @@ private:
 // Model of the targets' values over the active controls: the latest simulated point plus the study's response
 // changes of each control, plus a Broyden-updated linear correction for what the separable study model misses
 // (interactions, a different start than the study's base, the study's noise).
+// The response the surrogate steers by: the study's selected shape, or where that is "constant", the fitted line.
+// With three levels the F test of a slope has one residual degree of freedom and calls most real trends constant
+// (at 3 mm in examples/scale/ every response of E and nu but one); "constant" says the slope is not significant, not
+// that it is zero, and a step along its point estimate is checked by the next evaluation (and the Broyden update).
+const analytics::PolynomialFit& steering_fit(const analytics::ResponseShapeResult& r) {
+    if (r.shape == analytics::ResponseShape::constant && r.fits.size() > 1) return r.fits[1];
+    return r.selected();
+}
+
 class SurrogateModel {
 public:
     SurrogateModel(const Search& search, const SensitivityStudy& study, std::vector<std::size_t> active_controls,
@@ -284,7 +293,8 @@ public:
             for (std::size_t a = 0; a < active_controls_.size(); ++a) {
                 const std::size_t j = active_controls_[a];
                 const auto& r = responses_[a]->response(quantity);
-                v += r.value(search_.value_of(j, z[j])) - r.value(search_.value_of(j, anchor_z_[j]));
+                const auto& fit = steering_fit(r);
+                v += fit.value(search_.value_of(j, z[j]), r.x_ref) - fit.value(search_.value_of(j, anchor_z_[j]), r.x_ref);
                 v += correction_[t][a] * (z[j] - anchor_z_[j]);
             }
             y.push_back(v);

@@ -3,7 +3,8 @@
 // matches.
 //
 // Default search ("surrogate"): the sensitivity study's fitted responses (analytics/response_shape) are the model
-// of how each controlling parameter moves mu_b and tau_c. Anchored at the latest simulated point and corrected by a
+// of how each controlling parameter moves mu_b and tau_c (a response classified constant by its F test steers by its
+// fitted line: not significant is not zero). Anchored at the latest simulated point and corrected by a
 // Broyden (secant) update after each simulation, the model is searched over the parameters' bounds with NLopt
 // (GN_DIRECT_L over the whole box, then LN_BOBYQA / LN_COBYLA to polish); only the proposed point is simulated.
 // Why not NLopt directly on the simulations: BOBYQA needs 2n + 1 evaluations before its first model step (5 for two
