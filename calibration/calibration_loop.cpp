@@ -360,6 +360,56 @@ public:
         return z;
     }
 
+    // Where the model's local linearisation at the anchor meets every target, bounds ignored (one or two controls
+    // for as many targets), and the angle between the controls' effects in units of each target's acceptance (two
+    // controls; near 0: they move the targets alike, and their pair reaches only a narrow band of targets). Empty
+    // when the system is not square or is singular. For the message of an unreachable end: what the bounds hide.
+    struct UnboundedMatch {
+        std::vector<double> values;  // of the active controls
+        double effects_angle_deg = -1;
+    };
+    std::optional<UnboundedMatch> unbounded_match() const {
+        const std::size_t n = active_controls_.size();
+        if (n != active_targets_.size() || n == 0 || n > 2 || !has_anchor_) return std::nullopt;
+        constexpr double h = 0.01;  // in z: 1 % of a control's range
+        const auto y0 = predict(anchor_z_);
+        std::vector<std::vector<double>> J(n, std::vector<double>(n));  // [target][control], per unit z
+        for (std::size_t a = 0; a < n; ++a) {
+            auto z = anchor_z_;
+            z[active_controls_[a]] += h;
+            const auto y = predict(z);
+            for (std::size_t t = 0; t < n; ++t) J[t][a] = (y[t] - y0[t]) / h;
+        }
+        std::vector<double> miss(n), acceptance(n);
+        for (std::size_t t = 0; t < n; ++t) {
+            const auto& target = search_.targets()[active_targets_[t]];
+            miss[t] = target.value - y0[t];
+            acceptance[t] = target.acceptance(search_.options().tolerance);
+        }
+        std::vector<double> dz(n);
+        UnboundedMatch m;
+        if (n == 1) {
+            if (J[0][0] == 0) return std::nullopt;
+            dz[0] = miss[0] / J[0][0];
+        } else {
+            const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+            if (!(std::fabs(det) > 0)) return std::nullopt;
+            dz[0] = (miss[0] * J[1][1] - J[0][1] * miss[1]) / det;
+            dz[1] = (J[0][0] * miss[1] - miss[0] * J[1][0]) / det;
+            const double ax = J[0][0] / acceptance[0], ay = J[1][0] / acceptance[1];
+            const double bx = J[0][1] / acceptance[0], by = J[1][1] / acceptance[1];
+            const double cosine = (ax * bx + ay * by) / (std::hypot(ax, ay) * std::hypot(bx, by));
+            const double angle = std::acos(std::clamp(cosine, -1.0, 1.0)) * 180 / M_PI;
+            m.effects_angle_deg = std::min(angle, 180 - angle);  // a line's direction, either sense
+        }
+        for (std::size_t a = 0; a < n; ++a) {
+            const std::size_t j = active_controls_[a];
+            m.values.push_back(search_.value_of(j, anchor_z_[j] + dz[a]));
+        }
+        return m;
+    }
+    const std::vector<std::size_t>& active_controls() const { return active_controls_; }
+
 private:
     const Search& search_;
     std::vector<std::size_t> active_controls_, active_targets_;
@@ -426,7 +476,23 @@ bool target_within_noise_at(const Search& s, std::size_t k, const std::vector<st
 
 // Ends the search at `where`, a bound simulated already at evaluation k: unreachable, unless the target lies within
 // the noise of that line and its own (then the bound may have been reached by noise).
-void end_at_simulated_bound(Search& s, const std::string& where, std::size_t k, const std::vector<std::size_t>& targets) {
+// What the model says lies beyond the bounds of an unreachable end (SurrogateModel::unbounded_match), as text.
+std::string beyond_bounds(const Search& s, const SurrogateModel& model) {
+    const auto m = model.unbounded_match();
+    if (!m) return "";
+    std::string text = "; the study's model meets the targets at ";
+    for (std::size_t a = 0; a < m->values.size(); ++a)
+        text += (a ? ", " : "") + s.controls()[model.active_controls()[a]].name + " = " + num(m->values[a]);
+    if (m->effects_angle_deg >= 0) {
+        text += " (the two controls' effects are " + num(std::round(m->effects_angle_deg)) + " deg apart";
+        if (m->effects_angle_deg < 30) text += ": they move the targets nearly alike";
+        text += ")";
+    }
+    return text;
+}
+
+void end_at_simulated_bound(Search& s, const std::string& where, std::size_t k, const std::vector<std::size_t>& targets,
+                            const std::string& beyond = "") {
     auto& r = s.result();
     if (target_within_noise_at(s, k, targets)) {
         r.status = CalibrationStatus::not_converged;
@@ -437,8 +503,8 @@ void end_at_simulated_bound(Search& s, const std::string& where, std::size_t k, 
                     "); more packings per stress (--replicates) or a wider --tol";
     } else {
         r.status = CalibrationStatus::unreachable;
-        r.message = "target out of reach within the bounds: " + where + " (" + best_so_far(s, targets) +
-                    "); widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
+        r.message = "target out of reach within the bounds: " + where + " (" + best_so_far(s, targets) + ")" +
+                    beyond + "; widen it with --bounds NAME=LOW:HIGH or choose other controlling parameters";
     }
 }
 
@@ -555,7 +621,7 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
             const std::string where = bounds_at(s, proposal, controls);
             auto& r = s.result();
             if (!where.empty()) {
-                end_at_simulated_bound(s, where, repeated, targets);
+                end_at_simulated_bound(s, where, repeated, targets, beyond_bounds(s, model));
             } else {
                 r.status = CalibrationStatus::not_converged;
                 r.message = "the search stalled at an already simulated point (" + best_so_far(s, targets) +
@@ -566,7 +632,7 @@ bool surrogate_phase(Search& s, const SensitivityStudy& study, const std::vector
         // The model finds no point that meets the targets and wants a bound that has already been simulated, and no
         // two evaluations bracket the targets: the simulations confirmed the model there, so more cannot help.
         if (!pinned.empty()) {
-            end_at_simulated_bound(s, pinned, at_bound, targets);
+            end_at_simulated_bound(s, pinned, at_bound, targets, beyond_bounds(s, model));
             return false;
         }
         if (!s.budget_left()) {

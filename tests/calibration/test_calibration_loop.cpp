@@ -142,6 +142,17 @@ TEST_CASE("an unreachable target ends with the bound that stops it", "[calibrati
     CHECK(result.message.find("friction_coefficient at its upper bound 0.75") != std::string::npos);
     CHECK(result.message.find("best so far, evaluation #") != std::string::npos);
     CHECK(result.evaluations <= 4);
+    // beyond the bound, where the box's linear laws meet both targets: 0.5 f + 0.01 bs/kPa = 0.70 and
+    // 0.4 bs + 300 (f - 0.5) = 800 Pa give f = 1.373, bs = 1345 Pa (the anchor's line is noisy: within 10 %)
+    const std::string at = "meets the targets at friction_coefficient = ";
+    const auto pos = result.message.find(at);
+    REQUIRE(pos != std::string::npos);
+    CHECK(std::stod(result.message.substr(pos + at.size())) == Approx(1.373).epsilon(0.1));
+    const std::string bond = "bond_shear_strength = ";
+    const auto bond_pos = result.message.find(bond, pos);
+    REQUIRE(bond_pos != std::string::npos);
+    CHECK(std::stod(result.message.substr(bond_pos + bond.size())) == Approx(1345).epsilon(0.1));
+    CHECK(result.message.find("deg apart") != std::string::npos);
 }
 
 TEST_CASE("a calibration stopped half-way replays its finished evaluations from the store", "[calibration]") {
