@@ -235,9 +235,6 @@ private:
 
 // ---- surrogate search ----
 
-// Model of the targets' values over the active controls: the latest simulated point plus the study's response
-// changes of each control, plus a Broyden-updated linear correction for what the separable study model misses
-// (interactions, a different start than the study's base, the study's noise).
 // The response the surrogate steers by: the study's selected shape, or where that is "constant", the fitted line.
 // With three levels the F test of a slope has one residual degree of freedom and calls most real trends constant
 // (at 3 mm in examples/scale/ every response of E and nu but one); "constant" says the slope is not significant, not
@@ -247,6 +244,9 @@ const analytics::PolynomialFit& steering_fit(const analytics::ResponseShapeResul
     return r.selected();
 }
 
+// Model of the targets' values over the active controls: the latest simulated point plus the study's response
+// changes of each control, plus a Broyden-updated linear correction for what the separable study model misses
+// (interactions, a different start than the study's base, the study's noise).
 class SurrogateModel {
 public:
     SurrogateModel(const Search& search, const SensitivityStudy& study, std::vector<std::size_t> active_controls,
@@ -474,8 +474,6 @@ bool target_within_noise_at(const Search& s, std::size_t k, const std::vector<st
     return true;
 }
 
-// Ends the search at `where`, a bound simulated already at evaluation k: unreachable, unless the target lies within
-// the noise of that line and its own (then the bound may have been reached by noise).
 // What the model says lies beyond the bounds of an unreachable end (SurrogateModel::unbounded_match), as text.
 std::string beyond_bounds(const Search& s, const SurrogateModel& model) {
     const auto m = model.unbounded_match();
@@ -491,6 +489,8 @@ std::string beyond_bounds(const Search& s, const SurrogateModel& model) {
     return text;
 }
 
+// Ends the search at `where`, a bound simulated already at evaluation k: unreachable, unless the target lies within
+// the noise of that line and its own (then the bound may have been reached by noise).
 void end_at_simulated_bound(Search& s, const std::string& where, std::size_t k, const std::vector<std::size_t>& targets,
                             const std::string& beyond = "") {
     auto& r = s.result();
