@@ -28,9 +28,8 @@ FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runne
              ++round) {
             spec.base_seed += spec.replicates;  // the next unused seeds
             spec.label = label + (label.empty() ? "" : " ") + "replacement " + std::to_string(round);
-            const int rounds_before = ev.replacement_rounds;
             ev = failure_lines_of(merged_outcome(ev.outcome, runner.run(spec, progress)));
-            ev.replacement_rounds = rounds_before + 1;
+            ev.replacement_rounds = round;
         }
         if (ev.outcome.interrupted)
             throw std::runtime_error("interrupted; every finished run is stored: run the same command again to resume");
