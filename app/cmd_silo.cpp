@@ -65,6 +65,7 @@ struct SiloCli {
     double vibration_frequency = 0;
     double vibration_amplitude = 0;
     std::string vibration_direction = "x";
+    std::string vibration_part = "bin";
     double vibration_start = 0;
     bool no_plots = false;
     double checkpoint_every = 900;
@@ -262,8 +263,8 @@ void check_session_options(const SiloCli& o, CLI::App& sub) {
                         ": must be a number of seconds >= 0 (0: none)");
 }
 
-// --vibration-frequency and --vibration-amplitude go together; --vibration-direction and --vibration-start only with
-// them. The ranges are checked with the other settings (ks::validate).
+// --vibration-frequency and --vibration-amplitude go together; --vibration-direction, --vibration-part and
+// --vibration-start only with them. The ranges are checked with the other settings (ks::validate).
 ks::BinVibration vibration_from(const SiloCli& o, CLI::App& sub) {
     const bool frequency = sub.count("--vibration-frequency") > 0, amplitude = sub.count("--vibration-amplitude") > 0;
     if (frequency != amplitude)
@@ -272,7 +273,7 @@ ks::BinVibration vibration_from(const SiloCli& o, CLI::App& sub) {
                                   : "--vibration-amplitude " + ks::setting_text(o.vibration_amplitude) +
                                         " needs --vibration-frequency HZ");
     if (!frequency) {
-        for (const char* option : {"--vibration-direction", "--vibration-start"})
+        for (const char* option : {"--vibration-direction", "--vibration-part", "--vibration-start"})
             if (sub.count(option))
                 throw UserError(std::string(option) +
                                 " applies to a vibrating bin: add --vibration-frequency and --vibration-amplitude");
@@ -287,6 +288,11 @@ ks::BinVibration vibration_from(const SiloCli& o, CLI::App& sub) {
     else
         throw UserError("vibration-direction = '" + o.vibration_direction +
                         "': must be x (perpendicular to the silo axis) or z (along it)");
+    if (o.vibration_part == "bin") v.part = ks::VibratingPart::bin;
+    else if (o.vibration_part == "hopper") v.part = ks::VibratingPart::hopper;
+    else
+        throw UserError("vibration-part = '" + o.vibration_part.substr(0, 40) +
+                        "': must be bin (every wall) or hopper (the hopper and the outlet plate; the body still)");
     return v;
 }
 
@@ -297,7 +303,8 @@ std::string vibration_text(const ks::SiloCaseSettings& s) {
     return ks::setting_text(v.frequency) + " Hz, " + ks::setting_text(v.amplitude * 1e3) + " mm along " +
            ks::to_string(v.direction) +
            (v.direction == ks::VibrationDirection::x ? " (perpendicular to the axis)" : " (along the axis)") +
-           ", the whole bin from " + ks::setting_text(v.start_after_opening) +
+           (v.part == ks::VibratingPart::bin ? ", the whole bin from " : ", the hopper alone from ") +
+           ks::setting_text(v.start_after_opening) +
            " s after the opening (still while filling): peak acceleration " +
            ks::setting_text(v.peak_acceleration() / s.gravity) + " g";
 }
@@ -370,12 +377,14 @@ nlohmann::json vibration_json(const ks::SiloCaseSettings& s, const ks::SiloCaseR
             {"frequency_hz", v.frequency},
             {"amplitude_m", v.amplitude},
             {"direction", ks::to_string(v.direction)},
+            {"part", ks::to_string(v.part)},
             {"start_after_opening_s", v.start_after_opening},
             {"start_time_s", r.fill_time + v.start_after_opening},
             {"peak_acceleration_m_s2", v.peak_acceleration()},
             {"peak_acceleration_g", v.peak_acceleration() / s.gravity},
-            {"note", "displacement A sin(2 pi f (t - start_time_s)) of every wall of the bin (hopper, body, outlet "
-                     "plate), still while filling; x: horizontal, perpendicular to the silo axis (the seed's "
+            {"note", "displacement A sin(2 pi f (t - start_time_s)) of the walls of the part (bin: every wall, "
+                     "hopper, body and outlet plate; hopper: the hopper and the outlet plate, the body still), still "
+                     "while filling; x: horizontal, perpendicular to the silo axis (the seed's "
                      "vibrator), z: along the axis; peak acceleration A (2 pi f)^2, in g of the run's gravity"}};
 }
 
@@ -749,13 +758,17 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--skin", o.skin, "Verlet skin of the neighbour list [m] (0: 40 dt x 1 m/s within 0.2-1 mm)")
         ->capture_default_str();
     sub->add_option("--vibration-frequency", o.vibration_frequency,
-                    "the whole bin (hopper, body, outlet plate) vibrates at this frequency [Hz], 0-1000, from the "
-                    "opening (the seed's eccentric vibrator; needs --vibration-amplitude)");
+                    "the bin (--vibration-part) vibrates at this frequency [Hz], 0-1000, from the opening (the "
+                    "seed's eccentric vibrator; needs --vibration-amplitude)");
     sub->add_option("--vibration-amplitude", o.vibration_amplitude,
                     "displacement amplitude A of the bin's vibration [m], 0-0.01 (the seed: up to 1.1e-4); "
                     "d(t) = A sin(2 pi f t)");
     sub->add_option("--vibration-direction", o.vibration_direction,
                     "x: horizontal, perpendicular to the silo axis (as the seed's vibrator); z: along the axis")
+        ->capture_default_str();
+    sub->add_option("--vibration-part", o.vibration_part,
+                    "the walls that vibrate: bin (hopper, body and outlet plate as one rigid body) or hopper (the "
+                    "hopper and the outlet plate; the body still: the seed's vibrator sits on the cone)")
         ->capture_default_str();
     sub->add_option("--vibration-start", o.vibration_start,
                     "the vibration starts this many simulated seconds after the outlet opens; the bin is still "

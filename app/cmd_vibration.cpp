@@ -36,6 +36,7 @@ struct VibrationCli {
     std::vector<double> thetas, frequencies;
     double amplitude = 0;
     std::string direction = "x";
+    std::string part = "bin";
     int repeats = 3;
     long long first_seed = 1;
     std::string campaign;
@@ -57,21 +58,25 @@ struct RunSpec {
 
 // Options this command sets for every run itself.
 const std::vector<std::string> kOwnedSiloOptions = {"--theta", "--seed", "--out", "--resume", "--vibration-frequency",
-                                                    "--vibration-amplitude", "--vibration-direction", "--check"};
+                                                    "--vibration-amplitude", "--vibration-direction",
+                                                    "--vibration-part", "--check"};
 
 SiloRunPlan silo_plan(const VibrationCli& o, const RunSpec& r) {
     std::vector<std::string> a{"--theta", silo_number(r.theta), "--seed", std::to_string(r.seed)};
     if (r.frequency > 0)
         a.insert(a.end(), {"--vibration-frequency", silo_number(r.frequency), "--vibration-amplitude",
-                           silo_number(o.amplitude), "--vibration-direction", o.direction});
+                           silo_number(o.amplitude), "--vibration-direction", o.direction, "--vibration-part",
+                           o.part});
     a.insert(a.end(), o.silo_args.begin(), o.silo_args.end());
     return {r.name(), a};
 }
 
 json campaign_settings(const VibrationCli& o) {
-    return {{"thetas_deg", o.thetas},     {"frequencies_hz", o.frequencies}, {"amplitude_m", o.amplitude},
-            {"direction", o.direction},   {"repeats", o.repeats},           {"first_seed", o.first_seed},
-            {"silo_args", o.silo_args}};
+    json s = {{"thetas_deg", o.thetas},     {"frequencies_hz", o.frequencies}, {"amplitude_m", o.amplitude},
+              {"direction", o.direction},   {"repeats", o.repeats},           {"first_seed", o.first_seed},
+              {"silo_args", o.silo_args}};
+    if (o.part != "bin") s["part"] = o.part;  // absent for the whole bin: sweeps from before --part continue
+    return s;
 }
 
 void check_options(const VibrationCli& o) {
@@ -91,6 +96,8 @@ void check_options(const VibrationCli& o) {
     if (vibrating && !(o.amplitude > 0)) throw UserError("--amplitude: a frequency above 0 needs an amplitude > 0 m");
     if (o.direction != "x" && o.direction != "z")
         throw UserError("--direction = '" + o.direction.substr(0, 20) + "': x (perpendicular to the axis) or z");
+    if (o.part != "bin" && o.part != "hopper")
+        throw UserError("--part = '" + o.part.substr(0, 20) + "': bin (every wall) or hopper (the body still)");
 }
 
 struct Cell {
@@ -162,7 +169,8 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
     if (data_by_theta.empty()) return;
     std::ostringstream body;
     body << "set xlabel 'vibration frequency [Hz]'\nset ylabel 'discharge rate [g/s]'\nset key outside right\n"
-         << "set title 'amplitude " << o.amplitude * 1e3 << " mm, direction " << o.direction << "'\nplot ";
+         << "set title 'amplitude " << o.amplitude * 1e3 << " mm, direction " << o.direction << ", vibrating "
+         << o.part << "'\nplot ";
     bool first = true;
     for (const auto& [theta, data] : data_by_theta) {
         const fs::path file = dir / ("vibration_theta" + std::to_string(int(std::lround(theta))) + ".dat");
@@ -219,6 +227,9 @@ void add_vibration_command(CLI::App& app) {
     sub->add_option("--amplitude", o->amplitude, "vibration amplitude [m] (the seed: up to 1.1e-4)")
         ->check(number_in(0, 0.01));
     sub->add_option("--direction", o->direction, "x (perpendicular to the axis, the seed's) or z")->capture_default_str();
+    sub->add_option("--part", o->part, "the walls that vibrate: bin (every wall) or hopper (the hopper and the outlet "
+                                       "plate; the body still)")
+        ->capture_default_str();
     sub->add_option("--repeats", o->repeats, "runs per angle and frequency (seeds first-seed, first-seed + 1, ...)")
         ->check(integer_in(1, 100))
         ->capture_default_str();

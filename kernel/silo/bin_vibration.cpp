@@ -28,6 +28,8 @@ Vec3 axis_of(VibrationDirection d) { return d == VibrationDirection::z ? Vec3::U
 
 std::string to_string(VibrationDirection d) { return d == VibrationDirection::z ? "z" : "x"; }
 
+std::string to_string(VibratingPart p) { return p == VibratingPart::hopper ? "hopper" : "bin"; }
+
 double BinVibration::peak_acceleration() const {
     const double w = 2 * pi * frequency;
     return amplitude * w * w;
@@ -42,6 +44,8 @@ void validate(const BinVibration& v) {
     refuse_subnormal("vibration_start", v.start_after_opening);
     if (v.direction != VibrationDirection::x && v.direction != VibrationDirection::z)
         reject_setting("vibration_direction", double(v.direction), "must be x (0) or z (1)");
+    if (v.part != VibratingPart::bin && v.part != VibratingPart::hopper)
+        reject_setting("vibration_part", double(v.part), "must be bin (0) or hopper (1)");
 }
 
 BinVibrationMotion::BinVibrationMotion(const BinVibration& v) : v_(v) { validate(v_); }

@@ -148,34 +148,46 @@ typename Law::Params to_kernel(const PairCoefficients& p) {
     return k;
 }
 
-// The silo's walls, all moving on `bin_motion` (null: still); returns the outlet plate's wall id. The body wall
-// reaches up to `wall_top`.
+// The walls in the order silo_walls gives them; returns the outlet plate's wall id.
 template <class Sim>
 int add_silo_walls(Sim& sim, const SiloGeometry& g, int steel, double wall_top,
-                   const std::shared_ptr<const WallMotion>& bin_motion) {
-    const auto add = [&](const Wall& w) { return sim.add_wall(bin_motion ? w.moving(bin_motion) : w); };
+                   const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part) {
+    int plate = -1;
+    for (const Wall& w : silo_walls(g, steel, wall_top, bin_motion, part)) plate = sim.add_wall(w);
+    return plate;
+}
+
+}  // namespace
+
+std::vector<Wall> silo_walls(const SiloGeometry& g, int steel, double wall_top,
+                             const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part) {
+    std::vector<Wall> walls;
+    const auto hopper = [&](const Wall& w) { walls.push_back(bin_motion ? w.moving(bin_motion) : w); };
+    const auto body = [&](const Wall& w) {
+        walls.push_back(bin_motion && part == VibratingPart::bin ? w.moving(bin_motion) : w);
+    };
     const double hh = g.hopper_height(), th = g.half_angle_deg * pi / 180;
     if (g.shape == SiloShape::conical) {
         const double r0 = g.outlet_half(), R = g.top_half();
-        add(Wall::cone(0, 0, r0, 0, th, R, steel));
-        add(Wall::cylinder(0, 0, R, hh, wall_top, steel));
-        return add(Wall::disk(0, 0, r0 * 1.001, 0, steel));
+        hopper(Wall::cone(0, 0, r0, 0, th, R, steel));
+        body(Wall::cylinder(0, 0, R, hh, wall_top, steel));
+        hopper(Wall::disk(0, 0, r0 * 1.001, 0, steel));
+        return walls;
     }
     const double a2 = 0.5 * g.outlet, b2 = 0.5 * g.depth, c2 = 0.5 * g.width;
     for (double s : {-1.0, 1.0}) {
         // slanted hopper wall from the outlet edge (x = s a/2, z = 0) to the body (x = s c/2, z = hh), full depth
-        add(Wall::rectangle_from_corners(Vec3(s * a2, -b2, 0), Vec3(s * a2, b2, 0), Vec3(s * c2, -b2, hh), steel));
+        hopper(Wall::rectangle_from_corners(Vec3(s * a2, -b2, 0), Vec3(s * a2, b2, 0), Vec3(s * c2, -b2, hh), steel));
         // vertical body wall x = s c/2
-        add(Wall::rectangle_from_corners(Vec3(s * c2, -b2, hh), Vec3(s * c2, b2, hh), Vec3(s * c2, -b2, wall_top),
-                                         steel));
+        body(Wall::rectangle_from_corners(Vec3(s * c2, -b2, hh), Vec3(s * c2, b2, hh), Vec3(s * c2, -b2, wall_top),
+                                          steel));
         // front/back wall y = s b/2 over the whole height (the part outside the hopper is never reached)
-        add(Wall::rectangle_from_corners(Vec3(-c2, s * b2, 0), Vec3(c2, s * b2, 0), Vec3(-c2, s * b2, wall_top),
-                                         steel));
+        body(Wall::rectangle_from_corners(Vec3(-c2, s * b2, 0), Vec3(c2, s * b2, 0), Vec3(-c2, s * b2, wall_top),
+                                          steel));
     }
-    return add(Wall::rectangle(Vec3(0, 0, 0), Vec3::UnitZ(), Vec3::UnitX(), a2 * 1.001, b2, steel));
+    hopper(Wall::rectangle(Vec3(0, 0, 0), Vec3::UnitZ(), Vec3::UnitX(), a2 * 1.001, b2, steel));
+    return walls;
 }
-
-}  // namespace
 
 double smallest_sphere_rayleigh_step(const WheatMaterials& m) {
     double smallest_radius = 1;
@@ -278,7 +290,8 @@ namespace {
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 6;
+constexpr int kCheckpointVersion = 7;
+constexpr int kCheckpointVersionWithoutVibratingPart = 6;  // vibration_part: bin
 constexpr int kCheckpointVersionWithoutHistoryChoice = 5;  // contacts_at_opening: keep_history
 constexpr int kCheckpointVersionWithoutCohesion = 4;
 
@@ -342,6 +355,8 @@ void for_each_setting(S& s, F&& f) {
     f("surface_energy", s.materials.wheat_steel.surface_energy);
     // since version 6 (keep_history before)
     f("contacts_at_opening", s.contacts_at_opening);
+    // since version 7 (the whole bin before)
+    f("vibration_part", s.vibration.part);
 }
 
 void write_settings(StateWriter& w, const SiloCaseSettings& s) {
@@ -357,6 +372,7 @@ SiloCaseSettings read_settings(StateReader& r, int version) {
         if (version <= kCheckpointVersionWithoutCohesion && std::string_view(name) == "surface_energy") return;
         if (version <= kCheckpointVersionWithoutHistoryChoice && std::string_view(name) == "contacts_at_opening")
             return;
+        if (version <= kCheckpointVersionWithoutVibratingPart && std::string_view(name) == "vibration_part") return;
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
         else r.value(v, name);
     });
@@ -391,7 +407,7 @@ public:
         Generator gen(s_.geometry, tmpl_, s_.seed);
         const auto placed = gen.generate(n, 0.003, 30.0);
         wall_top_ = std::max(s_.geometry.top(), gen.top() + 0.01);
-        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_);
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_, s_.vibration.part);
         for (const auto& p : placed) sim_.add_clump(grain_, wheat_, p.com, p.q);
         r_.grains = long(placed.size());
         const double dt = s_.time_step > 0 ? s_.time_step : s_.time_step_fraction * sim_.rayleigh_timestep();
@@ -480,7 +496,7 @@ public:
         r.array(r_.discharge, "discharge record");
         if (phase_ != Phase::filling && phase_ != Phase::discharge) r.fail("phase", "unknown value");
         if (bin_motion_ && phase_ == Phase::discharge) bin_motion_->open_at(t_open_);  // the law the run was on
-        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_);
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_, s_.vibration.part);
         if (phase_ == Phase::discharge) {
             make_discharge_recorders();
             classifier_->load(r);
@@ -825,6 +841,8 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string current = prefix + std::to_string(kCheckpointVersion);
     if (tag == current) {
         version = kCheckpointVersion;
+    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutVibratingPart)) {
+        version = kCheckpointVersionWithoutVibratingPart;
     } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutHistoryChoice)) {
         version = kCheckpointVersionWithoutHistoryChoice;
     } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutCohesion)) {

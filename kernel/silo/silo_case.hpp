@@ -10,6 +10,7 @@
 #include "kernel/silo/silo_output.hpp"
 #include "kernel/silo/wheat.hpp"
 #include "kernel/clump.hpp"
+#include "kernel/walls.hpp"
 
 #include <functional>
 #include <memory>
@@ -68,8 +69,8 @@ struct SiloCaseSettings {
     double section_cell = 0.0025;    // [m]
     double section_half_thickness = 0.011;  // slab |y| < 2 d_p [m]
     FlowPatternSettings flow;
-    // The whole bin (every wall: hopper, body, outlet plate) vibrates from vibration.start_after_opening after the
-    // opening; still while it fills. Default: still.
+    // The bin (vibration.part: every wall, or the hopper and the outlet plate) vibrates from
+    // vibration.start_after_opening after the opening; still while it fills. Default: still.
     BinVibration vibration;
     ContactsAtOpening contacts_at_opening = ContactsAtOpening::keep_history;
     // Verlet skin [m]; 0: automatic, 40 dt x 1 m/s within [0.2 mm, 1 mm] (grains leave the outlet at ~1 m/s: the list
@@ -108,6 +109,11 @@ struct SiloCaseSettings {
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions, the vibration).
 void validate(const SiloCaseSettings& s);
+
+// The silo's walls of steel material `steel`, the outlet plate last; the body reaches up to `wall_top`. The walls of
+// the vibrating `part` move on `bin_motion` (null: every wall still).
+std::vector<Wall> silo_walls(const SiloGeometry& g, int steel, double wall_top,
+                             const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part);
 
 // The Rayleigh time step of the grain's smallest sphere at the materials' (scaled) stiffness [s], and the time step a
 // run of these settings plans from it (time_step, or time_step_fraction of it): what the checks of a run's settings

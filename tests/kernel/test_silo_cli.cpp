@@ -103,6 +103,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --vibration-start 0.1", "--vibration-start applies to a vibrating bin"},
                           Case{"--theta 30 --vibration-direction z",
                                "--vibration-direction applies to a vibrating bin"},
+                          Case{"--theta 30 --vibration-part hopper", "--vibration-part applies to a vibrating bin"},
                           Case{"--theta 30 --vibration-frequency 1500 --vibration-amplitude 1e-4",
                                "vibration_frequency = 1500"},
                           Case{"--theta 30 --vibration-frequency -5 --vibration-amplitude 1e-4",
@@ -117,6 +118,8 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                                "--vibration-amplitude: '1e-310' is subnormal"},
                           Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-4 --vibration-direction y",
                                "vibration-direction = 'y'"},
+                          Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-4 --vibration-part cone",
+                               "vibration-part = 'cone'"},
                           Case{"--theta 30 --vibration-frequency 100 --vibration-amplitude 1e-4 --vibration-start -1",
                                "vibration_start = -1"},
                           Case{"--theta 30 --vibration-frequency 1000 --vibration-amplitude 1e-4 "

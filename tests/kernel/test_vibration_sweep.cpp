@@ -72,6 +72,7 @@ TEST_CASE("demcal vibration: bad input exits 2 naming it before anything is writ
       {"--theta 95 --frequency 0" + campaign + " -- " + kTiny, "--theta"},
       {"--theta 45 --frequency 0,-5 --amplitude 1e-4" + campaign, "--frequency"},
       {"--theta 45 --frequency 100 --amplitude 1e-4 --direction y" + campaign, "--direction"},
+      {"--theta 45 --frequency 100 --amplitude 1e-4 --part body" + campaign, "--part = 'body'"},
       {"--theta 45 --frequency 100 --amplitude 1e-4 --repeats 0" + campaign, "--repeats"}};
   for (const auto& [args, expect] : cases) {
     INFO(args);
