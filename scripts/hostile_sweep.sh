@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Hostile-input sweep of the commands added since the last hardening pass (issue 23): shear-run, shear --engine
 # kernel, crosscheck shear, crosscheck silo (--fill), scale, cutoff, vibration, silo --export-bed/--export-cloud,
-# --forget-contact-history and the --vibration-* options, diagnose silo-dem --max-runs.
+# --forget-contact-history and the --vibration-* options (--vibration-part, --part), diagnose silo-dem --max-runs.
 # Each case runs the real demcal under `timeout` in a scratch folder and checks:
 #   - the exit code (2 for bad input unless the case says otherwise), never a signal (>= 128) nor a timeout (124);
 #   - the message names the option or field (EXPECT) and is short (a huge value is shortened, stderr < 4 kB);
@@ -225,6 +225,8 @@ V=(vibration --campaign camp --theta 30 --frequency 0,50 --amplitude 1e-4)
 run_case vibration/theta-nan         2 "theta"           -- vibration --campaign camp --theta nan --frequency 0 --amplitude 1e-4
 run_case vibration/frequency-subnormal 2 "frequency"     -- vibration --campaign camp --theta 30 --frequency 1e-320 --amplitude 1e-4
 run_case vibration/frequency-1e308   2 "frequency"       -- vibration --campaign camp --theta 30 --frequency 1e308 --amplitude 1e-4
+run_case vibration/part-bad          2 "--part"          -- vibration --campaign camp --theta 30 --frequency 50 --amplitude 1e-4 --part "$hugestr"
+run_case vibration/part-as-silo-arg  2 "--vibration-part" -- vibration --campaign camp --theta 30 --frequency 50 --amplitude 1e-4 -- --vibration-part hopper
 run_case vibration/amplitude-huge    2 "amplitude"       -- vibration --campaign camp --theta 30 --frequency 50 --amplitude "$huge"
 run_case vibration/repeats-huge      2 "repeats"         -- "${V[@]}" --repeats 2000000000
 run_case vibration/theta-list-huge   2 "--theta"         -- vibration --campaign camp --theta "$(seq -s, 5 0.01 85)" --frequency 0 --amplitude 1e-4
@@ -259,6 +261,8 @@ run_case silo/vib-frequency-negative 2 "vibration_frequency = -5" -- "${L[@]}" -
 run_case silo/vib-amplitude-huge     2 "vibration-amplitude" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude "$huge"
 run_case silo/vib-amplitude-alone    2 "vibration-amplitude" -- "${L[@]}" --vibration-amplitude 1e-4
 run_case silo/vib-direction-bad      2 "vibration-direction" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-direction "$hugestr"
+run_case silo/vib-part-bad           2 "vibration-part" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-part "$hugestr"
+run_case silo/vib-part-no-vib        2 "vibration-part" -- "${L[@]}" --vibration-part hopper
 run_case silo/vib-start-nan          2 "vibration-start" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-start nan
 run_case silo/vib-start-1e99         2 "vibration_start = 1e+99" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-start 1e99
 run_case silo/vib-start-no-vib       2 "vibration-start" -- "${L[@]}" --vibration-start 1
