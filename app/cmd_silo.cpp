@@ -388,6 +388,21 @@ nlohmann::json vibration_json(const ks::SiloCaseSettings& s, const ks::SiloCaseR
                      "vibrator), z: along the axis; peak acceleration A (2 pi f)^2, in g of the run's gravity"}};
 }
 
+// The outlet zone's density and speed over the steady window (kernel/silo/outlet_flow.hpp).
+nlohmann::json outlet_flow_json(const ks::OutletFlowResult& o) {
+    return {{"frames", o.frames},
+            {"zone_height_m", o.zone_height},
+            {"zone_volume_m3", o.zone_volume},
+            {"mean_grains", o.mean_grains},
+            {"solid_density_kg_m3", o.solid_density},
+            {"downward_speed_m_s", o.downward_speed},
+            {"flux_rate_kg_s", o.flux_rate},
+            {"note", "grains whose centre lies above the opening, below half the outlet size, over the rate's "
+                     "window: grain mass per zone volume, their mean downward velocity, and the product with the "
+                     "outlet area (a flux estimate, not the rate: compare it between runs of one geometry, where a "
+                     "change of the rate splits into the changes of density and speed)"}};
+}
+
 // Beverloo (with the Rose-Tanaka hopper factor) for the measured bulk density: the sanity check of the rate.
 nlohmann::json beverloo_check(const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
     const double dp = ks::wheat_equivalent_diameter();
@@ -648,6 +663,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     }
     j["rate"] = fit;
     j["flow_pattern"] = flow_pattern_json(r.flow);
+    j["outlet_flow"] = outlet_flow_json(r.outlet);
     j["vibration"] = vibration_json(s, r);
     if (r.bulk_density > 0) j["beverloo_check"] = beverloo_check(s, r);
     j["steps"] = r.steps;

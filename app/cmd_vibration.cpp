@@ -23,6 +23,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace demcal {
@@ -102,9 +103,25 @@ void check_options(const VibrationCli& o) {
 
 struct Cell {
     std::vector<double> rates;  // g/s
+    std::vector<double> outlet_densities, outlet_speeds;  // kg/m^3, m/s (runs of a demcal that measures them)
     std::map<std::string, int> patterns;
     int failed = 0;
 };
+
+// Mean and sample standard deviation (NaN where there are too few values).
+std::pair<double, double> mean_sd(const std::vector<double>& v) {
+    double mean = NAN, sd = NAN;
+    if (v.empty()) return {mean, sd};
+    mean = 0;
+    for (double x : v) mean += x;
+    mean /= double(v.size());
+    if (v.size() > 1) {
+        sd = 0;
+        for (double x : v) sd += (x - mean) * (x - mean);
+        sd = std::sqrt(sd / double(v.size() - 1));
+    }
+    return {mean, sd};
+}
 
 void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
     std::map<std::pair<double, double>, Cell> cells;
@@ -119,6 +136,12 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
             entry["flow_pattern"] = pattern;
             if (std::isfinite(rate)) c.rates.push_back(rate);
             ++c.patterns[pattern];
+            if (const auto outlet = s->find("outlet_flow"); outlet != s->end() && outlet->value("frames", 0) > 0) {
+                entry["outlet_solid_density_kg_m3"] = outlet->at("solid_density_kg_m3");
+                entry["outlet_downward_speed_m_s"] = outlet->at("downward_speed_m_s");
+                c.outlet_densities.push_back(outlet->at("solid_density_kg_m3").get<double>());
+                c.outlet_speeds.push_back(outlet->at("downward_speed_m_s").get<double>());
+            }
         } else if (silo_run_failed(dir, r.name())) {
             entry["failed"] = true;
             ++c.failed;
@@ -127,22 +150,14 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
     }
     json table = json::array();
     std::ostringstream md;
-    md << "| theta [deg] | f [Hz] | peak acceleration [g] | rate mean [g/s] | SD [g/s] | n | flow pattern |\n"
-       << "| --- | --- | --- | --- | --- | --- | --- |\n";
+    md << "| theta [deg] | f [Hz] | peak acceleration [g] | rate mean [g/s] | SD [g/s] | n | flow pattern | outlet "
+          "density [kg/m^3] | outlet speed [m/s] |\n"
+       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     std::map<double, std::string> data_by_theta;
     for (const auto& [key, c] : cells) {
         const auto [theta, f] = key;
-        double mean = NAN, sd = NAN;
-        if (!c.rates.empty()) {
-            mean = 0;
-            for (double x : c.rates) mean += x;
-            mean /= double(c.rates.size());
-            if (c.rates.size() > 1) {
-                sd = 0;
-                for (double x : c.rates) sd += (x - mean) * (x - mean);
-                sd = std::sqrt(sd / double(c.rates.size() - 1));
-            }
-        }
+        const auto [mean, sd] = mean_sd(c.rates);
+        const double outlet_density = mean_sd(c.outlet_densities).first, outlet_speed = mean_sd(c.outlet_speeds).first;
         std::string pattern = "-";
         int most = 0;
         for (const auto& [p, n] : c.patterns)
@@ -150,14 +165,16 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
         const double g = o.amplitude * std::pow(2 * M_PI * f, 2) / 9.81;
         table.push_back({{"theta_deg", theta}, {"frequency_hz", f}, {"peak_acceleration_g", g},
                          {"rate_mean_g_s", mean}, {"rate_sd_g_s", sd}, {"n", c.rates.size()}, {"failed", c.failed},
-                         {"flow_pattern", pattern}});
+                         {"flow_pattern", pattern}, {"outlet_solid_density_mean_kg_m3", outlet_density},
+                         {"outlet_downward_speed_mean_m_s", outlet_speed}});
         auto cell = [](double v, int digits) {
             std::ostringstream t;
             if (std::isfinite(v)) t << std::setprecision(digits) << v; else t << "-";
             return t.str();
         };
         md << "| " << theta << " | " << f << " | " << cell(g, 3) << " | " << cell(mean, 5) << " | " << cell(sd, 3)
-           << " | " << c.rates.size() << " | " << pattern << " |\n";
+           << " | " << c.rates.size() << " | " << pattern << " | " << cell(outlet_density, 4) << " | "
+           << cell(outlet_speed, 3) << " |\n";
         if (std::isfinite(mean))
             data_by_theta[theta] += std::to_string(f) + " " + std::to_string(mean) + " " +
                                     std::to_string(std::isfinite(sd) ? sd : 0.0) + "\n";

@@ -291,7 +291,7 @@ namespace {
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
 constexpr int kCheckpointVersion = 7;
-constexpr int kCheckpointVersionWithoutVibratingPart = 6;  // vibration_part: bin
+constexpr int kCheckpointVersionWithoutVibratingPart = 6;  // vibration_part: bin; no outlet-flow frames
 constexpr int kCheckpointVersionWithoutHistoryChoice = 5;  // contacts_at_opening: keep_history
 constexpr int kCheckpointVersionWithoutCohesion = 4;
 
@@ -459,6 +459,7 @@ public:
             if (open) {
                 classifier_->save(w);
                 r_.section->save(w);
+                outlet_->save(w);
             }
             w.checksum();
             sim_.save_state(os);
@@ -490,7 +491,6 @@ public:
         r.value(r_.filled_mass, "filled mass"); r.value(r_.fill_steps, "fill steps");
         r.value(r_.fill_wall_s, "fill wall time"); r.value(r_.sessions, "sessions");
         r.value(r_.checkpoints, "checkpoints"); r.value(r_.vtk_files, "vtk files");
-        (void)version;  // (one version is read: kCheckpointVersion)
         r.value(cpu_before_, "cpu time");
         r.value(r_.cpu_sessions, "cpu sessions");
         r.array(r_.discharge, "discharge record");
@@ -501,6 +501,8 @@ public:
             make_discharge_recorders();
             classifier_->load(r);
             r_.section->load(r);
+            // a version 6 run resumed in its discharge measures the outlet from here on (result(): its frames)
+            if (version > kCheckpointVersionWithoutVibratingPart) outlet_->load(r);
         }
         r.checksum();
         sim_.load_state(is, source);
@@ -663,6 +665,7 @@ private:
 
     void make_discharge_recorders() {
         classifier_ = std::make_unique<FlowPatternClassifier>(s_.geometry, s_.flow);
+        outlet_ = std::make_unique<OutletFlowMeter>(s_.geometry, tmpl_.mass);
         r_.section = std::make_shared<SectionField>(s_.geometry, s_.section_cell, s_.section_half_thickness,
                                                     r_.fill_height + 0.01);
     }
@@ -728,6 +731,7 @@ private:
                         vel.push_back(b.velocity);
                     }
                     classifier_->add_frame(pos, vel, mass_out_);
+                    outlet_->add_frame(pos, vel, mass_out_);
                     if (frac >= 0.3 && frac <= 0.5) r_.section->add_frame(pos, vel);
                 }
             }
@@ -783,6 +787,7 @@ private:
         for (const auto& d : r_.discharge) samples.push_back({d.time, d.mass});
         r_.fit = fit_discharge_rate(samples, mass_out_, s_.steady_lower, s_.steady_upper);
         r_.flow = classifier_->result(s_.steady_lower * mass_out_, s_.steady_upper * mass_out_);
+        r_.outlet = outlet_->result(s_.steady_lower * mass_out_, s_.steady_upper * mass_out_);
         record_state();
         report("done", r_.stop_reason);
     }
@@ -806,6 +811,7 @@ private:
     SiloCaseResult r_;
     SiloProgress pr_;
     std::unique_ptr<FlowPatternClassifier> classifier_;
+    std::unique_ptr<OutletFlowMeter> outlet_;
     const std::chrono::steady_clock::time_point t_start_ = std::chrono::steady_clock::now();
     double wall_before_ = 0;          // wall time of the earlier sessions of a resumed run
     const double cpu_start_ = process_cpu_seconds();

@@ -5,6 +5,7 @@
 #include "kernel/silo/bin_vibration.hpp"
 #include "kernel/silo/discharge_fit.hpp"
 #include "kernel/silo/flow_pattern.hpp"
+#include "kernel/silo/outlet_flow.hpp"
 #include "kernel/silo/section_field.hpp"
 #include "kernel/silo/silo_geometry.hpp"
 #include "kernel/silo/silo_output.hpp"
@@ -163,6 +164,7 @@ struct SiloCaseResult {
     std::vector<DischargeRow> discharge;  // time since the opening, mass, grains
     DischargeFit fit;
     FlowPatternResult flow;
+    OutletFlowResult outlet;  // density and speed of the grains above the outlet over the steady window
     std::shared_ptr<SectionField> section;
     double wall_s = 0, fill_wall_s = 0;  // wall-clock time of the whole run (every session of it) [s]
     int sessions = 1;                    // 1 + the number of times the run was resumed from its checkpoint

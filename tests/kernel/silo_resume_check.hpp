@@ -55,6 +55,9 @@ inline kernel::silo::SiloCaseSettings check_resumes_bit_for_bit(kernel::silo::Si
     CHECK(resumed.steps == whole.steps);
     CHECK(resumed.fit.rate == whole.fit.rate);
     CHECK(resumed.flow.ratio == whole.flow.ratio);
+    CHECK(resumed.outlet.frames == whole.outlet.frames);
+    CHECK(resumed.outlet.solid_density == whole.outlet.solid_density);
+    CHECK(resumed.outlet.downward_speed == whole.outlet.downward_speed);
     CHECK(resumed.contact_law == whole.contact_law);
     std::filesystem::remove_all(dir);
     return stored;
