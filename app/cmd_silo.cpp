@@ -288,11 +288,11 @@ ks::BinVibration vibration_from(const SiloCli& o, CLI::App& sub) {
     else
         throw UserError("vibration-direction = '" + o.vibration_direction +
                         "': must be x (perpendicular to the silo axis) or z (along it)");
-    if (o.vibration_part == "bin") v.part = ks::VibratingPart::bin;
-    else if (o.vibration_part == "hopper") v.part = ks::VibratingPart::hopper;
-    else
+    const auto part = ks::vibrating_part_named(o.vibration_part);
+    if (!part)
         throw UserError("vibration-part = '" + o.vibration_part.substr(0, 40) +
                         "': must be bin (every wall) or hopper (the hopper and the outlet plate; the body still)");
+    v.part = *part;
     return v;
 }
 

@@ -8,6 +8,7 @@
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
 #include "app/silo_campaign.hpp"
+#include "kernel/silo/bin_vibration.hpp"
 #include "orchestrator/shear_campaign.hpp"  // check_run_count
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
@@ -76,7 +77,8 @@ json campaign_settings(const VibrationCli& o) {
     json s = {{"thetas_deg", o.thetas},     {"frequencies_hz", o.frequencies}, {"amplitude_m", o.amplitude},
               {"direction", o.direction},   {"repeats", o.repeats},           {"first_seed", o.first_seed},
               {"silo_args", o.silo_args}};
-    if (o.part != "bin") s["part"] = o.part;  // absent for the whole bin: sweeps from before --part continue
+    // absent for the whole bin: sweeps from before --part continue
+    if (kernel::silo::vibrating_part_named(o.part) != kernel::silo::VibratingPart::bin) s["part"] = o.part;
     return s;
 }
 
@@ -97,7 +99,7 @@ void check_options(const VibrationCli& o) {
     if (vibrating && !(o.amplitude > 0)) throw UserError("--amplitude: a frequency above 0 needs an amplitude > 0 m");
     if (o.direction != "x" && o.direction != "z")
         throw UserError("--direction = '" + o.direction.substr(0, 20) + "': x (perpendicular to the axis) or z");
-    if (o.part != "bin" && o.part != "hopper")
+    if (!kernel::silo::vibrating_part_named(o.part))
         throw UserError("--part = '" + o.part.substr(0, 20) + "': bin (every wall) or hopper (the body still)");
 }
 

@@ -30,6 +30,12 @@ std::string to_string(VibrationDirection d) { return d == VibrationDirection::z 
 
 std::string to_string(VibratingPart p) { return p == VibratingPart::hopper ? "hopper" : "bin"; }
 
+std::optional<VibratingPart> vibrating_part_named(const std::string& name) {
+    for (const VibratingPart p : {VibratingPart::bin, VibratingPart::hopper})
+        if (name == to_string(p)) return p;
+    return std::nullopt;
+}
+
 double BinVibration::peak_acceleration() const {
     const double w = 2 * pi * frequency;
     return amplitude * w * w;

@@ -25,6 +25,8 @@ enum class VibratingPart : std::int32_t {
                  // accelerometer measured the cone: how much of that motion reached the body was not measured.
 };
 std::string to_string(VibratingPart p);
+// The part of a name as to_string gives it; empty for any other text.
+std::optional<VibratingPart> vibrating_part_named(const std::string& name);
 
 struct BinVibration {
     double frequency = 0;            // f [Hz]; 0: still
