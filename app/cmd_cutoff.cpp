@@ -201,21 +201,20 @@ bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double freque
     if (!summary)
         throw std::runtime_error("the silo run " + plan.name + " failed or left no summary: see " +
                                  (dir / "runs" / plan.name / "silo.log").string());
-    const double filled = summary->at("filled_mass_kg").get<double>();
-    const auto& discharge = summary->at("discharge");
-    const double fraction = filled > 0 ? discharge.at("discharged_mass_kg").get<double>() / filled : 0;
+    const double filled = summary->number("filled_mass_kg");
+    const double fraction = filled > 0 ? summary->number("discharge/discharged_mass_kg") / filled : 0;
     const bool flows = fraction >= kFlowingFraction * (1 - 1e-12);
     const double peak_g = run.vibration.peak_acceleration() / run.gravity;
-    const std::string stop_reason = discharge.at("stop_reason").get<std::string>();
-    const double cpu = summary->at("cpu_s").get<double>();
+    const std::string stop_reason = summary->text("discharge/stop_reason");
+    const double cpu = summary->number("cpu_s"), discharge_time = summary->number("discharge/time_s");
     std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% of %.1f g out in %.2f s -> %s  [%s; %.1f s CPU]\n",
-                frequency, peak_g, seed, 100 * fraction, 1e3 * filled, discharge.at("time_s").get<double>(),
+                frequency, peak_g, seed, 100 * fraction, 1e3 * filled, discharge_time,
                 flows ? "flows" : "arched", stop_reason.c_str(), cpu);
     std::fflush(stdout);
     runs.push_back({{"frequency_hz", frequency}, {"seed", seed}, {"run", plan.name}, {"peak_acceleration_g", peak_g},
                     {"discharged_fraction", fraction}, {"filled_mass_kg", filled},
-                    {"bulk_density_kg_m3", summary->at("bulk_density_kg_m3")}, {"discharge_time_s", discharge.at("time_s")},
-                    {"stop_reason", stop_reason}, {"flows", flows}, {"cpu_s", cpu}, {"wall_s", summary->at("wall_s")}});
+                    {"bulk_density_kg_m3", summary->number("bulk_density_kg_m3")}, {"discharge_time_s", discharge_time},
+                    {"stop_reason", stop_reason}, {"flows", flows}, {"cpu_s", cpu}, {"wall_s", summary->number("wall_s")}});
     return flows;
 }
 

@@ -132,17 +132,20 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
         Cell& c = cells[{r.theta, r.frequency}];
         json entry = {{"theta_deg", r.theta}, {"frequency_hz", r.frequency}, {"seed", r.seed}};
         if (const auto s = silo_run_summary(dir, r.name())) {
-            const double rate = s->at("rate").value("rate_kg_s", NAN) * 1e3;
-            const std::string pattern = s->at("flow_pattern").value("pattern", "?");
+            // no rate where the run ended without a steady discharge
+            const double rate = s->optional_number("rate/rate_kg_s").value_or(NAN) * 1e3;
+            const std::string pattern = s->text("flow_pattern/pattern");
             entry["rate_g_s"] = rate;
             entry["flow_pattern"] = pattern;
             if (std::isfinite(rate)) c.rates.push_back(rate);
             ++c.patterns[pattern];
-            if (const auto outlet = s->find("outlet_flow"); outlet != s->end() && outlet->value("frames", 0) > 0) {
-                entry["outlet_solid_density_kg_m3"] = outlet->at("solid_density_kg_m3");
-                entry["outlet_downward_speed_m_s"] = outlet->at("downward_speed_m_s");
-                c.outlet_densities.push_back(outlet->at("solid_density_kg_m3").get<double>());
-                c.outlet_speeds.push_back(outlet->at("downward_speed_m_s").get<double>());
+            if (s->optional_number("outlet_flow/frames").value_or(0) > 0) {
+                const double density = s->number("outlet_flow/solid_density_kg_m3");
+                const double speed = s->number("outlet_flow/downward_speed_m_s");
+                entry["outlet_solid_density_kg_m3"] = density;
+                entry["outlet_downward_speed_m_s"] = speed;
+                c.outlet_densities.push_back(density);
+                c.outlet_speeds.push_back(speed);
             }
         } else if (silo_run_failed(dir, r.name())) {
             entry["failed"] = true;

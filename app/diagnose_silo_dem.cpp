@@ -148,7 +148,7 @@ public:
                                                  "); a failed run is not retried: remove its folder to run it again");
                     // a run that ended without a steady discharge (an arch, a jam) predicts no flow: NaN, which the
                     // diagnosis reads as "this value stops the flow" (analytics/dem_diagnosis.hpp)
-                    const double rate = summary->at("rate").value("rate_kg_s", NAN) * 1e3;
+                    const double rate = summary->optional_number("rate/rate_kg_s").value_or(NAN) * 1e3;
                     sum += rate > 0 ? rate : NAN;
                 }
                 per_condition.push_back(sum / args_.seeds);

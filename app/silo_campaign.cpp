@@ -155,10 +155,45 @@ void open_silo_campaign(const fs::path& dir, const json& settings, const std::st
     orchestrator::write_text_file_atomically(settings_file, settings.dump(1) + "\n");
 }
 
-std::optional<json> silo_run_summary(const fs::path& dir, const std::string& name) {
+SiloRunSummary::SiloRunSummary(json summary, fs::path file) : j_(std::move(summary)), file_(std::move(file)) {}
+
+void SiloRunSummary::fail(const std::string& field, const std::string& why) const {
+    throw UserError("run summary '" + file_.string() + "': " + field + " " + why +
+                    " (written by demcal silo: remove the run's folder to run it again)");
+}
+
+bool SiloRunSummary::has(const std::string& field) const {
+    return j_.is_object() && j_.contains(json::json_pointer("/" + field));
+}
+
+const json& SiloRunSummary::find(const std::string& field) const {
+    if (!has(field)) fail(field, "is missing");
+    return j_.at(json::json_pointer("/" + field));
+}
+
+const json& SiloRunSummary::at(const std::string& field) const { return find(field); }
+
+double SiloRunSummary::number(const std::string& field) const {
+    const json& v = find(field);
+    if (!v.is_number()) fail(field, "= " + v.dump().substr(0, 40) + ": not a number");
+    return v.get<double>();
+}
+
+std::optional<double> SiloRunSummary::optional_number(const std::string& field) const {
+    if (!has(field)) return std::nullopt;
+    return number(field);
+}
+
+std::string SiloRunSummary::text(const std::string& field) const {
+    const json& v = find(field);
+    if (!v.is_string()) fail(field, "= " + v.dump().substr(0, 40) + ": not a text");
+    return v.get<std::string>();
+}
+
+std::optional<SiloRunSummary> silo_run_summary(const fs::path& dir, const std::string& name) {
     const fs::path summary = dir / "runs" / name / "summary.json";
     if (!fs::exists(summary)) return std::nullopt;
-    return read_json_file(summary.string(), "run summary");
+    return SiloRunSummary(read_json_file(summary.string(), "run summary"), summary);
 }
 
 bool silo_run_failed(const fs::path& dir, const std::string& name) { return fs::exists(dir / "runs" / name / "failed"); }

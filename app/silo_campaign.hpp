@@ -58,8 +58,28 @@ SiloCampaignOutcome run_silo_campaign(const std::filesystem::path& dir, const st
                                       const std::vector<std::string>& session_args, int jobs,
                                       const std::string& command, const SiloCampaignExecutor& where = {});
 
+// A finished run's summary.json, read field by field: a field given by its path ("rate/rate_kg_s") that is missing
+// or holds another type throws UserError naming the file, the field and what it holds (a summary edited or damaged
+// by hand stops the report with that, not with a library's message).
+class SiloRunSummary {
+public:
+    SiloRunSummary(nlohmann::json summary, std::filesystem::path file);
+    double number(const std::string& field) const;
+    // Empty when the field is absent (summaries of an older demcal); any other type than a number is an error.
+    std::optional<double> optional_number(const std::string& field) const;
+    std::string text(const std::string& field) const;
+    const nlohmann::json& at(const std::string& field) const;  // any type: copied into a report as it is
+    bool has(const std::string& field) const;
+
+private:
+    const nlohmann::json& find(const std::string& field) const;
+    [[noreturn]] void fail(const std::string& field, const std::string& why) const;
+    nlohmann::json j_;
+    std::filesystem::path file_;
+};
+
 // The summary.json of a finished run of DIR, if any.
-std::optional<nlohmann::json> silo_run_summary(const std::filesystem::path& dir, const std::string& name);
+std::optional<SiloRunSummary> silo_run_summary(const std::filesystem::path& dir, const std::string& name);
 bool silo_run_failed(const std::filesystem::path& dir, const std::string& name);
 
 // A number as a silo option: all 17 digits, so that the run gets exactly the value planned.

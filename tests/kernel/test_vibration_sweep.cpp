@@ -8,6 +8,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -56,6 +57,20 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
                    dir / "other.log") == 2);
   CHECK_THAT(demcal::test::read_file(dir / "other.log"), Catch::Matchers::Contains("other settings"));
   CHECK_FALSE(fs::exists(campaign / "runs" / "theta45_f50_seed1"));
+  // the cells carry the outlet's density and speed
+  CHECK(report["cells"][0]["outlet_solid_density_mean_kg_m3"].get<double>() > 0);
+  CHECK(report["cells"][0]["outlet_downward_speed_mean_m_s"].get<double>() > 0);
+  // a run's summary damaged by hand stops the report naming the file and the field, and the report is left as it was
+  const fs::path summary = campaign / "runs" / "theta45_f100_seed2" / "summary.json";
+  auto damaged = nlohmann::json::parse(demcal::test::read_file(summary));
+  damaged["outlet_flow"]["solid_density_kg_m3"] = "dense";
+  std::ofstream(summary) << damaged.dump();
+  const std::string before = demcal::test::read_file(campaign / "vibration.json");
+  CHECK(demcal_run(sweep, dir / "damaged.log") == 2);
+  CHECK_THAT(demcal::test::read_file(dir / "damaged.log"),
+             Catch::Matchers::Contains(summary.string()) &&
+                 Catch::Matchers::Contains("outlet_flow/solid_density_kg_m3 = \"dense\": not a number"));
+  CHECK(demcal::test::read_file(campaign / "vibration.json") == before);
   fs::remove_all(dir);
 }
 
