@@ -103,15 +103,37 @@ void check_options(const VibrationCli& o) {
         throw UserError("--part = '" + o.part.substr(0, 20) + "': bin (every wall) or hopper (the body still)");
 }
 
-struct Cell {
-    std::vector<double> rates;  // g/s
-    std::vector<double> outlet_densities, outlet_speeds;  // kg/m^3, m/s (runs of a demcal that measures them)
-    std::map<std::string, int> patterns;
-    int failed = 0;
+// What one run gave (NaN where it did not: a failed run, no steady discharge, a demcal without the outlet meter).
+struct RunResult {
+    bool finished = false, failed = false;
+    double rate = NAN;             // g/s
+    double outlet_density = NAN;   // kg/m^3
+    double outlet_speed = NAN;     // m/s
+    std::string pattern;
 };
 
-// Mean and sample standard deviation (NaN where there are too few values).
-std::pair<double, double> mean_sd(const std::vector<double>& v) {
+RunResult read_run(const fs::path& dir, const RunSpec& r) {
+    RunResult out;
+    if (const auto s = silo_run_summary(dir, r.name())) {
+        out.finished = true;
+        // no rate where the run ended without a steady discharge
+        out.rate = s->optional_number("rate/rate_kg_s").value_or(NAN) * 1e3;
+        out.pattern = s->text("flow_pattern/pattern");
+        if (s->optional_number("outlet_flow/frames").value_or(0) > 0) {
+            out.outlet_density = s->number("outlet_flow/solid_density_kg_m3");
+            out.outlet_speed = s->number("outlet_flow/downward_speed_m_s");
+        }
+    } else {
+        out.failed = silo_run_failed(dir, r.name());
+    }
+    return out;
+}
+
+// Mean and sample standard deviation of the finite values (NaN where there are too few).
+std::pair<double, double> mean_sd(const std::vector<double>& all) {
+    std::vector<double> v;
+    for (double x : all)
+        if (std::isfinite(x)) v.push_back(x);
     double mean = NAN, sd = NAN;
     if (v.empty()) return {mean, sd};
     mean = 0;
@@ -125,69 +147,46 @@ std::pair<double, double> mean_sd(const std::vector<double>& v) {
     return {mean, sd};
 }
 
-void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
-    std::map<std::pair<double, double>, Cell> cells;
-    json all = json::array();
-    for (const RunSpec& r : runs) {
-        Cell& c = cells[{r.theta, r.frequency}];
-        json entry = {{"theta_deg", r.theta}, {"frequency_hz", r.frequency}, {"seed", r.seed}};
-        if (const auto s = silo_run_summary(dir, r.name())) {
-            // no rate where the run ended without a steady discharge
-            const double rate = s->optional_number("rate/rate_kg_s").value_or(NAN) * 1e3;
-            const std::string pattern = s->text("flow_pattern/pattern");
-            entry["rate_g_s"] = rate;
-            entry["flow_pattern"] = pattern;
-            if (std::isfinite(rate)) c.rates.push_back(rate);
-            ++c.patterns[pattern];
-            if (s->optional_number("outlet_flow/frames").value_or(0) > 0) {
-                const double density = s->number("outlet_flow/solid_density_kg_m3");
-                const double speed = s->number("outlet_flow/downward_speed_m_s");
-                entry["outlet_solid_density_kg_m3"] = density;
-                entry["outlet_downward_speed_m_s"] = speed;
-                c.outlet_densities.push_back(density);
-                c.outlet_speeds.push_back(speed);
-            }
-        } else if (silo_run_failed(dir, r.name())) {
-            entry["failed"] = true;
-            ++c.failed;
-        }
-        all.push_back(entry);
-    }
-    json table = json::array();
-    std::ostringstream md;
-    md << "| theta [deg] | f [Hz] | peak acceleration [g] | rate mean [g/s] | SD [g/s] | n | flow pattern | outlet "
-          "density [kg/m^3] | outlet speed [m/s] |\n"
-       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
-    std::map<double, std::string> data_by_theta;
-    for (const auto& [key, c] : cells) {
-        const auto [theta, f] = key;
-        const auto [mean, sd] = mean_sd(c.rates);
-        const double outlet_density = mean_sd(c.outlet_densities).first, outlet_speed = mean_sd(c.outlet_speeds).first;
-        std::string pattern = "-";
-        int most = 0;
-        for (const auto& [p, n] : c.patterns)
-            if (n > most) pattern = p, most = n;
-        const double g = o.amplitude * std::pow(2 * M_PI * f, 2) / 9.81;
-        table.push_back({{"theta_deg", theta}, {"frequency_hz", f}, {"peak_acceleration_g", g},
-                         {"rate_mean_g_s", mean}, {"rate_sd_g_s", sd}, {"n", c.rates.size()}, {"failed", c.failed},
-                         {"flow_pattern", pattern}, {"outlet_solid_density_mean_kg_m3", outlet_density},
-                         {"outlet_downward_speed_mean_m_s", outlet_speed}});
-        auto cell = [](double v, int digits) {
-            std::ostringstream t;
-            if (std::isfinite(v)) t << std::setprecision(digits) << v; else t << "-";
-            return t.str();
-        };
-        md << "| " << theta << " | " << f << " | " << cell(g, 3) << " | " << cell(mean, 5) << " | " << cell(sd, 3)
-           << " | " << c.rates.size() << " | " << pattern << " | " << cell(outlet_density, 4) << " | "
-           << cell(outlet_speed, 3) << " |\n";
-        if (std::isfinite(mean))
-            data_by_theta[theta] += std::to_string(f) + " " + std::to_string(mean) + " " +
-                                    std::to_string(std::isfinite(sd) ? sd : 0.0) + "\n";
-    }
-    const json out = {{"settings", campaign_settings(o)}, {"cells", table}, {"runs", all}};
-    orchestrator::write_text_file_atomically(dir / "vibration.json", out.dump(1) + "\n");
-    orchestrator::write_text_file_atomically(dir / "vibration.md", md.str());
-    std::cout << md.str();
+// A change in per cent, paired seed by seed: every frequency of a seed discharges the bed that seed filled (the bin
+// is still while it fills), so the still run of the same angle and seed is the reference and the seeds' own scatter
+// drops out. Mean, its standard error and the number of pairs.
+struct PairedChange {
+    double mean = NAN, se = NAN;
+    std::size_t pairs = 0;
+};
+
+PairedChange paired_change(const std::vector<double>& values, const std::vector<double>& still) {
+    std::vector<double> changes;
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (std::isfinite(values[i]) && std::isfinite(still[i]) && still[i] != 0)
+            changes.push_back(100 * (values[i] / still[i] - 1));
+    const auto [mean, sd] = mean_sd(changes);
+    return {mean, std::isfinite(sd) ? sd / std::sqrt(double(changes.size())) : NAN, changes.size()};
+}
+
+struct Cell {
+    std::vector<RunResult> runs;
+    std::vector<RunResult> still;  // the still run of each run's seed and angle (an empty result where there is none)
+};
+
+std::string number_text(double v, int digits) {
+    std::ostringstream t;
+    if (std::isfinite(v)) t << std::setprecision(digits) << v; else t << "-";
+    return t.str();
+}
+
+std::string change_text(const PairedChange& c) {
+    if (!std::isfinite(c.mean)) return "-";
+    std::ostringstream t;
+    t << std::showpos << std::fixed << std::setprecision(1) << c.mean << std::noshowpos;
+    if (std::isfinite(c.se)) t << " (" << c.se << ")";
+    return t.str();
+}
+
+json change_json(const PairedChange& c) { return {{"mean_pct", c.mean}, {"se_pct", c.se}, {"pairs", c.pairs}}; }
+
+// Rate against frequency, one line per angle, the SD as error bars.
+void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<double, std::string>& data_by_theta) {
     if (data_by_theta.empty()) return;
     std::ostringstream body;
     body << "set xlabel 'vibration frequency [Hz]'\nset ylabel 'discharge rate [g/s]'\nset key outside right\n"
@@ -207,6 +206,92 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
     } catch (const std::exception& e) {
         std::cerr << "demcal vibration: warning: the plot was not drawn (" << e.what() << "); the tables are written\n";
     }
+}
+
+void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
+    std::map<std::pair<double, long long>, RunResult> still_of;  // (theta, seed)
+    std::vector<RunResult> results;
+    json all = json::array();
+    for (const RunSpec& r : runs) {
+        const RunResult res = read_run(dir, r);
+        results.push_back(res);
+        if (r.frequency == 0) still_of[{r.theta, r.seed}] = res;
+        json entry = {{"theta_deg", r.theta}, {"frequency_hz", r.frequency}, {"seed", r.seed}};
+        if (res.finished) {
+            entry["rate_g_s"] = res.rate;
+            entry["flow_pattern"] = res.pattern;
+            if (std::isfinite(res.outlet_density)) {
+                entry["outlet_solid_density_kg_m3"] = res.outlet_density;
+                entry["outlet_downward_speed_m_s"] = res.outlet_speed;
+            }
+        } else if (res.failed) {
+            entry["failed"] = true;
+        }
+        all.push_back(entry);
+    }
+    std::map<std::pair<double, double>, Cell> cells;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        Cell& c = cells[{runs[i].theta, runs[i].frequency}];
+        c.runs.push_back(results[i]);
+        const auto still = still_of.find({runs[i].theta, runs[i].seed});
+        c.still.push_back(still == still_of.end() ? RunResult{} : still->second);
+    }
+    json table = json::array();
+    std::ostringstream md;
+    md << "| theta [deg] | f [Hz] | peak acceleration [g] | rate mean [g/s] | SD [g/s] | n | flow pattern | rate change "
+          "against still, paired [%] (SE) | outlet density [kg/m^3] | its change [%] | outlet speed [m/s] | its change "
+          "[%] |\n"
+       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    std::map<double, std::string> data_by_theta;
+    for (const auto& [key, c] : cells) {
+        const auto [theta, f] = key;
+        std::vector<double> rates, densities, speeds, still_rates, still_densities, still_speeds;
+        std::map<std::string, int> patterns;
+        int failed = 0;
+        for (std::size_t i = 0; i < c.runs.size(); ++i) {
+            const RunResult& r = c.runs[i];
+            failed += r.failed;
+            if (r.finished) ++patterns[r.pattern];
+            rates.push_back(r.rate), densities.push_back(r.outlet_density), speeds.push_back(r.outlet_speed);
+            still_rates.push_back(c.still[i].rate), still_densities.push_back(c.still[i].outlet_density);
+            still_speeds.push_back(c.still[i].outlet_speed);
+        }
+        const auto [mean, sd] = mean_sd(rates);
+        std::size_t n = 0;
+        for (double x : rates) n += std::isfinite(x);
+        const double outlet_density = mean_sd(densities).first, outlet_speed = mean_sd(speeds).first;
+        // a still cell is its own reference: no change to report
+        const PairedChange rate_change = f > 0 ? paired_change(rates, still_rates) : PairedChange{};
+        const PairedChange density_change = f > 0 ? paired_change(densities, still_densities) : PairedChange{};
+        const PairedChange speed_change = f > 0 ? paired_change(speeds, still_speeds) : PairedChange{};
+        std::string pattern = "-";
+        int most = 0;
+        for (const auto& [p, count] : patterns)
+            if (count > most) pattern = p, most = count;
+        const double g = o.amplitude * std::pow(2 * M_PI * f, 2) / 9.81;
+        table.push_back({{"theta_deg", theta}, {"frequency_hz", f}, {"peak_acceleration_g", g},
+                         {"rate_mean_g_s", mean}, {"rate_sd_g_s", sd}, {"n", n}, {"failed", failed},
+                         {"flow_pattern", pattern}, {"rate_change_paired", change_json(rate_change)},
+                         {"outlet_solid_density_mean_kg_m3", outlet_density},
+                         {"outlet_density_change_paired", change_json(density_change)},
+                         {"outlet_downward_speed_mean_m_s", outlet_speed},
+                         {"outlet_speed_change_paired", change_json(speed_change)}});
+        md << "| " << theta << " | " << f << " | " << number_text(g, 3) << " | " << number_text(mean, 5) << " | "
+           << number_text(sd, 3) << " | " << n << " | " << pattern << " | " << change_text(rate_change) << " | "
+           << number_text(outlet_density, 4) << " | " << change_text(density_change) << " | "
+           << number_text(outlet_speed, 3) << " | " << change_text(speed_change) << " |\n";
+        if (std::isfinite(mean))
+            data_by_theta[theta] += std::to_string(f) + " " + std::to_string(mean) + " " +
+                                    std::to_string(std::isfinite(sd) ? sd : 0.0) + "\n";
+    }
+    md << "\nChanges are paired seed by seed against the still run of the same angle and seed (the same filled bed); "
+          "SE: the standard error of the pairs' mean. d ln(rate) = d ln(density) + d ln(speed) at the outlet splits a "
+          "change of the rate.\n";
+    const json out = {{"settings", campaign_settings(o)}, {"cells", table}, {"runs", all}};
+    orchestrator::write_text_file_atomically(dir / "vibration.json", out.dump(1) + "\n");
+    orchestrator::write_text_file_atomically(dir / "vibration.md", md.str());
+    std::cout << md.str();
+    plot_rates(o, dir, data_by_theta);
 }
 
 int run(const VibrationCli& o) {

@@ -60,6 +60,17 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
   // the cells carry the outlet's density and speed
   CHECK(report["cells"][0]["outlet_solid_density_mean_kg_m3"].get<double>() > 0);
   CHECK(report["cells"][0]["outlet_downward_speed_mean_m_s"].get<double>() > 0);
+  // the vibrating cell's change against the still runs of the same seeds, pair by pair
+  double still[2] = {0, 0}, shaken[2] = {0, 0};
+  for (const auto& run : report["runs"])
+    (run["frequency_hz"] == 0 ? still : shaken)[run["seed"].get<int>() - 1] = run["rate_g_s"].get<double>();
+  const double change1 = 100 * (shaken[0] / still[0] - 1), change2 = 100 * (shaken[1] / still[1] - 1);
+  const auto& paired = report["cells"][1]["rate_change_paired"];
+  CHECK(paired["pairs"] == 2);
+  CHECK(paired["mean_pct"].get<double>() == Approx((change1 + change2) / 2));
+  CHECK(paired["se_pct"].get<double>() == Approx(std::abs(change1 - change2) / 2));
+  CHECK(report["cells"][0]["rate_change_paired"]["pairs"] == 0);  // the still cell is the reference
+  CHECK(report["cells"][1]["outlet_speed_change_paired"]["pairs"] == 2);
   // a run's summary damaged by hand stops the report naming the file and the field, and the report is left as it was
   const fs::path summary = campaign / "runs" / "theta45_f100_seed2" / "summary.json";
   auto damaged = nlohmann::json::parse(demcal::test::read_file(summary));
