@@ -305,7 +305,9 @@ int run(const VibrationCli& o) {
     for (const RunSpec& r : runs) plans.push_back(silo_plan(o, r));
     // every cell's settings checked by silo itself before anything is written (the repeats differ by seed only)
     check_silo_runs({plans.begin(), plans.begin() + std::ptrdiff_t(o.thetas.size() * o.frequencies.size())});
-    open_silo_campaign(dir, campaign_settings(o), "vibration");
+    // a run is its angle, frequency and seed under the shared settings: a grid that grows (or shrinks) is the same
+    // campaign, its finished runs reused
+    open_silo_campaign(dir, campaign_settings(o), "vibration", {"thetas_deg", "frequencies_hz", "repeats", "first_seed"});
     const SiloCampaignOutcome outcome =
         run_silo_campaign(dir, plans, o.silo_args, o.jobs, "vibration", {o.executor, o.partition});
     if (outcome.stopped) {

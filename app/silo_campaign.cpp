@@ -143,10 +143,16 @@ void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
     }
 }
 
-void open_silo_campaign(const fs::path& dir, const json& settings, const std::string& command) {
+void open_silo_campaign(const fs::path& dir, const json& settings, const std::string& command,
+                        const std::vector<std::string>& may_change) {
     const fs::path settings_file = dir / "campaign.json";
     if (fs::exists(settings_file)) {
-        if (read_json_file(settings_file.string(), "campaign settings") != settings)
+        json stored = read_json_file(settings_file.string(), "campaign settings"), now = settings;
+        for (const std::string& key : may_change) {
+            if (stored.is_object()) stored.erase(key);
+            now.erase(key);
+        }
+        if (stored != now)
             throw UserError("campaign = '" + dir.string() + "' holds a " + command + " campaign with other settings (" +
                             settings_file.string() + "): give another --campaign, or the same settings to continue it");
         return;

@@ -28,8 +28,10 @@ void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const 
 void check_silo_runs(const std::vector<SiloRunPlan>& plans);
 
 // DIR/campaign.json: created with `settings` (and DIR/runs) when absent; when present it must hold the same settings,
-// else UserError (another campaign lives there). Call after every check of the input.
-void open_silo_campaign(const std::filesystem::path& dir, const nlohmann::json& settings, const std::string& command);
+// else UserError (another campaign lives there). The keys in `may_change` (a sweep's grid: more angles, frequencies or
+// seeds add runs to the same campaign) are left out of the comparison. Call after every check of the input.
+void open_silo_campaign(const std::filesystem::path& dir, const nlohmann::json& settings, const std::string& command,
+                        const std::vector<std::string>& may_change = {});
 
 struct SiloCampaignOutcome {
     std::size_t finished = 0;  // with a summary.json (before or now)

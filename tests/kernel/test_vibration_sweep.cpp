@@ -51,12 +51,24 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
   REQUIRE(demcal_run(sweep, dir / "again.log") == 0);
   CHECK(fs::last_write_time(campaign / "runs" / "theta45_f100_seed2" / "summary.json") == stamp);
   CHECK_THAT(demcal::test::read_file(dir / "again.log"), !Catch::Matchers::Contains("[1/"));
-  // the same directory with other settings is refused, and left as it was
-  CHECK(demcal_run("vibration --theta 45 --frequency 0,50 --amplitude 1.1e-4 --repeats 2 --campaign '" +
+  // the same directory with other settings (another amplitude) is refused, and left as it was
+  CHECK(demcal_run("vibration --theta 45 --frequency 0,50 --amplitude 1.2e-4 --repeats 2 --campaign '" +
                        campaign.string() + "' -- " + kTiny,
                    dir / "other.log") == 2);
   CHECK_THAT(demcal::test::read_file(dir / "other.log"), Catch::Matchers::Contains("other settings"));
   CHECK_FALSE(fs::exists(campaign / "runs" / "theta45_f50_seed1"));
+  // a grown grid is the same campaign: a third seed runs its two runs only, the first two seeds' are reused
+  const std::string grown = "vibration --theta 45 --frequency 0,100 --amplitude 1.1e-4 --repeats 3 --campaign '" +
+                            campaign.string() + "' -- " + kTiny;
+  REQUIRE(demcal_run(grown, dir / "grown.log") == 0);
+  CHECK(fs::last_write_time(campaign / "runs" / "theta45_f100_seed2" / "summary.json") == stamp);
+  CHECK(fs::exists(campaign / "runs" / "theta45_f100_seed3" / "summary.json"));
+  // (the progress counts the planned runs: only the 5th and 6th of 6 are started)
+  CHECK_THAT(demcal::test::read_file(dir / "grown.log"), Catch::Matchers::Contains("[5/6] theta45_f0_seed3") &&
+                                                             Catch::Matchers::Contains("[6/6] theta45_f100_seed3") &&
+                                                             !Catch::Matchers::Contains("[4/6]"));
+  const auto grown_report = nlohmann::json::parse(demcal::test::read_file(campaign / "vibration.json"));
+  CHECK(grown_report["cells"][1]["rate_change_paired"]["pairs"] == 3);
   // the cells carry the outlet's density and speed
   CHECK(report["cells"][0]["outlet_solid_density_mean_kg_m3"].get<double>() > 0);
   CHECK(report["cells"][0]["outlet_downward_speed_mean_m_s"].get<double>() > 0);
