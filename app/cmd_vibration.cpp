@@ -12,6 +12,7 @@
 #include "orchestrator/shear_campaign.hpp"  // check_run_count
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
+#include <gsl/gsl_statistics_double.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -134,17 +135,9 @@ std::pair<double, double> mean_sd(const std::vector<double>& all) {
     std::vector<double> v;
     for (double x : all)
         if (std::isfinite(x)) v.push_back(x);
-    double mean = NAN, sd = NAN;
-    if (v.empty()) return {mean, sd};
-    mean = 0;
-    for (double x : v) mean += x;
-    mean /= double(v.size());
-    if (v.size() > 1) {
-        sd = 0;
-        for (double x : v) sd += (x - mean) * (x - mean);
-        sd = std::sqrt(sd / double(v.size() - 1));
-    }
-    return {mean, sd};
+    if (v.empty()) return {NAN, NAN};
+    const double mean = gsl_stats_mean(v.data(), 1, v.size());
+    return {mean, v.size() > 1 ? gsl_stats_sd_m(v.data(), 1, v.size(), mean) : NAN};
 }
 
 // A change in per cent, paired seed by seed: every frequency of a seed discharges the bed that seed filled (the bin
