@@ -177,8 +177,6 @@ const json& SiloRunSummary::find(const std::string& field) const {
     return j_.at(json::json_pointer("/" + field));
 }
 
-const json& SiloRunSummary::at(const std::string& field) const { return find(field); }
-
 double SiloRunSummary::number(const std::string& field) const {
     const json& v = find(field);
     if (!v.is_number()) fail(field, "= " + v.dump().substr(0, 40) + ": not a number");

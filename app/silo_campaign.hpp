@@ -70,10 +70,9 @@ public:
     // Empty when the field is absent (summaries of an older demcal); any other type than a number is an error.
     std::optional<double> optional_number(const std::string& field) const;
     std::string text(const std::string& field) const;
-    const nlohmann::json& at(const std::string& field) const;  // any type: copied into a report as it is
-    bool has(const std::string& field) const;
 
 private:
+    bool has(const std::string& field) const;
     const nlohmann::json& find(const std::string& field) const;
     [[noreturn]] void fail(const std::string& field, const std::string& why) const;
     nlohmann::json j_;
