@@ -109,6 +109,19 @@ const std::vector<std::string>& reserved_columns(MeasuredKind kind) {
     return kind == MeasuredKind::discharge ? discharge : shear;
 }
 
+namespace {
+/// Spreadsheets save "CSV UTF-8" with a byte-order mark before the header; UTF-16 text cannot be read as CSV here.
+void strip_byte_order_mark(std::string& first_line, const std::string& source) {
+    static constexpr std::string_view utf8_bom = "\xEF\xBB\xBF";
+    if (first_line.starts_with(utf8_bom)) {
+        first_line.erase(0, utf8_bom.size());
+        return;
+    }
+    if (first_line.starts_with("\xFF\xFE") || first_line.starts_with("\xFE\xFF"))
+        throw std::invalid_argument(source + ": the file is UTF-16 text; save it as CSV in UTF-8 or ASCII");
+}
+}  // namespace
+
 MeasuredData parse_csv(std::istream& in, const std::string& source) {
     MeasuredData data;
     data.source = source;
@@ -117,6 +130,7 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
     bool have_header = false;
     while (std::getline(in, line)) {
         ++line_no;
+        if (line_no == 1) strip_byte_order_mark(line, source);
         const std::string t = trim(line);
         if (t.empty() || t[0] == '#') continue;  // blank lines and comments hold no data
         auto fields = split_csv_line(line, source, line_no);

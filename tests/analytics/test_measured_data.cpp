@@ -37,6 +37,20 @@ TEST_CASE("discharge CSV loads every row with covariates", "[measured]") {
     CHECK(round.at("W_kg_s").values[0] == Approx(0.171));
 }
 
+TEST_CASE("a spreadsheet's UTF-8 byte-order mark and CRLF line ends are read; UTF-16 is refused", "[measured]") {
+    const std::string row = "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n";
+    const auto with_mark = load("\xEF\xBB\xBF" + header + row);
+    CHECK(with_mark.find("geometry") != nullptr);
+    CHECK(with_mark.at("W_kg_s").values[0] == Approx(0.171));
+    // the mark before a comment line: the comment is still a comment
+    const auto comment_first = load("\xEF\xBB\xBF# exported\n" + header + row);
+    CHECK(comment_first.rows() == 1);
+    std::string crlf;
+    for (const char c : header + row) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    CHECK(load(crlf).at("moisture_pct").values[0] == Approx(12.5));
+    CHECK_THROWS_WITH(load(std::string("\xFF\xFEg\0e\0o\0", 8) + "\n"), Catch::Contains("UTF-16"));
+}
+
 TEST_CASE("bad discharge files name the line and the column", "[measured]") {
     const std::string good = "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n";
     auto fails_with = [&](const std::string& body, const std::string& expected) {
