@@ -7,3 +7,7 @@ bash scripts/setup.sh
 bash scripts/build.sh
 cd build
 ctest --output-on-failure --timeout 1500 "$@"
+# The readers' fuzz tests again under AddressSanitizer + UndefinedBehaviorSanitizer (build-fuzz/; the whole sanitized
+# suite is scripts/sanitize.sh, too long for CI)
+cd ..
+bash scripts/fuzz_sanitized.sh
