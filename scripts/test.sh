@@ -10,4 +10,4 @@ ctest --output-on-failure --timeout 1500 "$@"
 # The readers' fuzz tests again under AddressSanitizer + UndefinedBehaviorSanitizer (build-fuzz/; the whole sanitized
 # suite is scripts/sanitize.sh, too long for CI)
 cd ..
-bash scripts/fuzz_sanitized.sh
+bash scripts/sanitize.sh --fuzz
