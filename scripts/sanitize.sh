@@ -5,8 +5,9 @@
 #                                           no YADE, no SLURM, not slow, not a benchmark): about 80 min here.
 #   bash scripts/sanitize.sh --fuzz [ARGS]  only the readers' fuzz tests (every "[fuzz]" case: material and geometry
 #                                           JSON, measured CSV, silo-dem rates, the campaign store, shear results, flow
-#                                           frames) in one executable, test_fuzz, built in build-fuzz/ from just the
-#                                           libraries they read with: the part CI can afford (scripts/test.sh runs it).
+#                                           frames, a checkpoint's kernel state) in one executable, test_fuzz, built in
+#                                           build-fuzz/ from just the libraries they read with: the part CI can afford
+#                                           (scripts/test.sh runs it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # (-Wno-maybe-uninitialized: with ASan, GCC 12 warns falsely inside libstdc++'s regex, which Catch2 includes)
