@@ -503,8 +503,13 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
         c.rmse_fitted = std::sqrt(row_sse(data, s, logs(c.rates_fitted)) / r.n);
         const double u_declared = std::clamp(g.unit(c.declared), -1.0, 1.0);
         const auto l_declared = g.at_unit(u_declared), l_fit = g.at_unit(u_fit);
-        c.rmse_declared = c.cv_rmse_declared = std::sqrt(row_sse(data, s, l_declared) / r.n);
-        c.chi2_declared = chi2_of(s, l_declared, K);
+        // The declared model is measured twice: its own runs, and the smoothed curve at the declared value. Where the
+        // curve misses those runs (a response it cannot follow: nearly flat, then a steep fall toward arching), the
+        // gain from the declared value to the fit would be partly the curve's own error; so the declared model is
+        // taken as the better of the two (seen: a clean two-outlet set got cohesion "named" with its CV RMSE up from
+        // 2.96 to 3.88 %, 2026-12-02).
+        c.rmse_declared = c.cv_rmse_declared = std::min(std::sqrt(row_sse(data, s, l_declared) / r.n), r.rmse_before);
+        c.chi2_declared = std::min(chi2_of(s, l_declared, K), r.chi2_before);
         c.chi2_fitted = chi2_of(s, l_fit, K);
         c.f_statistic = std::max(0.0, c.chi2_declared - c.chi2_fitted);
         c.p_value = gsl_cdf_fdist_Q(c.f_statistic, 1.0, double(s.df_pure_error));

@@ -13,6 +13,8 @@
 //    the seed scatter of single runs; the surrogate's SSE is minimised by GSL's Brent minimiser, and every proposal is
 //    run (runs are cached by their material, so nothing runs twice);
 //  * decision: chi2(p) = sum_c (mean_c - pred_c(p))^2 / var_c; F = chi2(declared) - chi2(fitted) against F(1, df)
+//    (chi2(declared) and the declared CV RMSE: the better of the declared runs and the surrogate at the declared value,
+//    so that a surrogate that misses the declared runs cannot make an effect of its own error)
 //    (one parameter); Holm over the candidates; the candidate must also cut the leave-one-condition-out CV RMSE by
 //    at least min_cv_gain; the lowest CV RMSE among those wins. A clean set (the declared material right) gets none;
 //  * interval: the values whose chi2 is within the F(1, df) quantile of the minimum (profile of the SSE).
@@ -102,7 +104,7 @@ struct DemCandidateResult {
     bool interval_at_lower_bound = false, interval_at_upper_bound = false;
     std::vector<double> evaluated;          // values run, in order
     std::vector<double> sse_of_runs;        // row SSE of log residuals with the raw runs at each evaluated value
-    double rmse_declared = NAN;             // surrogate at the declared value, log scale
+    double rmse_declared = NAN;             // the declared model, log scale: the better of its runs and the surrogate
     double cv_rmse_declared = NAN;          // = rmse_declared (nothing fitted)
     double rmse_fitted = NAN;               // raw runs at the fitted value
     double cv_rmse = NAN;                   // leave one condition out: refit, predict it (surrogate)

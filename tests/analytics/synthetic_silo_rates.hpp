@@ -1,5 +1,7 @@
 // A stand-in for the kernel's silo in diagnose_dem tests: rate = 200 (1 - theta/100) exp(-k p) at angles 20-50 deg,
 // "measured" with a repeat scatter of 2 %; from p >= arches_from on the bed arches (no rate) at 30 deg and steeper.
+// With steep_near > 0 the rate instead stays nearly flat and falls steeply toward p = steep_near (1 - (p/steep_near)^8 / 2),
+// a response no low-degree polynomial over the whole range follows (cohesion near arching).
 #pragma once
 #include "analytics/dem_diagnosis.hpp"
 #include <cmath>
@@ -11,10 +13,15 @@ namespace demcal::test {
 struct SyntheticSilo {
     double sensitivity = 3.0;    // k
     double arches_from = INFINITY;
+    double steep_near = 0;
+
+    double response(double p) const {
+        return steep_near > 0 ? 1.0 - 0.5 * std::pow(p / steep_near, 8) : std::exp(-sensitivity * p);
+    }
 
     double rate(double theta, double p) const {
         if (p >= arches_from && theta >= 30) return NAN;
-        return 200.0 * (1.0 - theta / 100.0) * std::exp(-sensitivity * p);
+        return 200.0 * (1.0 - theta / 100.0) * response(p);
     }
     analytics::SiloMeasurements measured(double p_true) const {
         analytics::SiloMeasurements m;

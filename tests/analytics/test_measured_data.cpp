@@ -37,7 +37,7 @@ TEST_CASE("discharge CSV loads every row with covariates", "[measured]") {
     CHECK(round.at("W_kg_s").values[0] == Approx(0.171));
 }
 
-TEST_CASE("a spreadsheet's UTF-8 byte-order mark and CRLF line ends are read; UTF-16 is refused", "[measured]") {
+TEST_CASE("a spreadsheet's UTF-8 byte-order mark and CRLF line ends are read, UTF-16 is refused", "[measured]") {
     const std::string row = "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n";
     const auto with_mark = load("\xEF\xBB\xBF" + header + row);
     CHECK(with_mark.find("geometry") != nullptr);
