@@ -75,7 +75,15 @@ class StateReader {
   }
   template <class T>
   void value(T& v, const char* what) {
-    bytes(reinterpret_cast<char*>(&v), sizeof(T), what);
+    if constexpr (std::is_same_v<T, bool>) {
+      // a damaged byte must not become a bool that is neither true nor false (undefined behaviour)
+      unsigned char b = 0;
+      bytes(reinterpret_cast<char*>(&b), 1, what);
+      if (b > 1) fail(what, "not a truth value (byte " + std::to_string(b) + ")");
+      v = b != 0;
+    } else {
+      bytes(reinterpret_cast<char*>(&v), sizeof(T), what);
+    }
   }
   template <class T>
   T value(const char* what) {
