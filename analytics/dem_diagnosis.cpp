@@ -361,6 +361,60 @@ std::vector<double> holm(const std::vector<double>& p) {
     return adjusted;
 }
 
+constexpr int kMaxSeparationMultiplier = 1000;  // beyond: not a design anyone would run
+
+DemRivalSeparation rival_separation(const ConditionStats& s, int K, const DemCandidateResult& effect,
+                                    const DemCandidateResult& rival, int rival_index, double level) {
+    DemRivalSeparation sep;
+    sep.rival = rival_index;
+    sep.needed_chi2_difference = gsl_cdf_fdist_Pinv(level, 1.0, double(s.df_pure_error));
+    std::vector<double> part;
+    for (std::size_t c = 0; c < s.mean.size(); ++c) {
+        const double d = effect.log_curve_fitted[c] - rival.log_curve_fitted[c];
+        part.push_back(d * d / (s.s2 * (1.0 / s.count[c] + 1.0 / K)));
+        sep.expected_chi2_difference += part.back();
+        sep.repeats_only_limit += d * d * K / s.s2;
+    }
+    if (sep.expected_chi2_difference > 0) {
+        // m times the repeats also gives the pure error m N - C degrees of freedom, which lowers the threshold
+        const int rows = std::accumulate(s.count.begin(), s.count.end(), 0), conditions = int(s.count.size());
+        for (int m = 1; m <= kMaxSeparationMultiplier; ++m)
+            if (m * sep.expected_chi2_difference >= gsl_cdf_fdist_Pinv(level, 1.0, double(m * rows - conditions))) {
+                sep.multiplier = m;
+                break;
+            }
+        for (std::size_t c = 0; c < part.size(); ++c) sep.conditions.push_back(int(c));
+        std::stable_sort(sep.conditions.begin(), sep.conditions.end(), [&](int a, int b) { return part[a] > part[b]; });
+        for (int c : sep.conditions) sep.shares.push_back(part[std::size_t(c)] / sep.expected_chi2_difference);
+    }
+    return sep;
+}
+
+// The separation in words: how many repeats and seeds, where the two differ most.
+std::string separation_advice(const DemRivalSeparation& sep, const SiloMeasurements& data, const ConditionStats& s,
+                              int K, const std::string& effect) {
+    if (!(sep.expected_chi2_difference > 1e-12 * sep.needed_chi2_difference))
+        return "their predictions coincide at every condition measured: no number of repeats separates them here; "
+               "other conditions or another measured quantity can";
+    const int repeats = *std::min_element(s.count.begin(), s.count.end());
+    std::string where;
+    for (std::size_t j = 0; j < sep.conditions.size() && j < 2; ++j)
+        where += (j ? ", " : "") + data.conditions[std::size_t(sep.conditions[j])].label() + " (" +
+                 number_text(100 * sep.shares[j], 2) + " %)";
+    std::string text = "if " + effect + " is right, the expected chi2 difference is " +
+                       number_text(sep.expected_chi2_difference, 3) + " against the " +
+                       number_text(sep.needed_chi2_difference, 3) + " needed: ";
+    if (!std::isfinite(sep.multiplier)) return text + "beyond any affordable number of repeats; other conditions or another "
+                                             "measured quantity can tell them apart";
+    text += number_text(sep.multiplier, 4) + " times the repeats (" + std::to_string(repeats) + " -> " +
+            number_text(repeats * sep.multiplier, 4) + " per condition) and the prediction seeds (--seeds " +
+            std::to_string(K) + " -> " + number_text(K * sep.multiplier, 4) + ")";
+    if (sep.repeats_only_limit < sep.needed_chi2_difference)
+        text += " (more repeats alone reach at most " + number_text(sep.repeats_only_limit, 3) +
+                ": the predictions' own seed noise stays)";
+    return text + " would separate them; they differ most at " + where;
+}
+
 }  // namespace
 
 DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double>& rates_declared,
@@ -511,6 +565,7 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
         c.rmse_declared = c.cv_rmse_declared = std::min(std::sqrt(row_sse(data, s, l_declared) / r.n), r.rmse_before);
         c.chi2_declared = std::min(chi2_of(s, l_declared, K), r.chi2_before);
         c.chi2_fitted = chi2_of(s, l_fit, K);
+        c.log_curve_fitted = l_fit;
         c.f_statistic = std::max(0.0, c.chi2_declared - c.chi2_fitted);
         c.p_value = gsl_cdf_fdist_Q(c.f_statistic, 1.0, double(s.df_pure_error));
         // interval: the connected range around the fit where chi2 stays within the quantile of its minimum
@@ -573,11 +628,13 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
             if (int(k) == r.effect || !c.significant || !c.cv_gain) continue;
             if (c.chi2_fitted - e.chi2_fitted < delta_chi2) {
                 r.rivals.push_back(int(k));
+                const auto sep = rival_separation(s, K, e, c, int(k), o.interval_level);
+                r.separations.push_back(sep);
                 r.warnings.push_back(c.spec.name + " = " + number_text(c.fitted, 4) + " explains the data nearly as well "
                                      "as " + e.spec.name + " (CV RMSE " + number_text(c.cv_rmse, 3) + " against " +
                                      number_text(e.cv_rmse, 3) + ", chi2 " + number_text(c.chi2_fitted, 3) +
                                      " against " + number_text(e.chi2_fitted, 3) + "): these rates cannot tell the two "
-                                     "apart; more conditions, repeats or another measured quantity can");
+                                     "apart; " + separation_advice(sep, data, s, K, e.spec.name));
             }
         }
     }
@@ -647,6 +704,20 @@ nlohmann::json DemDiagnosis::to_json(const SiloMeasurements& data) const {
         json rival_names = json::array();
         for (int k : rivals) rival_names.push_back(candidates[std::size_t(k)].spec.name);
         effect_json["rivals"] = rival_names;
+        json separations_json = json::array();
+        for (const auto& sep : separations) {
+            json where = json::array();
+            for (std::size_t j = 0; j < sep.conditions.size(); ++j)
+                where.push_back({{"condition", data.conditions[std::size_t(sep.conditions[j])].label()},
+                                 {"share", sep.shares[j]}});
+            separations_json.push_back({{"rival", candidates[std::size_t(sep.rival)].spec.name},
+                                        {"expected_chi2_difference", sep.expected_chi2_difference},
+                                        {"needed_chi2_difference", sep.needed_chi2_difference},
+                                        {"repeats_only_limit", sep.repeats_only_limit},
+                                        {"repeats_and_seeds_multiplier", num(sep.multiplier)},
+                                        {"conditions_by_share", where}});
+        }
+        effect_json["rival_separation"] = separations_json;
     }
     return {{"model", "silo-dem"},
             {"n", n},

@@ -112,10 +112,28 @@ struct DemCandidateResult {
     double f_statistic = NAN, p_value = NAN, p_holm = NAN;
     bool significant = false, cv_gain = false, accepted = false;
     std::vector<double> rates_fitted;       // raw runs at the fitted value, per condition [g/s]
+    std::vector<double> log_curve_fitted;   // the smoothed prediction at the fitted value, log rate per condition
     std::vector<double> fitted_without;     // per condition: the value refitted without it (CV)
     // values run at which some condition did not discharge (an arch or a jam: no rate to fit); the search is then
     // confined to the flowing side of the smallest such value beyond the declared one (spec's bounds narrowed)
     std::vector<double> stops_flow;
+};
+
+// What would tell the named effect from a rival, if the effect is the truth (a model-discrimination design, the
+// T-optimality criterion of Atkinson and Fedorov): the rival's smoothed prediction misses the effect's by d_c at
+// condition c, so with n_c measured repeats and K prediction seeds its chi2 exceeds the effect's by about
+// sum d_c^2 / (s^2 (1/n_c + 1/K)). Scaling both n_c and K by m scales that by m; repeats alone cannot pass
+// sum d_c^2 K / s^2, since the predictions' own seed noise stays.
+struct DemRivalSeparation {
+    int rival = -1;                        // index into candidates
+    double expected_chi2_difference = 0;   // with the data's repeats and the prediction seeds of this diagnosis
+    double needed_chi2_difference = 0;     // the interval's F(1, df) quantile: the rival test's threshold
+    double repeats_only_limit = 0;         // the expected difference with unlimited repeats, K seeds
+    double multiplier = INFINITY;          // the smallest whole m (repeats and seeds times m) whose expected
+                                           // difference passes the threshold at its own degrees of freedom;
+                                           // inf: more than 1000, or the predictions are equal
+    std::vector<int> conditions;           // by share of the expected difference, largest first
+    std::vector<double> shares;            // the same order, fractions summing to 1
 };
 
 struct DemDiagnosis {
@@ -126,6 +144,7 @@ struct DemDiagnosis {
     std::vector<DemCandidateResult> candidates;
     int effect = -1;  // index into candidates of the effect named, -1: none
     std::vector<int> rivals;  // candidates that explain the data about as well as the effect (see diagnose_dem)
+    std::vector<DemRivalSeparation> separations;  // one per rival, same order
     double rmse_after = NAN, rmse_after_g_s = NAN, cv_rmse_after = NAN, lack_of_fit_p_after = NAN;
     std::vector<double> rates_after;  // per condition [g/s] (= declared when no effect)
     std::vector<std::string> warnings;

@@ -14,6 +14,7 @@ struct SyntheticSilo {
     double sensitivity = 3.0;    // k
     double arches_from = INFINITY;
     double steep_near = 0;
+    double angle_slope = 0;      // w: the effect's strength varies with the angle, k p (1 + w (theta - 35) / 15)
 
     double response(double p) const {
         return steep_near > 0 ? 1.0 - 0.5 * std::pow(p / steep_near, 8) : std::exp(-sensitivity * p);
@@ -21,9 +22,10 @@ struct SyntheticSilo {
 
     double rate(double theta, double p) const {
         if (p >= arches_from && theta >= 30) return NAN;
-        return 200.0 * (1.0 - theta / 100.0) * response(p);
+        return 200.0 * (1.0 - theta / 100.0) * response(p * (1 + angle_slope * (theta - 35) / 15));
     }
-    analytics::SiloMeasurements measured(double p_true) const {
+    // repeats: times the scatter pattern -2 %, 0, +2 % per condition
+    analytics::SiloMeasurements measured(double p_true, int repeats = 1) const {
         analytics::SiloMeasurements m;
         m.source = "synthetic";
         const double thetas[] = {20, 30, 40, 50};
@@ -33,6 +35,7 @@ struct SyntheticSilo {
             analytics::SiloCondition cond;
             cond.theta_deg = thetas[c];
             m.conditions.push_back(cond);
+            for (int rep = 0; rep < repeats; ++rep)
             for (double e : scatter) {
                 m.condition_of_row.push_back(c);
                 m.rate_g_s.push_back(rate(thetas[c], p_true) * (1 + e));

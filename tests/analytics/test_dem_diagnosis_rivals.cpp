@@ -27,6 +27,53 @@ TEST_CASE("silo-dem: a candidate that explains the data as well as the effect is
     for (const auto& w : r.warnings) warned = warned || w.find("cannot tell the two apart") != std::string::npos;
     CHECK(warned);
     CHECK(r.to_json(data)["effect"]["rivals"].size() == 1);
+    // the two predict the same rate at every condition: no number of repeats tells them apart
+    REQUIRE(r.separations.size() == 1);
+    CHECK_FALSE(std::isfinite(r.separations[0].multiplier));
+}
+
+TEST_CASE("silo-dem: a rival's separation design (repeats and seeds times m) does separate it when applied",
+          "[diagnose][silo-dem]") {
+    // the truth's effect is the same at every angle; the rival's grows with the angle by 8 % per 15 deg: close
+    // enough to be a rival at 3 repeats and 1 prediction seed
+    const SyntheticSilo truth{3.0};
+    SyntheticSilo tilted{3.0};
+    tilted.angle_slope = 0.08;
+    int calls = 0;
+    const auto diagnose = [&](const an::SiloMeasurements& data, int seeds) {
+        an::DemDiagnoseOptions o;
+        o.prediction_seeds = seeds;
+        return an::diagnose_dem(data, truth.rates(data, 0.0),
+                                {truth.candidate("cohesion", "grain_grain.surface_energy_J_m2", 0.3, data, &calls),
+                                 tilted.candidate("rolling_friction", "grain_grain.rolling_friction", 0.3, data, &calls)},
+                                o);
+    };
+    const auto data = truth.measured(0.1);
+    const auto r = diagnose(data, 1);
+    REQUIRE(r.effect == 0);
+    REQUIRE(r.rivals == std::vector<int>{1});
+    REQUIRE(r.separations.size() == 1);
+    const auto& sep = r.separations[0];
+    INFO("expected " << sep.expected_chi2_difference << ", needed " << sep.needed_chi2_difference << ", multiplier "
+                     << sep.multiplier);
+    CHECK(sep.expected_chi2_difference < sep.needed_chi2_difference);
+    REQUIRE(sep.multiplier >= 2);
+    REQUIRE(sep.multiplier <= 10);
+    // they differ most at the extreme angles (20 and 50 deg), least in the middle
+    const auto first = data.conditions[std::size_t(sep.conditions[0])].theta_deg;
+    const auto last = data.conditions[std::size_t(sep.conditions.back())].theta_deg;
+    CHECK((first == 20 || first == 50));
+    CHECK((last == 30 || last == 40));
+    CHECK(r.to_json(data)["effect"]["rival_separation"][0]["repeats_and_seeds_multiplier"] == sep.multiplier);
+    // apply the design: m times the repeats and the seeds
+    const int m = int(sep.multiplier);
+    const auto more = truth.measured(0.1, m);
+    const auto r_more = diagnose(more, m);
+    REQUIRE(r_more.effect == 0);
+    CHECK(r_more.rivals.empty());
+    // one step short of it, the rival stays: the design asks for no more than it needs
+    const auto fewer = truth.measured(0.1, m - 1);
+    CHECK(diagnose(fewer, m - 1).rivals.size() == 1);
 }
 
 TEST_CASE("silo-dem: a candidate that fits clearly worse is no rival", "[diagnose][silo-dem]") {
