@@ -370,19 +370,25 @@ DemRivalSeparation rival_separation(const ConditionStats& s, int K, const DemCan
     sep.needed_chi2_difference = gsl_cdf_fdist_Pinv(level, 1.0, double(s.df_pure_error));
     std::vector<double> part;
     for (std::size_t c = 0; c < s.mean.size(); ++c) {
+        const double var = s.s2 * (1.0 / s.count[c] + 1.0 / K);
         const double d = effect.log_curve_fitted[c] - rival.log_curve_fitted[c];
-        part.push_back(d * d / (s.s2 * (1.0 / s.count[c] + 1.0 / K)));
+        const double miss_e = s.mean[c] - effect.log_curve_fitted[c], miss_r = s.mean[c] - rival.log_curve_fitted[c];
+        const double observed = (miss_r * miss_r - miss_e * miss_e) / var;
+        part.push_back(d * d / var);
         sep.expected_chi2_difference += part.back();
-        sep.repeats_only_limit += d * d * K / s.s2;
+        sep.observed_chi2_difference += observed;
+        sep.repeats_only_limit += observed * (1.0 + double(K) / s.count[c]);  // var -> s^2 / K
     }
-    if (sep.expected_chi2_difference > 0) {
+    if (sep.observed_chi2_difference > 0) {
         // m times the repeats also gives the pure error m N - C degrees of freedom, which lowers the threshold
         const int rows = std::accumulate(s.count.begin(), s.count.end(), 0), conditions = int(s.count.size());
         for (int m = 1; m <= kMaxSeparationMultiplier; ++m)
-            if (m * sep.expected_chi2_difference >= gsl_cdf_fdist_Pinv(level, 1.0, double(m * rows - conditions))) {
+            if (m * sep.observed_chi2_difference >= gsl_cdf_fdist_Pinv(level, 1.0, double(m * rows - conditions))) {
                 sep.multiplier = m;
                 break;
             }
+    }
+    if (sep.expected_chi2_difference > 0) {
         for (std::size_t c = 0; c < part.size(); ++c) sep.conditions.push_back(int(c));
         std::stable_sort(sep.conditions.begin(), sep.conditions.end(), [&](int a, int b) { return part[a] > part[b]; });
         for (int c : sep.conditions) sep.shares.push_back(part[std::size_t(c)] / sep.expected_chi2_difference);
@@ -401,18 +407,27 @@ std::string separation_advice(const DemRivalSeparation& sep, const SiloMeasureme
     for (std::size_t j = 0; j < sep.conditions.size() && j < 2; ++j)
         where += (j ? ", " : "") + data.conditions[std::size_t(sep.conditions[j])].label() + " (" +
                  number_text(100 * sep.shares[j], 2) + " %)";
-    std::string text = "if " + effect + " is right, the expected chi2 difference is " +
-                       number_text(sep.expected_chi2_difference, 3) + " against the " +
-                       number_text(sep.needed_chi2_difference, 3) + " needed: ";
-    if (!std::isfinite(sep.multiplier)) return text + "beyond any affordable number of repeats; other conditions or another "
-                                             "measured quantity can tell them apart";
-    text += number_text(sep.multiplier, 4) + " times the repeats (" + std::to_string(repeats) + " -> " +
-            number_text(repeats * sep.multiplier, 4) + " per condition) and the prediction seeds (--seeds " +
-            std::to_string(K) + " -> " + number_text(K * sep.multiplier, 4) + ")";
-    if (sep.repeats_only_limit < sep.needed_chi2_difference)
-        text += " (more repeats alone reach at most " + number_text(sep.repeats_only_limit, 3) +
-                ": the predictions' own seed noise stays)";
-    return text + " would separate them; they differ most at " + where;
+    std::string text = "the chi2 difference is " + number_text(sep.observed_chi2_difference, 3) + " against the " +
+                       number_text(sep.needed_chi2_difference, 3) + " needed; ";
+    if (!std::isfinite(sep.multiplier)) {
+        text += sep.observed_chi2_difference > 0 ? "more than 1000 times the repeats would be needed"
+                                                 : "these rates do not favour " + effect + " over it at all";
+    } else {
+        text += "if it grows in proportion, " + number_text(sep.multiplier, 4) + " times the repeats (" +
+                std::to_string(repeats) + " -> " + number_text(repeats * sep.multiplier, 4) +
+                " per condition) and the prediction seeds (--seeds " + std::to_string(K) + " -> " +
+                number_text(K * sep.multiplier, 4) + ") would separate them";
+        if (sep.repeats_only_limit < sep.needed_chi2_difference)
+            text += " (more repeats alone reach at most " + number_text(sep.repeats_only_limit, 3) +
+                    ": the predictions' own seed noise stays)";
+    }
+    text += "; their predictions differ most at " + where;
+    // T-optimal view: were the effect exactly right, the data would sit on its curve, at this distance from the rival's
+    if (sep.expected_chi2_difference >= sep.needed_chi2_difference &&
+        sep.observed_chi2_difference < sep.needed_chi2_difference)
+        text += "; were " + effect + " exactly right, these repeats would already show about " +
+                number_text(sep.expected_chi2_difference, 3) + ": the rates lie between the two predictions";
+    return text;
 }
 
 }  // namespace
@@ -711,6 +726,7 @@ nlohmann::json DemDiagnosis::to_json(const SiloMeasurements& data) const {
                 where.push_back({{"condition", data.conditions[std::size_t(sep.conditions[j])].label()},
                                  {"share", sep.shares[j]}});
             separations_json.push_back({{"rival", candidates[std::size_t(sep.rival)].spec.name},
+                                        {"observed_chi2_difference", sep.observed_chi2_difference},
                                         {"expected_chi2_difference", sep.expected_chi2_difference},
                                         {"needed_chi2_difference", sep.needed_chi2_difference},
                                         {"repeats_only_limit", sep.repeats_only_limit},

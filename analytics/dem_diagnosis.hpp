@@ -119,19 +119,21 @@ struct DemCandidateResult {
     std::vector<double> stops_flow;
 };
 
-// What would tell the named effect from a rival, if the effect is the truth (a model-discrimination design, the
-// T-optimality criterion of Atkinson and Fedorov): the rival's smoothed prediction misses the effect's by d_c at
-// condition c, so with n_c measured repeats and K prediction seeds its chi2 exceeds the effect's by about
-// sum d_c^2 / (s^2 (1/n_c + 1/K)). Scaling both n_c and K by m scales that by m; repeats alone cannot pass
-// sum d_c^2 K / s^2, since the predictions' own seed noise stays.
+// What would tell the named effect from a rival. The rival test compares the chi2 of the two fits; with n_c measured
+// repeats and K prediction seeds each condition weighs 1 / (s^2 (1/n_c + 1/K)), so if the data's means stay where
+// they are, m times the repeats and the seeds multiply the observed difference by m (repeats alone approach a limit:
+// the predictions' seed noise stays). The shares say where the two smoothed predictions differ most, and the
+// expected difference sum d_c^2 / (s^2 (1/n_c + 1/K)) is what the data would show were the named effect exactly right
+// (the T-optimality criterion of model discrimination, Atkinson and Fedorov 1975).
 struct DemRivalSeparation {
     int rival = -1;                        // index into candidates
-    double expected_chi2_difference = 0;   // with the data's repeats and the prediction seeds of this diagnosis
+    double observed_chi2_difference = 0;   // the rival's chi2 minus the effect's
+    double expected_chi2_difference = 0;   // were the effect exactly right, with these repeats and seeds
     double needed_chi2_difference = 0;     // the interval's F(1, df) quantile: the rival test's threshold
-    double repeats_only_limit = 0;         // the expected difference with unlimited repeats, K seeds
-    double multiplier = INFINITY;          // the smallest whole m (repeats and seeds times m) whose expected
-                                           // difference passes the threshold at its own degrees of freedom;
-                                           // inf: more than 1000, or the predictions are equal
+    double repeats_only_limit = 0;         // the observed difference with unlimited repeats, K seeds
+    double multiplier = INFINITY;          // the smallest whole m (repeats and seeds times m) whose observed
+                                           // difference times m passes the threshold at its own degrees of
+                                           // freedom; inf: more than 1000, or no difference in the effect's favour
     std::vector<int> conditions;           // by share of the expected difference, largest first
     std::vector<double> shares;            // the same order, fractions summing to 1
 };

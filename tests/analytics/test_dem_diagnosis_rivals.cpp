@@ -57,6 +57,8 @@ TEST_CASE("silo-dem: a rival's separation design (repeats and seeds times m) doe
     INFO("expected " << sep.expected_chi2_difference << ", needed " << sep.needed_chi2_difference << ", multiplier "
                      << sep.multiplier);
     CHECK(sep.expected_chi2_difference < sep.needed_chi2_difference);
+    // the data's means are the truth's: what is seen is what the truth would show
+    CHECK(sep.observed_chi2_difference == Approx(sep.expected_chi2_difference).epsilon(0.05));
     REQUIRE(sep.multiplier >= 2);
     REQUIRE(sep.multiplier <= 10);
     // they differ most at the extreme angles (20 and 50 deg), least in the middle
