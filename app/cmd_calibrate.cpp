@@ -18,6 +18,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -367,9 +368,17 @@ void add_enlarge(CLI::App& app) {
             throw UserError("output = '" + o->output + "': must end in .json");
         check_output_file(o->output, "output");
         std::vector<double> r, e, nu;
+        std::map<double, std::string> file_of_radius;
         for (const auto& file : o->materials) {
             const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
-            r.push_back(m.at("particle_radius").get<double>());
+            const double radius = m.at("particle_radius").get<double>();
+            // the same radius twice (often the same file twice) is a point counted twice: it fakes the degrees of
+            // freedom the intervals stand on (two radii given three times fitted "exactly", +/- 1e-15)
+            if (const auto [it, fresh] = file_of_radius.emplace(radius, file); !fresh)
+                throw UserError("materials: '" + analytics::shortened_text(file, 200) + "' and '" +
+                                analytics::shortened_text(it->second, 200) + "' both have particle_radius = " +
+                                analytics::number_text(radius) + " m; give one calibrated material per radius");
+            r.push_back(radius);
             e.push_back(m.at("young_modulus").get<double>());
             nu.push_back(m.at("poisson_ratio").get<double>());
         }

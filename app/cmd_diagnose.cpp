@@ -7,6 +7,7 @@
 #include "app/commands.hpp"
 #include "app/diagnose_silo_dem.hpp"
 #include "app/gnuplot.hpp"
+#include "orchestrator/run_identity.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -41,10 +42,11 @@ void write_text(const std::string& path, const std::string& text) {
     // the folders an output path names are created (checked creatable before any work)
     if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
         std::filesystem::create_directories(folder);
-    std::ofstream out(path);
-    if (!out) throw UserError("cannot write " + path);
-    out << text;
-    if (!out) throw UserError("failed writing " + path);
+    try {
+        orchestrator::write_text_file_atomically(path, text);  // whole or not at all
+    } catch (const std::exception& e) {
+        throw UserError("cannot write " + path + ": " + e.what());
+    }
 }
 
 std::string fixed(double v, int digits) {
@@ -54,6 +56,7 @@ std::string fixed(double v, int digits) {
 }
 
 void run_predict(const std::string& geometry_path, const std::string& json_out) {
+    check_output_file_in_new_folders(json_out, "--json");  // before anything is printed as a result
     analytics::SiloGeometry geometry;
     try {
         geometry = analytics::geometry_from_json(read_json_file(geometry_path, "predict"));

@@ -340,6 +340,9 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.geometry = geometry_from(o, sub);
     if (sub.count("--particles") && sub.count("--fill-mass"))
         throw UserError("--particles and --fill-mass both set the amount of grain; give one");
+    // 0 is the setting's "not given": given on the command line it must be a real amount, not the default's signal
+    if (sub.count("--fill-mass") && !(o.fill_mass > 0))
+        throw UserError("--fill-mass = " + ks::setting_text(o.fill_mass) + ": must be > 0 kg (or give --particles)");
     if (sub.count("--vtk-every") && o.vtk.empty())
         throw UserError("--vtk-every applies to the VTK snapshots: add --vtk DIR");
     if (o.seed < 0) throw UserError("seed = " + std::to_string(o.seed) + ": must be >= 0");

@@ -24,6 +24,7 @@ CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& 
     const fs::path lock = dir_ / ".lock";
     // O_CLOEXEC: children must not inherit the lock, or a resume right after kill -9 of the orchestrator finds the
     // directory "in use" until the last orphan has died.
+    const bool lock_existed = fs::exists(lock, ec);
     lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (lock_fd_ < 0) throw std::runtime_error("cannot open " + lock.string());
     if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
@@ -33,6 +34,8 @@ CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& 
     try {
         store_ = std::make_unique<CampaignStore>(dir_ / "campaign.sqlite");
     } catch (...) {
+        // a file that is not our store was refused: leave its folder as it was found (no lock file of ours in it)
+        if (!lock_existed) ::unlink(lock.c_str());
         ::close(lock_fd_);
         throw;
     }

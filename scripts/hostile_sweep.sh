@@ -2,6 +2,8 @@
 # Hostile-input sweep of the commands added since the last hardening pass (issue 23): shear-run, shear --engine
 # kernel, crosscheck shear, crosscheck silo (--fill), scale, cutoff, vibration, silo --export-bed/--export-cloud,
 # --forget-contact-history and the --vibration-* options (--vibration-part, --part), diagnose silo-dem --max-runs.
+# Then the examples the issue itself lists, on the older commands (predict, silo --fill-mass, status and resume on a
+# store that is not demcal's, calibrate targets, enlarge).
 # Each case runs the real demcal under `timeout` in a scratch folder and checks:
 #   - the exit code (2 for bad input unless the case says otherwise), never a signal (>= 128) nor a timeout (124);
 #   - the message names the option or field (EXPECT) and is short (a huge value is shortened, stderr < 4 kB);
@@ -11,7 +13,7 @@
 # simulation when demcal behaves; a hang costs the case's time limit, 20 s).
 set -u
 here="$(cd "$(dirname "$0")/.." && pwd)"
-build="${1:-$here/build}"
+build="$(cd "${1:-$here/build}" 2>/dev/null && pwd)" || { echo "no build folder ${1:-$here/build}"; exit 1; }
 demcal="$build/app/demcal"
 [ -x "$demcal" ] || { echo "no demcal at $demcal (build first)"; exit 1; }
 limit="${DEMCAL_SWEEP_TIMEOUT:-20}"
@@ -282,6 +284,37 @@ run_case diagnose-dem/max-runs-nan   2 "--max-runs"      -- "${D[@]}" --max-runs
 run_case diagnose-dem/max-runs-huge  2 "--max-runs"      -- "${D[@]}" --max-runs "$huge" -- --particles 200
 run_case diagnose-dem/plan-too-big   2 "--max-runs = 100" -- "${D[@]}" --max-runs 100 --seeds 20 -- --particles 200
 run_case diagnose-dem/max-runs-oldal 2 "--max-runs"      -- diagnose --model oldal --data "$work/rates.csv" --max-runs 5
+
+# ---- the issue's own examples on the older commands (replayed 2026-12-03) --------------------------------------------
+G="$work/geometry.json"
+printf '{"geometry":"conical","D_m":0.105,"outlet_m":0.035,"theta_deg":30,"d_p_m":0.004,"rho_b_kg_m3":780}' > "$G"
+sed 's/"theta_deg":30/"theta_deg":1e-320/' "$G" > "$work/geometry_theta_sub.json"
+sed 's/"rho_b_kg_m3":780/"rho_b_kg_m3":1e308/' "$G" > "$work/geometry_rho_huge.json"
+run_case predict/theta-subnormal     2 "theta_deg"       -- predict "$work/geometry_theta_sub.json"
+run_case predict/density-1e308       2 "rho_b_kg_m3"     -- predict "$work/geometry_rho_huge.json"
+run_case predict/geometry-deep       2 "nest"            -- predict "$work/deep.json"
+run_case predict/json-folder         2 "folder.json"     -- predict "$G" --json "$work/folder.json"
+run_case silo/fill-mass-0            2 "--fill-mass = 0" -- silo --theta 30 --fill-mass 0 --check
+run_case silo/fill-mass-below-grain  2 "fill_mass"       -- silo --theta 30 --fill-mass 1e-9 --check
+run_case silo/seed-2^64              2 "--seed"          -- silo --theta 30 --seed 18446744073709551616 --check
+mkdir -p "$work/zero_store" "$work/foreign_store"
+: > "$work/zero_store/campaign.sqlite"
+python3 -c "import sqlite3,sys; c=sqlite3.connect(sys.argv[1]); c.execute('create table foo(x)'); c.commit()" \
+  "$work/foreign_store/campaign.sqlite"
+for store in zero_store foreign_store; do  # the folder is watched: not even a lock file may be left in it
+    run_case "status/$store"         2 "not a demcal campaign store" "$work/$store" -- status "$work/$store"
+    run_case "resume/$store"         2 "not a demcal campaign store" "$work/$store" -- resume "$work/$store"
+done
+run_case calibrate/tau-c-negative    2 "tau_c = -100"    -- calibrate --target mu_b=0.5,tau_c=-100 --start "$tiny" -c camp
+run_case calibrate/measured-negative 2 "measured point 1" -- calibrate --measured -5000:3000,1e4:6e3,1.5e4:9e3 --start "$tiny" -c camp
+python3 - "$tiny" "$work" <<'EOF2'
+import json, sys
+m = json.load(open(sys.argv[1]))
+for r in (0.0025, 0.003):
+    m.update(particle_radius=r, young_modulus=1e10 * r + 5e6, poisson_ratio=0.01 / r ** 0.5, box_height=0.05)
+    json.dump(m, open("%s/enlarge_%g.json" % (sys.argv[2], r), "w"))
+EOF2
+run_case enlarge/same-radius-twice   2 "both have particle_radius" -- enlarge --no-plot -o e.json "$work/enlarge_0.0025.json" "$work/enlarge_0.003.json" "$work/enlarge_0.003.json"
 
 echo
 echo "hostile sweep: $pass passed, $fail failed"

@@ -227,6 +227,8 @@ void validate(const SiloCaseSettings& s) {
     constexpr double kMaxGrains = 5e6;  // 15e6 spheres: about 9 GB of state, beyond any machine this runs on
     if (s.particles > kMaxGrains) reject_setting("particles", double(s.particles), "more than 5,000,000 grains");
     const double grain_mass = s.materials.wheat.density * wheat_grain_volume();
+    if (s.fill_mass > 0 && s.fill_mass < 0.5 * grain_mass)  // would round to no grain (it was silently one)
+        reject_setting("fill_mass", s.fill_mass, "less than one grain of " + setting_text(grain_mass * 1e3) + " g");
     if (s.fill_mass / grain_mass > kMaxGrains)
         reject_setting("fill_mass", s.fill_mass,
                        "more than 5,000,000 grains of " + setting_text(grain_mass * 1e3) + " g");

@@ -176,6 +176,7 @@ TEST_CASE("status and resume refuse a file that is not a demcal store without wr
         const std::string log = test::read_file(dir / "out.log");
         CHECK_THAT(log, Contains((dir / "campaign.sqlite").string()) && Contains("is empty (0 bytes)"));
         CHECK(fs::file_size(dir / "campaign.sqlite") == 0);
+        CHECK_FALSE(fs::exists(dir / ".lock"));  // the folder as it was found: not even the lock file is left
     }
     fs::remove_all(dir);
 }
@@ -224,6 +225,24 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
                            dir / "resume.log") == 0);
     INFO(test::read_file(dir / "resume.log"));
     for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::done);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal enlarge refuses a radius given twice (one file twice was fitted exactly) and writes nothing", "[cli]") {
+    const fs::path dir = test::fresh_test_dir("cli-enlarge-same-radius");
+    auto material = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand.json")));
+    std::vector<std::string> args{"enlarge", "--no-plot", "-o", (dir / "e.json").string()};
+    for (double r : {0.0025, 0.003}) {
+        material["particle_radius"] = r;
+        material["young_modulus"] = 1e10 * r + 5e6;
+        material["poisson_ratio"] = 0.01 / std::sqrt(r);
+        args.push_back((dir / ("r" + std::to_string(args.size()) + ".json")).string());
+        std::ofstream(args.back()) << material.dump();
+    }
+    args.push_back(args.back());  // two radii, three points: reported R^2 1 and intervals of 1e-15
+    CHECK(test::run_demcal(args, dir / "out.log") == 2);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("both have particle_radius = 0.003 m"));
+    CHECK_FALSE(fs::exists(dir / "e.json"));
     fs::remove_all(dir);
 }
 

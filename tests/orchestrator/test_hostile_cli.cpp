@@ -102,8 +102,11 @@ TEST_CASE("output paths are tried for real before any work: a folder nobody can 
         p["seed"] = 1;
         std::ofstream(params) << p.dump();
     }
+    const std::string geometry = test::source_path("examples/silo/seed_conical_30deg.json").string();
     refused({{{"cutoff", "--bond-number", "10", "--json", "/proc/cutoff.json"},
               {"--json = '/proc/cutoff.json'", "the folder /proc is not writable"}},
+             // predict printed its table, then failed on the JSON
+             {{"predict", geometry, "--json", "/proc/predict.json"}, {"--json = '/proc/predict.json'", "not writable"}},
              // the kernel engine's run: the result's place is checked before the shear box runs (exit 2, not 3)
              {{"shear-run", params, "/proc/result.json"}, {"DEMCAL_FAILURE output", "result = '/proc/result.json'"}},
              {{"shear-run", params, dir.string()}, {"DEMCAL_FAILURE output", "is a folder"}},
@@ -137,6 +140,18 @@ TEST_CASE("silo: a time step that never lets the run end, or a snapshot every st
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--vtk", (dir / "v").string(), "--vtk-every",
                "1e-300"},
               {"--vtk-every 1e-300 s", "snapshots, more than 100000"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("silo: a fill mass of 0 or of less than one grain is refused, not run as the default or as one grain",
+          "[cli]") {
+    // --fill-mass 0 was the setting's "not given" and ran 50,000 grains; 1e-9 kg ran one grain
+    const fs::path root = test::fresh_test_dir("hostile-silo-fill-mass"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string out = (dir / "o").string();
+    refused({{{"silo", "--theta", "30", "--out", out, "--fill-mass", "0"}, {"--fill-mass = 0: must be > 0 kg"}},
+             {{"silo", "--theta", "30", "--out", out, "--fill-mass", "1e-9"}, {"fill_mass", "less than one grain"}}},
             dir);
     fs::remove_all(root);
 }
