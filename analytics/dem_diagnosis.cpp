@@ -60,6 +60,16 @@ const std::vector<DemEffectCandidate>& dem_effect_candidates() {
          "grain-grain cohesion (moisture, fines, fat: JKR surface energy), which slows and finally arches the flow; the "
          "grain-wall adhesion keeps its declared value",
          0.0},
+        // the grain family of kernel/silo/wheat.hpp at the seed's volume: 1.2 is nearly a sphere, 2.5 a long grain
+        // (wheat kernels measure about 1.6-2.3); 11/6 is the seed's clump, what a material without the field has
+        {"grain_elongation",
+         {"grain.aspect_ratio"},
+         1.2,
+         2.5,
+         ParameterScale::linear,
+         "grain shape: the length / width of the 3-sphere grain at the declared volume (variety, a clump built from "
+         "another grain's photographs); an elongated grain interlocks and aligns, a rounder one rolls",
+         11.0 / 6.0},
     };
     return table;
 }

@@ -1,8 +1,10 @@
 // demcal predict GEOMETRY.json: every discharge model's rate with its validity.
 // demcal diagnose --model M --data F.csv: fit, residual diagnosis, the effect the model lacks, before/after errors.
+#include "analytics/dem_diagnosis.hpp"
 #include "analytics/diagnose.hpp"
 #include "analytics/discharge_models.hpp"
 #include "analytics/measured_data.hpp"
+#include "analytics/number_text.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/diagnose_silo_dem.hpp"
@@ -103,9 +105,29 @@ See examples/diagnose/README.md.)";
 constexpr const char* silo_dem_help = R"(--model silo-dem --material M.json [--campaign DIR] [--jobs N] [-- silo options]:
   data: theta_deg, rate_g_s (g/s), optional outlet_m, D_m, body_height_m (conical), replicate; repeats as rows.
   Every condition is predicted by demcal silo with the declared material (a resumable, cached campaign); the
-  residuals are traced to a DEM effect among rolling_friction, wall_friction, restitution and cohesion (grain-grain
-  JKR surface energy; a material without it has none), or those named by --candidates, each fitted (coarse
-  bracket, refinement), tested (F against the repeat scatter, Holm) and cross-validated leaving one condition out.)";
+  residuals are traced to a DEM effect among the candidates below (or those named by --candidates), each fitted
+  (coarse bracket, refinement), tested (F against the repeat scatter, Holm) and cross-validated leaving one
+  condition out. A material without a candidate's field has the reader's default (no cohesion; the seed's grain).
+  Candidates (material fields, bounds):)";
+
+// The candidate table as the help lists it: one line each, from the table itself.
+std::string candidate_help() {
+    std::string text;
+    for (const auto& c : analytics::dem_effect_candidates()) {
+        std::string fields;
+        for (const auto& f : c.fields) fields += (fields.empty() ? "" : ", ") + f;
+        text += "\n    " + c.name + " (" + fields + ", " + analytics::number_text(c.lower) + " to " +
+                analytics::number_text(c.upper) + ")";
+    }
+    return text;
+}
+
+// "all of a, b, c" for --candidates' help.
+std::string candidate_names() {
+    std::string names;
+    for (const auto& c : analytics::dem_effect_candidates()) names += (names.empty() ? "" : ", ") + c.name;
+    return names;
+}
 
 std::string sci(double v) {
     if (!std::isfinite(v)) return "n/a";
@@ -425,14 +447,14 @@ void add_discharge_commands(CLI::App& app) {
         ->capture_default_str()
         ->check(integer_in(1, 1000000000));
     diagnose->add_option("--candidates", dem.candidates,
-                         "silo-dem: the DEM effects to try, by name (default: all of rolling_friction, wall_friction, "
-                         "restitution, cohesion; e.g. wall_friction,cohesion)")
+                         "silo-dem: the DEM effects to try, by name (default: all of " + candidate_names() +
+                             "; e.g. wall_friction,cohesion)")
         ->allow_extra_args(false)  // (one value, split at commas: not the silo options after --)
         ->delimiter(',');
     diagnose->add_option("silo_args", dem.silo_args,
                          "silo-dem, after --: options of every demcal silo run (e.g. --geometry G --particles 2000 "
                          "--stiffness-scale 0.001 --fill-time 0.5 --threads 1 --no-plots)");
-    diagnose->footer(std::string(diagnose_help) + "\n\n" + silo_dem_help);
+    diagnose->footer(std::string(diagnose_help) + "\n\n" + silo_dem_help + candidate_help());
     diagnose->callback([args, diagnose] {
         if (args->model == "silo-dem") {
             for (const char* option : kAnalyticalOnlyOptions)

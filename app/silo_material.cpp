@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 
+#include "analytics/number_text.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 
@@ -40,7 +41,7 @@ double number(const json& j, const std::string& file, const std::string& field, 
 ks::Material solid(const json& root, const std::string& file, const std::string& field, bool grain) {
     if (!root.contains(field)) throw UserError(file + ": " + field + " is missing");
     std::set<std::string> keys{"shear_modulus_Pa", "young_Pa", "poisson", "density_kg_m3"};
-    if (grain) keys.insert("shape");
+    if (grain) keys.insert({"shape", "aspect_ratio"});
     const json& j = object_with(root.at(field), file, field, keys);
     if (grain && j.contains("shape") && j.at("shape") != "wheat-clump")
         throw UserError(file + ": " + field + ".shape = " + j.at("shape").dump().substr(0, 40) +
@@ -54,6 +55,18 @@ ks::Material solid(const json& root, const std::string& file, const std::string&
     m.shear_modulus = has_g ? number(j, file, field, "shear_modulus_Pa")
                             : number(j, file, field, "young_Pa") / (2 * (1 + m.poisson));
     return m;
+}
+
+// The grain's length over its width (optional: the seed's 11/6); the family and its bounds: kernel/silo/wheat.hpp.
+double grain_aspect_ratio(const json& root, const std::string& file) {
+    const json& grain = root.at("grain");
+    if (!grain.contains("aspect_ratio")) return ks::wheat_aspect_ratio;
+    const double ratio = number(grain, file, "grain", "aspect_ratio");
+    if (!(ratio >= ks::min_grain_aspect_ratio && ratio <= ks::max_grain_aspect_ratio))
+        throw UserError(file + ": grain.aspect_ratio = " + analytics::number_text(ratio) +
+                        ": must lie in [1, 2.6] (the grain's length / width: 1 a sphere, the seed's wheat 1.833; "
+                        "beyond 2.6 the three spheres would no longer overlap)");
+    return ratio;
 }
 
 ks::PairCoefficients pair(const json& root, const std::string& file, const std::string& field) {
@@ -74,6 +87,7 @@ ks::WheatMaterials read_silo_material(const std::string& file) {
     object_with(root, file, "", {"name", "description", "grain", "wall", "grain_grain", "grain_wall"});
     ks::WheatMaterials m;
     m.wheat = solid(root, file, "grain", true);
+    m.grain_aspect_ratio = grain_aspect_ratio(root, file);
     m.steel = solid(root, file, "wall", false);
     m.wheat_wheat = pair(root, file, "grain_grain");
     m.wheat_steel = pair(root, file, "grain_wall");
@@ -92,6 +106,8 @@ json silo_material_json(const ks::WheatMaterials& m) {
     };
     json grain = solid(m.wheat);
     grain["shape"] = "wheat-clump";
+    // only when not the seed's: the seed grain's JSON (and the identities built on it) stays as it was
+    if (m.grain_aspect_ratio != ks::wheat_aspect_ratio) grain["aspect_ratio"] = m.grain_aspect_ratio;
     return {{"grain", grain}, {"wall", solid(m.steel)}, {"grain_grain", pair(m.wheat_wheat)},
             {"grain_wall", pair(m.wheat_steel)}};
 }

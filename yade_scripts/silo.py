@@ -56,6 +56,10 @@ def solid_specs(prefix, what, shape=False):
     if shape:
         specs[prefix + ".shape"] = text("grain shape: the seed's 3-sphere clump (the bed file gives its members)",
                                         choices=("wheat-clump",), default="wheat-clump")
+        # the kernel's bounds (kernel/silo/wheat.hpp); the members themselves come from the bed file
+        specs[prefix + ".aspect_ratio"] = number("-", 1.0, 2.6, "grain length / width of the 3-sphere clump "
+                                                 "(the seed's 11/6; the bed file gives its members)",
+                                                 default=11.0 / 6.0)
     return specs
 
 

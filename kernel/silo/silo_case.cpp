@@ -189,9 +189,16 @@ std::vector<Wall> silo_walls(const SiloGeometry& g, int steel, double wall_top,
     return walls;
 }
 
+// The grain's length, which sets the outlet's particle size and the filling's rest criterion.
+double grain_length(const WheatMaterials& m) {
+    return m.grain_aspect_ratio == wheat_aspect_ratio ? wheat_length
+                                                      : clump_length(elongated_wheat_clump(m.grain_aspect_ratio));
+}
+
 double smallest_sphere_rayleigh_step(const WheatMaterials& m) {
     double smallest_radius = 1;
-    for (const auto& sphere : wheat_clump()) smallest_radius = std::min(smallest_radius, sphere.radius);
+    for (const auto& sphere : elongated_wheat_clump(m.grain_aspect_ratio))
+        smallest_radius = std::min(smallest_radius, sphere.radius);
     return rayleigh_time_step(m.wheat_scaled(), smallest_radius);
 }
 
@@ -221,7 +228,11 @@ void validate(const SiloCaseSettings& s) {
     };
     pair(s.materials.wheat_wheat, "grain_grain");
     pair(s.materials.wheat_steel, "grain_wall");
-    validate(s.geometry, wheat_length);
+    if (!(s.materials.grain_aspect_ratio >= min_grain_aspect_ratio &&
+          s.materials.grain_aspect_ratio <= max_grain_aspect_ratio))
+        reject_setting("grain.aspect_ratio", s.materials.grain_aspect_ratio,
+                       "must lie in [1, 2.6] (length / width of the 3-sphere grain; the seed's 1.833)");
+    validate(s.geometry, grain_length(s.materials));
     if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
     if (s.fill_mass == 0 && s.particles < 1) reject_setting("particles", double(s.particles), "must be at least 1");
     constexpr double kMaxGrains = 5e6;  // 15e6 spheres: about 9 GB of state, beyond any machine this runs on
@@ -287,12 +298,14 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
+// Version 8: the grain's aspect ratio at the end of the settings (versions 4 to 7 are read, with the seed's grain).
 // Version 5: the pairs' surface energies (JKR cohesion) at the end of the settings; version 4, the same without them
 // (no cohesion), is read too. Version 4: each section (tag and settings; the case's state; the kernel's state) closed
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 7;
+constexpr int kCheckpointVersion = 8;
+constexpr int kCheckpointVersionWithoutGrainShape = 7;     // grain_aspect_ratio: the seed's
 constexpr int kCheckpointVersionWithoutVibratingPart = 6;  // vibration_part: bin; no outlet-flow frames
 constexpr int kCheckpointVersionWithoutHistoryChoice = 5;  // contacts_at_opening: keep_history
 constexpr int kCheckpointVersionWithoutCohesion = 4;
@@ -359,6 +372,8 @@ void for_each_setting(S& s, F&& f) {
     f("contacts_at_opening", s.contacts_at_opening);
     // since version 7 (the whole bin before)
     f("vibration_part", s.vibration.part);
+    // since version 8 (the seed's grain before)
+    f("grain_aspect_ratio", s.materials.grain_aspect_ratio);
 }
 
 void write_settings(StateWriter& w, const SiloCaseSettings& s) {
@@ -375,6 +390,7 @@ SiloCaseSettings read_settings(StateReader& r, int version) {
         if (version <= kCheckpointVersionWithoutHistoryChoice && std::string_view(name) == "contacts_at_opening")
             return;
         if (version <= kCheckpointVersionWithoutVibratingPart && std::string_view(name) == "vibration_part") return;
+        if (version <= kCheckpointVersionWithoutGrainShape && std::string_view(name) == "grain_aspect_ratio") return;
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
         else r.value(v, name);
     });
@@ -389,7 +405,8 @@ public:
     using Progress = std::function<void(const SiloProgress&)>;
 
     SiloRun(const SiloCaseSettings& s, Progress progress)
-        : s_(s), progress_(std::move(progress)), tmpl_(wheat_clump_template(s.materials.wheat.density)) {
+        : s_(s), progress_(std::move(progress)), tmpl_(wheat_grain_template(s.materials.wheat.density, s.materials.grain_aspect_ratio)),
+          grain_length_(grain_length(s.materials)) {
         validate(s_);
         sim_.set_threads(s_.threads);
         sim_.set_gravity(Vec3(0, 0, -s_.gravity));
@@ -619,7 +636,7 @@ private:
 
     // Filling against the closed plate until the grains are at rest (or the time limit). False: stopped at the
     // session's wall limit.
-    double rest_energy() const { return s_.rest_energy_factor * tmpl_.mass * s_.gravity * wheat_length; }
+    double rest_energy() const { return s_.rest_energy_factor * tmpl_.mass * s_.gravity * grain_length_; }
 
     bool fill() {
         const double rest_energy = this->rest_energy();
@@ -807,6 +824,7 @@ private:
     SiloCaseSettings s_;
     Progress progress_;
     ClumpTemplate tmpl_;
+    double grain_length_;  // [m]
     BasicSimulation<Law> sim_;
     int wheat_ = 0, steel_ = 0, grain_ = 0, plate_ = -1;
     std::shared_ptr<BinVibrationMotion> bin_motion_;  // every wall's law; null: the bin is still
@@ -849,6 +867,8 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string current = prefix + std::to_string(kCheckpointVersion);
     if (tag == current) {
         version = kCheckpointVersion;
+    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutGrainShape)) {
+        version = kCheckpointVersionWithoutGrainShape;
     } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutVibratingPart)) {
         version = kCheckpointVersionWithoutVibratingPart;
     } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutHistoryChoice)) {

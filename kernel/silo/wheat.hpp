@@ -4,6 +4,8 @@
 
 #include <vector>
 
+#include "kernel/clump.hpp"
+
 namespace demcal::kernel::silo {
 
 // One sphere of a rigid clump: centre in the clump's body frame (long axis along x) and radius.
@@ -17,6 +19,12 @@ struct ClumpSphere {
 // axis) and 7.654e-11 kg m^2.
 std::vector<ClumpSphere> wheat_clump();
 inline constexpr double wheat_length = 0.0055;       // end to end [m]: the particle size d_p used for the outlet
+// The seed's grain's length over its width: (2 x 1.5 + 2 x 1.25) / (2 x 1.5) mm.
+inline constexpr double wheat_aspect_ratio = 11.0 / 6.0;
+// Elongations a grain of this family may take: at 1 the end spheres touch the middle one from inside (a sphere); at
+// 8/3 they touch it from outside, beyond which the clump would fall apart into three spheres. 2.6 keeps every
+// member overlapping its neighbour by 4 % of the middle radius.
+inline constexpr double min_grain_aspect_ratio = 1.0, max_grain_aspect_ratio = 2.6;
 inline constexpr double wheat_mass = 3.56e-5;        // seed [kg]
 inline constexpr double wheat_inertia_axial = 2.918e-11;      // seed [kg m^2]
 inline constexpr double wheat_inertia_transverse = 7.654e-11;  // seed [kg m^2]
@@ -24,6 +32,21 @@ inline constexpr double wheat_inertia_transverse = 7.654e-11;  // seed [kg m^2]
 double wheat_grain_volume();
 // Equivalent-volume sphere diameter of the grain: (6 V / pi)^(1/3) = 3.62 mm.
 double wheat_equivalent_diameter();
+
+// A grain of the seed's family with another elongation (length / width = aspect_ratio, within the bounds above):
+// the same three spheres in a row with the seed's radius ratio (1.25 : 1.5), the end spheres moved along the axis,
+// and the whole scaled so that the union keeps the seed grain's volume (so its mass, equivalent diameter and the
+// grain count of a fill mass stay). Elongation alone changes, not size. At the seed's ratio: exactly wheat_clump().
+// Throws std::invalid_argument naming the value outside the bounds.
+std::vector<ClumpSphere> elongated_wheat_clump(double aspect_ratio);
+// End-to-end length of a clump of spheres in a row along x [m].
+double clump_length(const std::vector<ClumpSphere>& spheres);
+// Volume of the union of spheres whose centres lie on the x axis [m^3] (a solid of revolution, integrated exactly
+// between the breakpoints where the outermost sphere changes, by Gauss-Legendre on each piece).
+double coaxial_union_volume(const std::vector<ClumpSphere>& spheres);
+// The mass properties of such a grain at `density` (kernel/clump.hpp). At the seed's ratio the same template as
+// kernel::wheat_clump_template, bit for bit.
+kernel::ClumpTemplate wheat_grain_template(double density, double aspect_ratio);
 
 struct Material {
     double shear_modulus;  // G [Pa]
@@ -50,6 +73,8 @@ struct WheatMaterials {
     // Scales both shear moduli (1 = the seed's values). A softer contact allows a larger time step (dt ~ G^-1/2) at
     // the cost of larger overlaps; the reduced test cases use 0.01 (see examples/silo/README.md).
     double stiffness_scale = 1.0;
+    // Length over width of the grain (elongated_wheat_clump): the seed's 11/6 unless a material says otherwise.
+    double grain_aspect_ratio = wheat_aspect_ratio;
 
     Material wheat_scaled() const { return {wheat.shear_modulus * stiffness_scale, wheat.poisson, wheat.density}; }
     // Whether either pair is cohesive: the silo then runs JKR (with gamma = 0 for a pair without cohesion, which is

@@ -88,7 +88,8 @@ TEST_CASE("silo-dem candidates: the table is sane, its defects are caught, and i
     CHECK(an::candidate_table_defects(table).empty());
     std::vector<std::string> names;
     for (const auto& c : table) names.push_back(c.name);
-    CHECK(names == std::vector<std::string>{"rolling_friction", "wall_friction", "restitution", "cohesion"});
+    CHECK(names == std::vector<std::string>{"rolling_friction", "wall_friction", "restitution", "cohesion",
+                                            "grain_elongation"});
     // the declared wheat lies inside every candidate's bounds (a field it lacks: at the row's absent value, which may
     // be a bound, as no cohesion is), so each candidate is nested in the declared model
     const auto material = nlohmann::json::parse(read_file(kDeclared));
@@ -157,14 +158,15 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
         {"--model silo-dem" + data + campaign + " --material '" + (dir / "m.csv").string() + "' -- " + kTinySilo,
          "--material"},
         {"--model silo-dem" + data + campaign + material + " --candidates wall_friction,moisture -- " + kTinySilo,
-         "--candidates: no DEM effect 'moisture' (known: rolling_friction, wall_friction, restitution, cohesion)"},
+         "--candidates: no DEM effect 'moisture' (known: rolling_friction, wall_friction, restitution, cohesion, "
+         "grain_elongation)"},
         {"--model silo-dem" + data + campaign + material + " --candidates cohesion,cohesion -- " + kTinySilo,
          "--candidates: 'cohesion' named twice"},
-        // 3 conditions x 20 seeds x (1 + 4 candidates x (30 + 20)) = 12060 runs
+        // 3 conditions x 20 seeds x (1 + 5 candidates x (30 + 20)) = 15060 runs
         {"--model silo-dem" + data + campaign + material + " --seeds 20 --grid-points 30 --refine-steps 20 -- " +
              kTinySilo,
-         "diagnose silo-dem: 3 conditions x 20 seeds x (1 declared + 4 candidates x (30 grid points + 20 refine "
-         "steps)) materials = 12060 simulations, more than the limit --max-runs = 10000"},
+         "diagnose silo-dem: 3 conditions x 20 seeds x (1 declared + 5 candidates x (30 grid points + 20 refine "
+         "steps)) materials = 15060 simulations, more than the limit --max-runs = 10000"},
         {"--model oldal" + data + material, "--material: only --model silo-dem"},
         {"--model oldal" + data + " --max-runs 5", "--max-runs: only --model silo-dem"},
         {"--model silo-dem" + data + campaign + material + " --drop-outliers -- " + kTinySilo,

@@ -56,6 +56,23 @@ TEST_CASE("demcal silo --material: the Table 2.1 file is the default, bit for bi
     "grain_grain": {"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01, "surface_energy_J_m2": 0},
     "grain_wall": {"restitution": 0.6, "friction": 0.25, "rolling_friction": 0.01, "surface_energy_J_m2": 0}})";
   CHECK(tiny_run(dir, "dry", "--material '" + (dir / "dry.json").string() + "'") == builtin);
+  // the seed grain's aspect ratio said aloud (11/6, shortest decimal) is the seed's grain: the same bits, and the
+  // summary's material stays as the seed's (no aspect_ratio field); another one changes the run and is written back
+  std::ofstream(dir / "seed_shape.json") << R"({"grain": {"shear_modulus_Pa": 3.58e8, "poisson": 0.4,
+    "density_kg_m3": 1430, "shape": "wheat-clump", "aspect_ratio": 1.8333333333333333},
+    "wall": {"shear_modulus_Pa": 8e8, "poisson": 0.3, "density_kg_m3": 7500},
+    "grain_grain": {"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01},
+    "grain_wall": {"restitution": 0.6, "friction": 0.25, "rolling_friction": 0.01}})";
+  CHECK(tiny_run(dir, "seed_shape", "--material '" + (dir / "seed_shape.json").string() + "'") == builtin);
+  CHECK_THAT(demcal::test::read_file(dir / "seed_shape" / "summary.json"), !Catch::Matchers::Contains("aspect_ratio"));
+  std::ofstream(dir / "long.json") << R"({"grain": {"shear_modulus_Pa": 3.58e8, "poisson": 0.4,
+    "density_kg_m3": 1430, "aspect_ratio": 2.25},
+    "wall": {"shear_modulus_Pa": 8e8, "poisson": 0.3, "density_kg_m3": 7500},
+    "grain_grain": {"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01},
+    "grain_wall": {"restitution": 0.6, "friction": 0.25, "rolling_friction": 0.01}})";
+  CHECK(tiny_run(dir, "long", "--material '" + (dir / "long.json").string() + "'") != builtin);
+  CHECK_THAT(demcal::test::read_file(dir / "long" / "summary.json"),
+             Catch::Matchers::Contains("\"aspect_ratio\": 2.25"));
   // a cohesive one runs on the JKR law, says so and writes its cohesion back
   std::ofstream(dir / "meal.json") << R"({"grain": {"shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430},
     "wall": {"shear_modulus_Pa": 8e8, "poisson": 0.3, "density_kg_m3": 7500},
@@ -97,6 +114,12 @@ TEST_CASE("demcal silo --material: bad files name the file, the field and the va
                              "surface_energy_J_m2": -0.5})"), "grain_grain.surface_energy = -0.5"},
       {file(good_solid, R"({"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01,
                              "surface_energy_J_m2": "sticky"})"), "surface_energy_J_m2 = \"sticky\": must be a number"},
+      {file(R"({"aspect_ratio": 3, "shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430})", good_pair),
+       "grain.aspect_ratio = 3: must lie in [1, 2.6]"},
+      {file(R"({"aspect_ratio": 0.5, "shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430})", good_pair),
+       "grain.aspect_ratio = 0.5"},
+      {file(R"({"aspect_ratio": "long", "shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430})",
+            good_pair), "grain.aspect_ratio = \"long\": must be a number"},
       {"[1, 2]", "must be a JSON object"}};
   int k = 0;
   for (const auto& [text, expect] : cases) {
