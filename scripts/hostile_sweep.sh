@@ -46,6 +46,14 @@ for key, value in [("timestep_fraction", 1e-320), ("normal_stress", 1e308), ("se
 t = json.dumps(m).replace("5000.0", "NaN")
 open(w + "/params_nan_text.json", "w").write(t)
 EOF
+# the silo material with bad grain elongations
+python3 - "$wheat" "$work" <<'EOF'
+import json, sys
+m = json.load(open(sys.argv[1]))
+for name, value in [("subnormal", 1e-320), ("huge", 1e308), ("apart", 2.7), ("flat", 0.9), ("text", "long")]:
+    m["grain"]["aspect_ratio"] = value
+    json.dump(m, open("%s/aspect_%s.json" % (sys.argv[2], name), "w"))
+EOF
 
 pass=0; fail=0; failures=()
 
@@ -240,6 +248,11 @@ run_case vibration/campaign-file     2 "campaign"        -- vibration --campaign
 
 # ---- demcal silo: --export-bed, --vibration-*, output paths ---------------------------------------------------------
 L=(silo --theta 30 --particles 200 --no-plots --max-time 0.05 --fill-time 0.05)
+run_case silo/aspect-subnormal        2 "grain.aspect_ratio' = 1e-320" -- "${L[@]}" --material "$work/aspect_subnormal.json"
+run_case silo/aspect-huge             2 "grain.aspect_ratio' = 1e+308" -- "${L[@]}" --material "$work/aspect_huge.json"
+run_case silo/aspect-apart            2 "grain.aspect_ratio = 2.7"    -- "${L[@]}" --material "$work/aspect_apart.json"
+run_case silo/aspect-flat             2 "grain.aspect_ratio = 0.9"    -- "${L[@]}" --material "$work/aspect_flat.json"
+run_case silo/aspect-text             2 "grain.aspect_ratio"          -- "${L[@]}" --material "$work/aspect_text.json"
 run_case silo/export-bed-folder      2 "--export-bed"    -- "${L[@]}" --export-bed "$work/folder.json"
 run_case silo/export-bed-no-folder   2 "--export-bed"    -- "${L[@]}" --export-bed /no/such/b.json
 run_case silo/export-bed-readonly    2 "--export-bed" "$ro" -- "${L[@]}" --export-bed "$ro/b.json"
@@ -284,6 +297,7 @@ run_case diagnose-dem/max-runs-nan   2 "--max-runs"      -- "${D[@]}" --max-runs
 run_case diagnose-dem/max-runs-huge  2 "--max-runs"      -- "${D[@]}" --max-runs "$huge" -- --particles 200
 run_case diagnose-dem/plan-too-big   2 "--max-runs = 100" -- "${D[@]}" --max-runs 100 --seeds 20 -- --particles 200
 run_case diagnose-dem/max-runs-oldal 2 "--max-runs"      -- diagnose --model oldal --data "$work/rates.csv" --max-runs 5
+run_case diagnose-dem/aspect-material 2 "grain.aspect_ratio = 2.7" -- diagnose --model silo-dem --data "$work/rates.csv" --material "$work/aspect_apart.json" --campaign camp -- --particles 200
 
 # ---- the issue's own examples on the older commands (replayed 2026-12-03) --------------------------------------------
 G="$work/geometry.json"
