@@ -362,7 +362,9 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
     campaign.check_settings();  // silo's own checks of every condition and the material, nothing written
     const json settings{{"command", "diagnose --model silo-dem"}, {"silo_args", a.silo_args},
                         {"first_seed", a.first_seed}, {"prediction_seeds", a.seeds}};
-    open_silo_campaign(a.campaign, settings, "diagnose silo-dem");
+    // runs are named by material, condition and seed, so more (or other) prediction seeds reuse the runs already made:
+    // the design for separating a rival asks for exactly that (--seeds m)
+    open_silo_campaign(a.campaign, settings, "diagnose silo-dem", {"first_seed", "prediction_seeds"});
 
     an::DemDiagnoseOptions options;
     options.grid_points = a.grid_points;

@@ -185,7 +185,8 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
 }
 
 TEST_CASE("diagnose silo-dem: a raised wall friction is named or is the named effect's rival, with its value inside "
-          "its interval - the declared material's own rates get nothing - the same command again runs nothing",
+          "its interval - the declared material's own rates get nothing - the same command again runs nothing - more "
+          "seeds reuse the campaign's runs",
           "[diagnose][silo-dem][slow]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-dem-" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -264,5 +265,21 @@ TEST_CASE("diagnose silo-dem: a raised wall friction is named or is the named ef
                        dir / "again.log") == 0);
     CHECK_THAT(read_file(dir / "again.log"), Catch::Matchers::Contains("0 run now"));
     CHECK_THAT(read_file(dir / "again.log"), Catch::Matchers::Contains("DEM effect: " + named));
+
+    // twice the prediction seeds (what a rival's separation design asks for) in the same campaign: the seed-1 runs are
+    // reused, only the new seed's are made
+    REQUIRE(demcal_run("diagnose --model silo-dem --seeds 2 --candidates wall_friction --data '" +
+                           (dir / "rough.csv").string() + "' --json '" + (dir / "seeds2.json").string() + "'" + common,
+                       dir / "seeds2.log") == 0);
+    INFO(read_file(dir / "seeds2.log"));
+    const auto s2 = nlohmann::json::parse(read_file(dir / "seeds2.json"));
+    CHECK(s2["prediction_seeds"] == 2);
+    CHECK(s2["runs"]["run_now"].get<int>() > 0);
+    CHECK(s2["runs"]["run_now"].get<int>() < s2["runs"]["used"].get<int>());
+    // other silo settings in the same campaign are still refused, before any run
+    CHECK(demcal_run("diagnose --model silo-dem --data '" + (dir / "rough.csv").string() + "'" + common +
+                         " --dt-fraction 0.2",
+                     dir / "other.log") == 2);
+    CHECK_THAT(read_file(dir / "other.log"), Catch::Matchers::Contains("other settings"));
     fs::remove_all(dir);
 }
