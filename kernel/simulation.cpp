@@ -7,4 +7,5 @@ template class BasicSimulation<HertzMindlinEdem>;
 template class BasicSimulation<HertzMindlin>;
 template class BasicSimulation<JkrMindlinEdem>;
 template class BasicSimulation<YadeCohesiveFrictional>;
+template class BasicSimulation<YadeHertzMindlin>;
 }  // namespace demcal::kernel

@@ -1,5 +1,6 @@
 # -*- coding: utf-8 -*-
-"""One contact in YADE 2023.02a with the shear box's functors, driven along a prescribed path; writes a per-step trace.
+"""One contact in YADE 2023.02a with the shear box's functors (or, with "law": "mindlin", silo.py's Hertz-Mindlin),
+driven along a prescribed path; writes a per-step trace.
 
 Run:  yade -n -j1 -x single_contact.py params.json out.csv
       (or through run_clean.py, as the orchestrator runs shear_box.py, to remove YADE's empty /tmp/yade-XXXXXX)
@@ -15,7 +16,9 @@ pos += vel * dt, the orientation by angVel * dt. The moving sphere may instead b
 starts with vel0/angVel0 and moves under its contact force only (no gravity, NewtonIntegrator damping), which exercises
 YADE's integrator and its local damping.
 
-The engines are those of shear_box.py (same Ig2/Ip2/Law2 functors, same order), with two PyRunners around them:
+The engines are those of shear_box.py (same Ig2/Ip2/Law2 functors, same order), or with "law": "mindlin" those of
+silo.py's grains (Ig2_Sphere_Sphere_ScGeom, Ip2_FrictMat_FrictMat_MindlinPhys with betan = betas = params "betan",
+Law2_ScGeom_MindlinPhys_Mindlin), with two PyRunners around them:
   [pre PyRunner, ForceResetter, InsertionSortCollider, InteractionLoop, NewtonIntegrator(damping), post PyRunner]
 pre  records the kinematics the InteractionLoop of this step sees (positions x^n, the velocities state.vel/angVel);
 post records the interaction (normal, penetration, forces, bond state) and O.forces on both bodies (forces of step n),
@@ -110,14 +113,24 @@ def main():
 
     bond_at = p.get("bond_at_step")
     cohesive_ip = Ip2_CohFrictMat_CohFrictMat_CohFrictPhys(setCohesionNow=(bond_at == 0), setCohesionOnNewContacts=False)
+    if p["law"] == "mindlin":
+        # silo.py's Hertz-Mindlin: MindlinPhys with betan = betas, Law2_ScGeom_MindlinPhys_Mindlin (no moment)
+        beta = float(p.get("betan", 0.0))
+        loop = InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_MindlinPhys(betan=MatchMaker(algo="val", val=beta),
+                                               betas=MatchMaker(algo="val", val=beta))],
+            [Law2_ScGeom_MindlinPhys_Mindlin()])
+    else:
+        loop = InteractionLoop(
+            [Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Box_Sphere_ScGeom()],
+            [Ip2_FrictMat_FrictMat_FrictPhys(), cohesive_ip],
+            [Law2_ScGeom_FrictPhys_CundallStrack(), Law2_ScGeom6D_CohFrictPhys_CohesionMoment()])
     O.engines = [
         PyRunner(iterPeriod=1, initRun=True, command="pre_step()"),
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
-        InteractionLoop(
-            [Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Box_Sphere_ScGeom()],
-            [Ip2_FrictMat_FrictMat_FrictPhys(), cohesive_ip],
-            [Law2_ScGeom_FrictPhys_CundallStrack(), Law2_ScGeom6D_CohFrictPhys_CohesionMoment()]),
+        loop,
         NewtonIntegrator(damping=float(p.get("damping", 0.0)), gravity=Vector3(0, 0, 0)),
         PyRunner(iterPeriod=1, initRun=True, command="post_step()"),
     ]

@@ -15,6 +15,8 @@
 #include "kernel/contact/rolling_edem_cdt.hpp"
 #include "kernel/contact/yade_cohesive_normal.hpp"
 #include "kernel/contact/yade_incremental_tangential.hpp"
+#include "kernel/contact/yade_mindlin_normal.hpp"
+#include "kernel/contact/yade_mindlin_tangential.hpp"
 
 namespace demcal::kernel {
 
@@ -124,5 +126,8 @@ using JkrMindlinEdem = ComposedLaw<JkrNormal, MindlinTangential, EdemCdtRolling>
 /// YADE's linear law with fragile cohesive bonds, as its shear box uses it (CohesionMoment for particle pairs;
 /// CundallStrack for walls, the same without a bond). No rolling resistance (momentRotationLaw = False).
 using YadeCohesiveFrictional = ComposedLaw<YadeCohesiveNormal, YadeIncrementalTangential, NoRolling>;
+/// YADE's Hertz-Mindlin as its silo script uses it (Ip2_FrictMat_FrictMat_MindlinPhys with betan = betas,
+/// Law2_ScGeom_MindlinPhys_Mindlin without rolling moment), for cross-checks that run one law in both codes.
+using YadeHertzMindlin = ComposedLaw<YadeMindlinNormal, YadeMindlinTangential, NoRolling>;
 
 }  // namespace demcal::kernel

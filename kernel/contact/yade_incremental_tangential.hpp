@@ -1,10 +1,10 @@
 // Tangential sub-model: YADE's incremental shear force (Law2_ScGeom_FrictPhys_CundallStrack, and
 // Law2_ScGeom6D_CohFrictPhys_CohesionMoment's shear part), as yade_scripts/YADE_LAWS.md documents it:
 //   the stored shear force F turns with the contact frame (F -= F x (n_old x n), then F -= F x ((dt/2)
-//   (n_old . (w_i + w_j)) n_old)), then F -= ks dt v_t, with YADE's relative velocity (sphere pairs:
-//   alpha (v_i - v_j) - w_i x (r_i n) - w_j x (r_j n), alpha = (r_i + r_j)/(r_i + r_j - dn); walls: the velocity of
-//   the sphere's point at r - dn/2 relative to the wall);
-//   ks = 2 (E_a R_a nu_a)(E_b R_b nu_b) / (E_a R_a nu_a + E_b R_b nu_b): YADE's "poisson" is ks/kn, not a Poisson ratio;
+//   (n_old . (w_i + w_j)) n_old)), then F -= ks dt v_t, v_t the tangential part of YADE's relative velocity
+//   (yade_scgeom.hpp's yade_incident_velocity);
+//   ks = 2 (E_a R_a nu_a)(E_b R_b nu_b) / (E_a R_a nu_a + E_b R_b nu_b): YADE's "poisson" is ks/kn, not a Poisson
+//   ratio;
 //   cap max(0, S + Fn tan(phi)) with S the bond's shear strength; passing it breaks an intact bond (the cap is then
 //   max(0, Fn tan(phi)) in the same step) and, with Fn < 0, cancels the normal force for that step.
 // The force acts at the middle of the overlap (wall contacts too: ComposedLaw asks lever_at_overlap_middle).
@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include "kernel/contact/contact_state.hpp"
+#include "kernel/contact/yade_scgeom.hpp"
 #include "kernel/material.hpp"
 #include "kernel/types.hpp"
 
@@ -45,24 +46,9 @@ struct YadeIncrementalTangential {
   [[gnu::always_inline]] static inline Vec3 force(const Coeffs& c, const ContactGeometry& g, const ContactKinematics& k,
                                                   const Vec3&, NormalState& nrm, double* h, double dt, bool wall) {
     const Vec3& n = g.n;
-    Vec3 f(h[0], h[1], h[2]);
-    const Vec3 n_old(h[3], h[4], h[5]);
-    if (n_old.squaredNorm() > 0.0) {
-      f -= f.cross(n_old.cross(n));
-      f -= f.cross((0.5 * dt * n_old.dot(k.omega_i + k.omega_j)) * n_old);
-    } else {
-      f.setZero();  // a new contact
-    }
-    Vec3 v;  // velocity of i relative to j at the contact, as YADE computes it
-    double rj;
-    if (wall) {
-      rj = g.radius_i;
-      v = k.v_i - k.omega_i.cross((g.radius_i - 0.5 * g.dn) * n) - k.v_j;
-    } else {
-      rj = g.radius_j;
-      const double alpha = (g.radius_i + g.radius_j) / (g.radius_i + g.radius_j - g.dn);
-      v = alpha * (k.v_i - k.v_j) - k.omega_i.cross(g.radius_i * n) - k.omega_j.cross(g.radius_j * n);
-    }
+    Vec3 f = yade_rotated_shear(h, n, k, dt);
+    const Vec3 v = yade_incident_velocity(g, k, wall);  // i relative to j, as YADE computes it
+    const double rj = wall ? g.radius_i : g.radius_j;
     const Vec3 inc = dt * (v - n.dot(v) * n);
     const double ka = c.ks_i * g.radius_i, kb = c.ks_j * rj;
     const double ks = (ka != 0.0 && kb != 0.0) ? 2 * ka * kb / (ka + kb) : 0.0;

@@ -133,3 +133,15 @@ write("cb_clump_damped", "a free rigid clump of two sand spheres (aspect ratio 1
           "moving": {"clump": [[0.002, 0.001, 0.0035 + 2.5e-6, 0.0035],
                                [0.002 + 0.0035 * 0.95, 0.001 + 0.0035 * 0.3, 0.0035 + 2.5e-6 + 6e-6, 0.0035]],
                      "material": "b", "vel0": [0.05, -0.02, -0.1]}})
+
+# silo.py's Hertz-Mindlin (Ip2_FrictMat_FrictMat_MindlinPhys, betan = betas; Law2_ScGeom_MindlinPhys_Mindlin) between
+# two unlike FrictMat spheres (shear stiffness from YADE's arithmetic means of G and nu): the kernel's YadeHertzMindlin
+BETA_E05 = math.sqrt(5.0 / 6.0) * abs(math.log(0.5) / math.sqrt(math.log(0.5) ** 2 + math.pi ** 2))  # silo.py, e = 0.5
+f0, f1 = sphere_pair(0.0035, 0.003, 4.5e-6)
+write("hm_pair", "sphere-sphere, silo.py's Hertz-Mindlin with viscous damping (betan = betas for e = 0.5), two unlike "
+      "FrictMat materials; approach, slide past Coulomb, slide back while rolling, twist, push in, then pull apart so "
+      "fast that the damping would pull (YADE clips the normal force at zero) until the contact ends", {
+          "case": "sphere_sphere", "law": "mindlin", "betan": BETA_E05, "dt": DT, "sample_every": 1, "damping": 0.0,
+          "materials": {"a": FRICT_A, "b": FRICT_B}, "fixed": f0, "moving": f1,
+          "path": frict_path[:5] + [seg(40, scale(0.4, N0))]})
+
