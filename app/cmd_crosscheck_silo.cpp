@@ -65,6 +65,7 @@ struct SiloCrosscheckOptions {
     std::string plot_format = "png";
     long max_runs = 10000;
     std::string fill_text = "same-bed";  // same-bed | own | both (checked by the option)
+    std::string kernel_law = "edem";     // demcal silo --contact-law: edem | yade (checked by the option)
     FillMode fill() const { return kFillModes.at(fill_text); }
 };
 
@@ -93,6 +94,7 @@ std::vector<std::string> kernel_argv(const SiloCrosscheckOptions& o, double thet
                                   "--export-cloud", (bed.parent_path() / "cloud.json").string()};
     if (!o.material.empty()) a.insert(a.end(), {"--material", fs::absolute(o.material).string()});
     if (!o.geometry.empty()) a.insert(a.end(), {"--geometry", fs::absolute(o.geometry).string()});
+    if (o.kernel_law != "edem") a.insert(a.end(), {"--contact-law", o.kernel_law});
     return a;
 }
 
@@ -206,7 +208,7 @@ std::vector<orchestrator::StoredJob> kernel_jobs(const SiloCrosscheckOptions& o,
         const fs::path d = root / theta_name(theta);
         fs::create_directories(d / "kernel");
         // the identity: what the run computes, without paths (a campaign moved elsewhere keeps its runs)
-        const json params = {{"code", "kernel"},
+        json params = {{"code", "kernel"},
                              {"what", "demcal silo, its bed at the opening and its generated cloud exported"},
                              {"theta_deg", theta},
                              {"particles", o.particles},
@@ -215,6 +217,8 @@ std::vector<orchestrator::StoredJob> kernel_jobs(const SiloCrosscheckOptions& o,
                              {"max_time_s", o.max_time},
                              {"material_sha256", file_hash(o.material)},
                              {"geometry_sha256", file_hash(o.geometry)}};
+        // only when not the default: the runs of campaigns made before the choice keep their identity
+        if (o.kernel_law != "edem") params["contact_law"] = o.kernel_law;
         auto job = orchestrator::stored_job(theta_name(theta) + " kernel", params,
                                             {{"theta_deg", theta}, {"code", "kernel"}}, d / "kernel",
                                             kernel_argv(o, theta, d / "kernel", d / "bed.json", program),
@@ -276,6 +280,7 @@ crosscheck_silo::ReportSettings report_settings(const SiloCrosscheckOptions& o, 
     r.yade_material = in.yade_material;
     r.yade_material_file = o.yade_material;
     r.fill_text = o.fill_text;
+    r.kernel_law = o.kernel_law;
     r.yade_runs = yade_runs(o.fill());
     r.plot_format = o.plot_format;
     return r;
@@ -346,6 +351,11 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
                      "kernel's generated cloud, then discharges; both: the two, and the filling's share of the "
                      "difference")
         ->check(CLI::IsMember({"same-bed", "own", "both"}))
+        ->capture_default_str();
+    silo->add_option("--kernel-law", o->kernel_law,
+                     "the kernel's contact law (demcal silo --contact-law): edem, its own; yade, YADE's Hertz-Mindlin, "
+                     "so that both codes run one law (the material's rolling friction must then be 0)")
+        ->check(CLI::IsMember({"edem", "yade"}))
         ->capture_default_str();
     silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (3 with --fill both; a guard against typos)")
         ->check(integer_in(1, 1000000000))

@@ -248,7 +248,7 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     std::printf("cut-off search in the silo: %s, %s, stiffness scale %g; %s; A = %g m along x; bracket "
                 "[%g, %g] Hz to %g Hz, %zu seed(s); flows = half the mass out within %g s of the opening; runs in %s\n",
                 base.geometry.describe().c_str(), amount.c_str(), base.materials.stiffness_scale,
-                ks::contact_law_name(base.materials).c_str(), o.base.amplitude, search.lo, search.hi, search.tol,
+                ks::contact_law_name(base).c_str(), o.base.amplitude, search.lo, search.hi, search.tol,
                 search.seeds.size(), o.base.window, dir.string().c_str());
     std::fflush(stdout);
     nlohmann::json runs = nlohmann::json::array();
@@ -274,7 +274,7 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     nlohmann::json out = {{"case", "silo"},
                           {"geometry", base.geometry.describe()},
                           {"silo_options", o.silo_args},
-                          {"contact_law", ks::contact_law_name(base.materials)},
+                          {"contact_law", ks::contact_law_name(base)},
                           {"amplitude_m", o.base.amplitude},
                           {"direction", "x"},
                           {"window_s", o.base.window},

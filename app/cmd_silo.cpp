@@ -76,6 +76,7 @@ struct SiloCli {
     std::string export_bed;  // the filled bed at the opening, for yade_scripts/silo.py
     std::string export_cloud;  // the generated cloud before filling, for yade_scripts/silo.py to fill on its own
     bool forget_contact_history = false;  // at the opening, as a bed imported into YADE starts
+    std::string contact_law = "edem";     // edem | yade (checked by the option)
 };
 
 // Exit status of a run stopped at --wall-limit (EX_TEMPFAIL): not finished, resume it. A job script can loop on it.
@@ -362,6 +363,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.vibration = vibration_from(o, sub);
     s.contacts_at_opening =
         o.forget_contact_history ? ks::ContactsAtOpening::forget_history : ks::ContactsAtOpening::keep_history;
+    s.contact_law = o.contact_law == "yade" ? ks::SiloContactLaw::yade : ks::SiloContactLaw::edem;
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
     try {
@@ -548,7 +550,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     s.wall_limit = o.wall_limit;
     std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
               << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string() << "\n  contact law: "
-              << ks::contact_law_name(s.materials);
+              << ks::contact_law_name(s);
     if (s.vibration.vibrates()) std::cout << "\n  vibration: " << vibration_text(s);
     if (!s.checkpoint_file.empty())
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
@@ -693,6 +695,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"contacts_at_opening", s.contacts_at_opening == ks::ContactsAtOpening::forget_history
                                                  ? "forget_history"
                                                  : "keep_history"},
+                     {"contact_law_family", s.contact_law == ks::SiloContactLaw::yade ? "yade" : "edem"},
                      // as a --material file gives it (silo_material.cpp), unscaled: demcal silo --material reads it back
                      {"material", silo_material_json(s.materials)},
                      {"contact_law", r.contact_law}};
@@ -802,6 +805,12 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_flag("--forget-contact-history", o.forget_contact_history,
                   "at the opening every contact forgets its past (tangential springs at zero), as the bed does when "
                   "YADE's silo.py imports it: measures that one difference of a cross-check");
+    sub->add_option("--contact-law", o.contact_law,
+                    "edem: the kernel's Hertz-Mindlin (JKR when cohesive) with EDEM's rolling friction; yade: YADE "
+                    "2023.02a's Hertz-Mindlin as yade_scripts/silo.py runs it (incremental tangential force, no "
+                    "rolling resistance: the material's rolling friction must be 0), for a cross-check on one law")
+        ->check(CLI::IsMember({"edem", "yade"}))
+        ->capture_default_str();
     sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o.checkpoint_every,
                     "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "

@@ -38,6 +38,7 @@ struct ReportSettings {
     nlohmann::json yade_material;        // null: YADE ran the bed's material
     std::string yade_material_file;      // its file, for the report's note
     std::string fill_text;               // same-bed | own | both
+    std::string kernel_law = "edem";     // the kernel's contact law family (demcal silo --contact-law)
     std::vector<YadeRunKind> yade_runs;  // the first is compared with the kernel; a second is YADE's own filling
     std::string plot_format = "png";
 };

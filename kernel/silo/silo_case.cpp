@@ -136,14 +136,14 @@ kernel::Material to_kernel(const silo::Material& m, const char* name) {
     return k;
 }
 
-// The pair's inputs of the law the run is on: the cohesion only where the law has it (a law without it runs only
-// cohesionless materials: run_on_its_law's choice).
+// The pair's inputs of the law the run is on: the cohesion and the rolling friction only where the law has them (a
+// law without them runs only materials without them: run_on_its_law's choice, validate's refusal).
 template <class Law>
 typename Law::Params to_kernel(const PairCoefficients& p) {
     typename Law::Params k;
     k.restitution = p.restitution;
     k.friction = p.friction;
-    k.rolling_friction = p.rolling_friction;
+    if constexpr (requires { k.rolling_friction; }) k.rolling_friction = p.rolling_friction;
     if constexpr (requires { k.surface_energy; }) k.surface_energy = p.surface_energy;
     return k;
 }
@@ -254,6 +254,21 @@ void validate(const SiloCaseSettings& s) {
     if (!(s.time_step_fraction > 0 && s.time_step_fraction <= 1))
         reject_setting("dt_fraction", s.time_step_fraction, "must lie in (0, 1] (of the Rayleigh time step)");
     validate(s.vibration);
+    if (s.contact_law != SiloContactLaw::edem && s.contact_law != SiloContactLaw::yade)
+        reject_setting("contact_law", static_cast<double>(s.contact_law), "must be edem (0) or yade (1)");
+    if (s.contact_law == SiloContactLaw::yade) {
+        // YADE's Hertz-Mindlin (as silo.py runs it) has neither: a value would be silently dropped
+        for (const auto& [p, name] : {std::pair{&s.materials.wheat_wheat, "grain_grain"},
+                                      std::pair{&s.materials.wheat_steel, "grain_wall"}}) {
+            if (p->surface_energy != 0)
+                reject_setting(std::string(name) + ".surface_energy", p->surface_energy,
+                               "the yade contact law has no cohesion (use the edem law, JKR)");
+            if (p->rolling_friction != 0)
+                reject_setting(std::string(name) + ".rolling_friction", p->rolling_friction,
+                               "the yade contact law has no rolling resistance (as yade_scripts/silo.py's default): "
+                               "set it to 0, or use the edem law");
+        }
+    }
     if (s.contacts_at_opening != ContactsAtOpening::keep_history &&
         s.contacts_at_opening != ContactsAtOpening::forget_history)
         reject_setting("contacts_at_opening", static_cast<double>(s.contacts_at_opening),
@@ -298,13 +313,15 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
+// Version 9: the contact law (edem / yade) at the end of the settings (versions 4 to 8 are read, on the edem law).
 // Version 8: the grain's aspect ratio at the end of the settings (versions 4 to 7 are read, with the seed's grain).
 // Version 5: the pairs' surface energies (JKR cohesion) at the end of the settings; version 4, the same without them
 // (no cohesion), is read too. Version 4: each section (tag and settings; the case's state; the kernel's state) closed
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 8;
+constexpr int kCheckpointVersion = 9;
+constexpr int kCheckpointVersionWithoutLawChoice = 8;      // contact_law: edem
 constexpr int kCheckpointVersionWithoutGrainShape = 7;     // grain_aspect_ratio: the seed's
 constexpr int kCheckpointVersionWithoutVibratingPart = 6;  // vibration_part: bin; no outlet-flow frames
 constexpr int kCheckpointVersionWithoutHistoryChoice = 5;  // contacts_at_opening: keep_history
@@ -374,6 +391,8 @@ void for_each_setting(S& s, F&& f) {
     f("vibration_part", s.vibration.part);
     // since version 8 (the seed's grain before)
     f("grain_aspect_ratio", s.materials.grain_aspect_ratio);
+    // since version 9 (edem before)
+    f("contact_law", s.contact_law);
 }
 
 void write_settings(StateWriter& w, const SiloCaseSettings& s) {
@@ -391,6 +410,7 @@ SiloCaseSettings read_settings(StateReader& r, int version) {
             return;
         if (version <= kCheckpointVersionWithoutVibratingPart && std::string_view(name) == "vibration_part") return;
         if (version <= kCheckpointVersionWithoutGrainShape && std::string_view(name) == "grain_aspect_ratio") return;
+        if (version <= kCheckpointVersionWithoutLawChoice && std::string_view(name) == "contact_law") return;
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
         else r.value(v, name);
     });
@@ -867,6 +887,8 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string current = prefix + std::to_string(kCheckpointVersion);
     if (tag == current) {
         version = kCheckpointVersion;
+    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutLawChoice)) {
+        version = kCheckpointVersionWithoutLawChoice;
     } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutGrainShape)) {
         version = kCheckpointVersionWithoutGrainShape;
     } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutVibratingPart)) {
@@ -893,21 +915,24 @@ SiloCaseResult run_on(const SiloCaseSettings& s, const std::function<void(const 
     SiloRun<Law> run(s, progress);
     start(run);
     SiloCaseResult r = run.run();
-    r.contact_law = contact_law_name(s.materials);
+    r.contact_law = contact_law_name(s);
     return r;
 }
 
 template <class Start>
 SiloCaseResult run_on_its_law(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress,
                               Start&& start) {
+    if (s.contact_law == SiloContactLaw::yade) return run_on<YadeHertzMindlin>(s, progress, start);
     if (s.materials.cohesive()) return run_on<JkrMindlinEdem>(s, progress, start);
     return run_on<HertzMindlinEdem>(s, progress, start);
 }
 
 }  // namespace
 
-std::string contact_law_name(const WheatMaterials& m) {
-    return m.cohesive() ? "Hertz-Mindlin with JKR cohesion, EDEM rolling friction"
+std::string contact_law_name(const SiloCaseSettings& s) {
+    if (s.contact_law == SiloContactLaw::yade)
+        return "YADE's Hertz-Mindlin (incremental tangential force, normal force clipped at zero), no rolling friction";
+    return s.materials.cohesive() ? "Hertz-Mindlin with JKR cohesion, EDEM rolling friction"
                         : "Hertz-Mindlin (no slip), EDEM rolling friction";
 }
 

@@ -48,6 +48,13 @@ struct BedSnapshot {
 // (YADE's silo.py creates its interactions afresh): the cross-check's switch for that one difference.
 enum class ContactsAtOpening : std::uint8_t { keep_history = 0, forget_history = 1 };
 
+// The contact law family the grains run on. edem: the kernel's own (Hertz-Mindlin with a total-displacement
+// tangential spring and EDEM's rolling friction; JKR when a pair is cohesive). yade: YADE 2023.02a's Hertz-Mindlin as
+// yade_scripts/silo.py runs it (incremental tangential force, normal force clipped at zero, no rolling resistance;
+// kernel/contact/yade_mindlin_*.hpp), so that a cross-check can run one law in both codes. It has no cohesion and no
+// rolling friction: materials with either are refused.
+enum class SiloContactLaw : std::uint8_t { edem = 0, yade = 1 };
+
 struct SiloCaseSettings {
     SiloGeometry geometry;
     WheatMaterials materials;
@@ -74,6 +81,7 @@ struct SiloCaseSettings {
     // vibration.start_after_opening after the opening; still while it fills. Default: still.
     BinVibration vibration;
     ContactsAtOpening contacts_at_opening = ContactsAtOpening::keep_history;
+    SiloContactLaw contact_law = SiloContactLaw::edem;
     // Verlet skin [m]; 0: automatic, 40 dt x 1 m/s within [0.2 mm, 1 mm] (grains leave the outlet at ~1 m/s: the list
     // then lasts tens of steps; measured on the reduced 70 deg case, dt = 66 us: 1 mm ran 1.7 times faster than the
     // kernel's default 0.1 r; at the seed's dt = 2.1 us a 0.2 mm skin keeps fewer pairs in the list).
@@ -180,9 +188,10 @@ struct SiloCaseResult {
     long vtk_files = 0;
 };
 
-// The contact law a silo of these materials runs on: Hertz-Mindlin with EDEM's rolling friction, or, when a pair is
-// cohesive (WheatMaterials::cohesive), JKR with the same friction and rolling friction (kernel/contact/contact_law.hpp).
-std::string contact_law_name(const WheatMaterials& m);
+// The contact law a silo runs on: with SiloContactLaw::edem Hertz-Mindlin with EDEM's rolling friction, or, when a
+// pair is cohesive (WheatMaterials::cohesive), JKR with the same friction and rolling friction; with
+// SiloContactLaw::yade YADE's Hertz-Mindlin (kernel/contact/contact_law.hpp).
+std::string contact_law_name(const SiloCaseSettings& s);
 
 SiloCaseResult run_silo_case(const SiloCaseSettings& s,
                              const std::function<void(const SiloProgress&)>& progress = {});

@@ -4,7 +4,8 @@
 // status` lists; a run whose output is gone runs again, alone); a deliberate mismatch of the grains' friction is
 // flagged; a bad angle is refused before anything runs. YADE's flow pattern is measured by the kernel's classifier on
 // YADE's frames: on 600 grains in a 20 deg hopper both codes give mass flow. --fill both: YADE also fills the silo
-// itself from the kernel's generated cloud, to the kernel's rest rule, and discharges that bed.
+// itself from the kernel's generated cloud, to the kernel's rest rule, and discharges that bed. --kernel-law yade: the
+// kernel runs YADE's own Hertz-Mindlin, and the report says so.
 #include "slurm_for_test.hpp"
 #include "demcal_cli.hpp"
 #include "test_files.hpp"
@@ -78,6 +79,42 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     // a bad angle: exit 2, named, nothing run
     CHECK(run_demcal("crosscheck silo --theta 95 -c '" + (dir / "bad").string() + "'", dir / "bad.log") == 2);
     CHECK(read_file(dir / "bad.log").find("theta") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "bad"));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindlin, the report says so", "[yade]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-xsilo-law-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    auto material = nlohmann::json::parse(
+        read_file(fs::path(DEMCAL_SOURCE_DIR) / "examples/materials/silo_wheat_table21.json"));
+    material["grain_grain"]["rolling_friction"] = 0;  // YADE's law has none: refused otherwise
+    material["grain_wall"]["rolling_friction"] = 0;
+    {
+        std::ofstream f(dir / "no_rolling.json");
+        f << material.dump();
+    }
+    const std::string args = "crosscheck silo --theta 45 --particles 300 --stiffness-scale 1e-3 --geometry '" +
+                             (fs::path(DEMCAL_SOURCE_DIR) / "examples/silo/reduced_conical_70deg.json").string() +
+                             "' --max-time 3 --jobs 1 --material '" + (dir / "no_rolling.json").string() +
+                             "' --kernel-law yade -c '" + (dir / "c").string() + "'";
+    REQUIRE(run_demcal(args, dir / "first.log") == 0);
+    INFO(read_file(dir / "first.log"));
+    const auto report = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
+    CHECK(report["kernel_contact_law"] == "yade");
+    CHECK_THAT(report["known_differences"].dump(), Catch::Contains("YADE 2023.02a's Hertz-Mindlin"));
+    const auto summary = nlohmann::json::parse(read_file(dir / "c" / "theta_45" / "kernel" / "summary.json"));
+    CHECK(summary["settings"]["contact_law_family"] == "yade");
+    CHECK_THAT(summary["settings"]["contact_law"].get<std::string>(), Catch::Contains("YADE"));
+    const auto& a = report["angles"][0];
+    CHECK(a["rate_ratio_yade_over_kernel"].get<double>() > 0.8);
+    CHECK(a["rate_ratio_yade_over_kernel"].get<double>() < 1.25);
+    // the default material (rolling friction 0.01) on YADE's law: refused before anything runs, the field named
+    const std::string bad = "crosscheck silo --theta 45 --particles 300 --kernel-law yade -c '" +
+                            (dir / "bad").string() + "'";
+    CHECK(run_demcal(bad, dir / "bad.log") == 2);
+    CHECK_THAT(read_file(dir / "bad.log"), Catch::Contains("rolling_friction"));
     CHECK_FALSE(fs::exists(dir / "bad"));
     fs::remove_all(dir);
 }
