@@ -46,8 +46,7 @@ const char* const kKnownDifferences[] = {
 // The same when the kernel runs YADE's own Hertz-Mindlin (--kernel-law yade): the law's differences are gone.
 const char* const kKnownDifferencesOnYadeLaw[] = {
     "contact law: the kernel runs YADE 2023.02a's Hertz-Mindlin (kernel/contact/yade_mindlin_*.hpp, equal to YADE's "
-    "own single-contact trace to 1e-6 for two spheres); its wall contacts take R* = r, as YADE's hertzian facets, "
-    "but were not checked against a YADE facet trace",
+    "own single-contact traces to 1e-6, two spheres and a sphere on a hertzian facet)",
     "contact history at the opening: YADE starts the imported bed's contacts afresh (tangential forces at zero), the "
     "kernel keeps its own",
     "integrators: YADE's leapfrog with its aspherical rotation for clumps, the kernel's velocity Verlet with a "

@@ -10,9 +10,12 @@ parameters, YADE's version, dt, the ids, the interaction's classes, masses). The
 and the Python reimplementation that reproduces them live in tests/data/yade_contact/ and
 yade_scripts/check_single_contact.py; the formulas are in yade_scripts/YADE_LAWS.md.
 
-Bodies: id 0 is the fixed body (a sphere, or a box made by utils.box), id 1 the moving sphere. Both are
-non-dynamic (dynamic=False: all DOFs blocked), so NewtonIntegrator leaves their velocities alone and only moves them:
-pos += vel * dt, the orientation by angVel * dt. The moving sphere may instead be dynamic ("dynamic": true): it then
+Bodies: id 0 is the fixed body (a sphere, a box made by utils.box, or a facet made by utils.facet from
+fixed.vertices: silo.py's walls, Ig2_Facet_Sphere_ScGeom with hertzian = params "hertzian_facet", default true), id 1
+the moving sphere. Both are non-dynamic (dynamic=False: all DOFs blocked), so NewtonIntegrator leaves their
+velocities alone and only moves them: pos += vel * dt, the orientation by angVel * dt. (Against a facet the sphere is
+a dynamic body with all DOFs but the spin about z blocked instead: it moves the same way, and the Hertz-Mindlin damping
+takes its mass as m*, as for a silo grain; a non-dynamic pair would take the facet's zero mass: no damping.) The moving sphere may instead be dynamic ("dynamic": true): it then
 starts with vel0/angVel0 and moves under its contact force only (no gravity, NewtonIntegrator damping), which exercises
 YADE's integrator and its local damping.
 
@@ -78,22 +81,35 @@ def main():
     for key in REQUIRED:
         if key not in p:
             fail("%s=<missing> required field" % key)
-    if p["case"] not in ("sphere_sphere", "sphere_box"):
-        fail("case=%s must be sphere_sphere or sphere_box" % json.dumps(p["case"]))
+    if p["case"] not in ("sphere_sphere", "sphere_box", "sphere_facet"):
+        fail("case=%s must be sphere_sphere, sphere_box or sphere_facet" % json.dumps(p["case"]))
+    if p["case"] == "sphere_facet" and p["law"] != "mindlin":
+        fail("law=%s: a sphere_facet case runs silo.py's law, mindlin" % json.dumps(p["law"]))
 
     mats = {name: make_material(spec, name) for name, spec in p["materials"].items()}
     fixed, moving = p["fixed"], p["moving"]
     if p["case"] == "sphere_sphere":
         b0 = utils.sphere(vec(fixed["pos"], "fixed.pos"), float(fixed["radius"]), material=mats[fixed["material"]],
                           fixed=True)
-    else:
+    elif p["case"] == "sphere_box":
         b0 = utils.box(center=vec(fixed["center"], "fixed.center"), extents=vec(fixed["extents"], "fixed.extents"),
                        fixed=True, material=mats[fixed["material"]])
+    else:
+        b0 = utils.facet([vec(v, "fixed.vertices[%d]" % k) for k, v in enumerate(fixed["vertices"])],
+                         material=mats[fixed["material"]])
     if "clump" in moving:
         return run_clump(p, mats, b0, out_path)
     dynamic = bool(moving.get("dynamic", False))
+    # against a facet (mass 0) the sphere must be a dynamic body for the damping's m* to be its mass, as a silo grain
+    # against silo.py's walls. YADE's "dynamic" is "not every DOF blocked" (blocking all six makes m* = 0: no damping),
+    # so all but the spin about z are blocked: on a horizontal facet the contact's torque has no z component, and the
+    # path sets the velocities every step anyway
+    blocked = p["case"] == "sphere_facet" and not dynamic
     b1 = utils.sphere(vec(moving["pos"], "moving.pos"), float(moving["radius"]), material=mats[moving["material"]],
-                      fixed=not dynamic)
+                      fixed=not dynamic and not blocked)
+    if blocked:
+        b1.state.blockedDOFs = "xyzXY"
+        assert b1.dynamic
     id0 = O.bodies.append(b0)
     id1 = O.bodies.append(b1)
     assert (id0, id1) == (0, 1)
@@ -117,7 +133,8 @@ def main():
         # silo.py's Hertz-Mindlin: MindlinPhys with betan = betas, Law2_ScGeom_MindlinPhys_Mindlin (no moment)
         beta = float(p.get("betan", 0.0))
         loop = InteractionLoop(
-            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom(),
+             Ig2_Facet_Sphere_ScGeom(hertzian=bool(p.get("hertzian_facet", True)))],
             [Ip2_FrictMat_FrictMat_MindlinPhys(betan=MatchMaker(algo="val", val=beta),
                                                betas=MatchMaker(algo="val", val=beta))],
             [Law2_ScGeom_MindlinPhys_Mindlin()])
@@ -129,7 +146,7 @@ def main():
     O.engines = [
         PyRunner(iterPeriod=1, initRun=True, command="pre_step()"),
         ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
+        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb(), Bo1_Facet_Aabb()]),
         loop,
         NewtonIntegrator(damping=float(p.get("damping", 0.0)), gravity=Vector3(0, 0, 0)),
         PyRunner(iterPeriod=1, initRun=True, command="post_step()"),

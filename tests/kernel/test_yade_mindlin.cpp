@@ -1,8 +1,9 @@
 // YADE's Hertz-Mindlin as yade_scripts/silo.py uses it (YadeHertzMindlin: Ip2_FrictMat_FrictMat_MindlinPhys with
 // betan = betas, Law2_ScGeom_MindlinPhys_Mindlin) against YADE's own single-contact trace (tests/data/yade_contact/
 // hm_pair: two unlike spheres through approach, sliding, rolling, twist and a separation fast enough that the damping
-// would pull). The kernel's default Hertz-Mindlin (EDEM / LIGGGHTS) on the same path is not YADE's: the test also says
-// by how much, so that it can tell the two apart.
+// would pull; hm_facet: a sphere on one of silo.py's wall facets through the same kinds of motion). The kernel's
+// default Hertz-Mindlin (EDEM / LIGGGHTS) on the same path is not YADE's: the test also says by how much, so that it
+// can tell the two apart.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -48,5 +49,17 @@ TEST_CASE("YADE Hertz-Mindlin: a prescribed contact of two unlike spheres gives 
   // EDEM's Hertz-Mindlin (total tangential displacement, harmonic shear mixing, attractive damping) is another law
   const double edem_law = replay_hm<HertzMindlin>("hm_pair");
   INFO("HertzMindlin: max relative error " << edem_law);
+  CHECK(edem_law > 1e-2);
+}
+
+TEST_CASE("YADE Hertz-Mindlin: a sphere on one of silo.py's wall facets gives YADE's force and torque to 1e-6",
+          "[kernel][yade-laws][yade-mindlin]") {
+  // the kernel's wall contact on YadeHertzMindlin (R* = r, m* = the sphere's mass) against Ig2_Facet_Sphere_ScGeom
+  // with hertzian facets (R* = r / (1 + 1e-8)): approach, slide with spin, slide back rolling, press, fast lift-off
+  const double yade_law = replay_hm<YadeHertzMindlin>("hm_facet");
+  INFO("YadeHertzMindlin on a facet: max relative error " << yade_law);
+  CHECK(yade_law < 1e-6);
+  const double edem_law = replay_hm<HertzMindlin>("hm_facet");
+  INFO("HertzMindlin on a facet: max relative error " << edem_law);
   CHECK(edem_law > 1e-2);
 }

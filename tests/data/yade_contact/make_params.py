@@ -135,7 +135,8 @@ write("cb_clump_damped", "a free rigid clump of two sand spheres (aspect ratio 1
                      "material": "b", "vel0": [0.05, -0.02, -0.1]}})
 
 # silo.py's Hertz-Mindlin (Ip2_FrictMat_FrictMat_MindlinPhys, betan = betas; Law2_ScGeom_MindlinPhys_Mindlin) between
-# two unlike FrictMat spheres (shear stiffness from YADE's arithmetic means of G and nu): the kernel's YadeHertzMindlin
+# two unlike FrictMat spheres (YADE 2023.02a mixes G* as the kernel does, harmonic in (2 - nu) / G): the kernel's
+# YadeHertzMindlin
 BETA_E05 = math.sqrt(5.0 / 6.0) * abs(math.log(0.5) / math.sqrt(math.log(0.5) ** 2 + math.pi ** 2))  # silo.py, e = 0.5
 f0, f1 = sphere_pair(0.0035, 0.003, 4.5e-6)
 write("hm_pair", "sphere-sphere, silo.py's Hertz-Mindlin with viscous damping (betan = betas for e = 0.5), two unlike "
@@ -145,3 +146,16 @@ write("hm_pair", "sphere-sphere, silo.py's Hertz-Mindlin with viscous damping (b
           "materials": {"a": FRICT_A, "b": FRICT_B}, "fixed": f0, "moving": f1,
           "path": frict_path[:5] + [seg(40, scale(0.4, N0))]})
 
+
+# the same law against one of silo.py's wall facets (Ig2_Facet_Sphere_ScGeom, hertzian): a large horizontal triangle at
+# z = 0 (normal +z), the sphere above its interior all along the path (no edge contact), the wall's own material
+facet = {"vertices": [[-0.05, -0.04, 0.0], [0.06, -0.04, 0.0], [0.0, 0.06, 0.0]], "material": "wall"}
+write("hm_facet", "a sphere on one of silo.py's wall facets (utils.facet, Ig2_Facet_Sphere_ScGeom hertzian), silo.py's "
+      "Hertz-Mindlin with viscous damping (betan = betas for e = 0.5), the sphere a dynamic body with all DOFs but "
+      "the spin about the facet's normal blocked (m* = its mass); approach, slide with spin past Coulomb, slide back rolling, press in, then lift off so "
+      "fast that the damping would pull", {
+          "case": "sphere_facet", "law": "mindlin", "betan": BETA_E05, "dt": DT, "sample_every": 1, "damping": 0.0,
+          "materials": {"wall": WALL, "b": FRICT_A}, "fixed": facet,
+          "moving": {"pos": [0.002, 0.001, 0.0035 + 4.5e-6], "radius": 0.0035, "material": "b"},
+          "path": [seg(30, [0, 0, -0.05]), seg(100, [0.05, 0.02, 0.0], [3.0, 25.0, 8.0]),
+                   seg(60, [-0.05, 0.0, 0.0], [0.0, -15.0, 0.0]), seg(20, [0, 0, -0.03]), seg(40, [0, 0, 0.4])]})
