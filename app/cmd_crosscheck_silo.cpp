@@ -12,6 +12,7 @@
 #include "app/commands.hpp"
 #include "app/silo_material.hpp"
 #include "app/silo_settings.hpp"
+#include "kernel/silo/silo_case.hpp"
 #include "analytics/user_input.hpp"
 #include "orchestrator/campaign_directory.hpp"
 #include "orchestrator/executor.hpp"
@@ -65,7 +66,7 @@ struct SiloCrosscheckOptions {
     std::string plot_format = "png";
     long max_runs = 10000;
     std::string fill_text = "same-bed";  // same-bed | own | both (checked by the option)
-    std::string kernel_law = "edem";     // demcal silo --contact-law: edem | yade (checked by the option)
+    std::string kernel_law = "edem";     // demcal silo --contact-law (a name of silo_contact_laws: the option checks)
     FillMode fill() const { return kFillModes.at(fill_text); }
 };
 
@@ -280,7 +281,7 @@ crosscheck_silo::ReportSettings report_settings(const SiloCrosscheckOptions& o, 
     r.yade_material = in.yade_material;
     r.yade_material_file = o.yade_material;
     r.fill_text = o.fill_text;
-    r.kernel_law = o.kernel_law;
+    r.kernel_law = kernel::silo::silo_contact_laws().at(o.kernel_law);
     r.yade_runs = yade_runs(o.fill());
     r.plot_format = o.plot_format;
     return r;
@@ -355,7 +356,7 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
     silo->add_option("--kernel-law", o->kernel_law,
                      "the kernel's contact law (demcal silo --contact-law): edem, its own; yade, YADE's Hertz-Mindlin, "
                      "so that both codes run one law (the material's rolling friction must then be 0)")
-        ->check(CLI::IsMember({"edem", "yade"}))
+        ->check(CLI::IsMember(kernel::silo::silo_contact_laws()))
         ->capture_default_str();
     silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (3 with --fill both; a guard against typos)")
         ->check(integer_in(1, 1000000000))

@@ -363,7 +363,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.vibration = vibration_from(o, sub);
     s.contacts_at_opening =
         o.forget_contact_history ? ks::ContactsAtOpening::forget_history : ks::ContactsAtOpening::keep_history;
-    s.contact_law = o.contact_law == "yade" ? ks::SiloContactLaw::yade : ks::SiloContactLaw::edem;
+    s.contact_law = ks::silo_contact_laws().at(o.contact_law);  // a name the option checked
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
     try {
@@ -695,7 +695,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"contacts_at_opening", s.contacts_at_opening == ks::ContactsAtOpening::forget_history
                                                  ? "forget_history"
                                                  : "keep_history"},
-                     {"contact_law_family", s.contact_law == ks::SiloContactLaw::yade ? "yade" : "edem"},
+                     {"contact_law_family", ks::silo_contact_law_text(s.contact_law)},
                      // as a --material file gives it (silo_material.cpp), unscaled: demcal silo --material reads it back
                      {"material", silo_material_json(s.materials)},
                      {"contact_law", r.contact_law}};
@@ -809,7 +809,7 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
                     "edem: the kernel's Hertz-Mindlin (JKR when cohesive) with EDEM's rolling friction; yade: YADE "
                     "2023.02a's Hertz-Mindlin as yade_scripts/silo.py runs it (incremental tangential force, no "
                     "rolling resistance: the material's rolling friction must be 0), for a cross-check on one law")
-        ->check(CLI::IsMember({"edem", "yade"}))
+        ->check(CLI::IsMember(ks::silo_contact_laws()))
         ->capture_default_str();
     sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o.checkpoint_every,

@@ -26,8 +26,9 @@ std::string theta_name(double theta) {
 
 namespace {
 
-// The differences between the two codes' set-ups that YADE cannot remove (yade_scripts/README.md measures them).
-const char* const kKnownDifferences[] = {
+// The differences between the two codes' set-ups that YADE cannot remove (yade_scripts/README.md measures them): those
+// of the kernel's own contact law, gone when it runs YADE's (--kernel-law yade), and those left on either law.
+const char* const kOwnLawDifferences[] = {
     "rolling friction: YADE has no EDEM-type constant directional torque; its elastic-plastic rolling moment "
     "(run.rolling_moment) is a different law (measured on a 30 deg bed: +2.6 % on the rate against none). YADE runs "
     "without rolling resistance by default: at 10 deg (4000 grains) YADE / kernel was 1.064 and 1.087 on two beds; "
@@ -38,29 +39,25 @@ const char* const kKnownDifferences[] = {
     "the opening, demcal silo --forget-contact-history, moved its rate by -2.8 to +2.1 %, no systematic sign)",
     "YADE clips the normal force at zero in a separating contact; the kernel does not (a very small effect at "
     "restitution 0.5-0.6)",
-    "integrators: YADE's leapfrog with its aspherical rotation for clumps, the kernel's velocity Verlet with a "
-    "Richardson quaternion update",
-    "walls: YADE's cone and cylinder are facet polygons (72 sides), the kernel's are exact surfaces of revolution",
 };
-
-// The same when the kernel runs YADE's own Hertz-Mindlin (--kernel-law yade): the law's differences are gone.
-const char* const kKnownDifferencesOnYadeLaw[] = {
+const char* const kYadeLawDifferences[] = {
     "contact law: the kernel runs YADE 2023.02a's Hertz-Mindlin (kernel/contact/yade_mindlin_*.hpp, equal to YADE's "
     "own single-contact traces to 1e-6, two spheres and a sphere on a hertzian facet)",
     "contact history at the opening: YADE starts the imported bed's contacts afresh (tangential forces at zero), the "
     "kernel keeps its own",
+};
+const char* const kDifferencesOnEitherLaw[] = {
     "integrators: YADE's leapfrog with its aspherical rotation for clumps, the kernel's velocity Verlet with a "
     "Richardson quaternion update",
     "walls: YADE's cone and cylinder are facet polygons (72 sides), the kernel's are exact surfaces of revolution",
 };
 
-template <std::size_t N>
-std::vector<std::string> as_strings(const char* const (&list)[N]) {
-    return {std::begin(list), std::end(list)};
-}
-
 std::vector<std::string> known_differences(const ReportSettings& s) {
-    return s.kernel_law == "yade" ? as_strings(kKnownDifferencesOnYadeLaw) : as_strings(kKnownDifferences);
+    const bool yade_law = s.kernel_law == kernel::silo::SiloContactLaw::yade;
+    std::vector<std::string> d(yade_law ? std::begin(kYadeLawDifferences) : std::begin(kOwnLawDifferences),
+                               yade_law ? std::end(kYadeLawDifferences) : std::end(kOwnLawDifferences));
+    d.insert(d.end(), std::begin(kDifferencesOnEitherLaw), std::end(kDifferencesOnEitherLaw));
+    return d;
 }
 
 std::string g(double v, int digits = 4) {
@@ -320,7 +317,8 @@ struct Verdict {
 std::string closing_text(const ReportSettings& s, const Verdict& v) {
     std::ostringstream md;
     md << "\nThe kernel ran "
-       << (s.kernel_law == "yade" ? "YADE's Hertz-Mindlin (--kernel-law yade)" : "its own contact law (--kernel-law edem)")
+       << (s.kernel_law == kernel::silo::SiloContactLaw::yade ? "YADE's Hertz-Mindlin (--kernel-law yade)"
+                                                              : "its own contact law (--kernel-law edem)")
        << ".\n\nRates agree when YADE / kernel lies within 1 +/- " << g(s.tolerance)
        << (v.all_agree ? ": they do at every angle." : ": **they do not at every angle**.");
     if (!s.yade_material.is_null())
@@ -344,7 +342,7 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
                    {"stiffness_scale", s.stiffness_scale},
                    {"seed", s.seed},
                    {"angles", json::array()},
-                   {"kernel_contact_law", s.kernel_law},
+                   {"kernel_contact_law", kernel::silo::silo_contact_law_text(s.kernel_law)},
                    {"known_differences", known_differences(s)}};
     report["tolerance"] = s.tolerance;
     if (!s.yade_material.is_null()) report["yade_material"] = s.yade_material;

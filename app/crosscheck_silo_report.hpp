@@ -4,6 +4,7 @@
 // remove. Written as JSON, a Markdown table and one mass-time plot per angle.
 #pragma once
 
+#include "kernel/silo/silo_case.hpp"
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -38,7 +39,7 @@ struct ReportSettings {
     nlohmann::json yade_material;        // null: YADE ran the bed's material
     std::string yade_material_file;      // its file, for the report's note
     std::string fill_text;               // same-bed | own | both
-    std::string kernel_law = "edem";     // the kernel's contact law family (demcal silo --contact-law)
+    kernel::silo::SiloContactLaw kernel_law = kernel::silo::SiloContactLaw::edem;  // demcal silo --contact-law
     std::vector<YadeRunKind> yade_runs;  // the first is compared with the kernel; a second is YADE's own filling
     std::string plot_format = "png";
 };

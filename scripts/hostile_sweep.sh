@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Hostile-input sweep of the commands added since the last hardening pass (issue 23): shear-run, shear --engine
-# kernel, crosscheck shear, crosscheck silo (--fill), scale, cutoff, vibration, silo --export-bed/--export-cloud,
-# --forget-contact-history, --contact-law / --kernel-law and the --vibration-* options (--vibration-part, --part), diagnose silo-dem --max-runs.
+# kernel, crosscheck shear, crosscheck silo (--fill, --kernel-law), scale, cutoff, vibration, silo --export-bed /
+# --export-cloud, --forget-contact-history, --contact-law and the --vibration-* options (--vibration-part, --part),
+# diagnose silo-dem --max-runs.
 # Then the examples the issue itself lists, on the older commands (predict, silo --fill-mass, status and resume on a
 # store that is not demcal's, calibrate targets, enlarge).
 # Each case runs the real demcal under `timeout` in a scratch folder and checks:

@@ -63,8 +63,7 @@ struct YadeIncrementalTangential {
       f *= cap / fs;
       if (nrm.fn < 0) nrm.fn = 0;
     }
-    h[0] = f.x(); h[1] = f.y(); h[2] = f.z();
-    h[3] = n.x(); h[4] = n.y(); h[5] = n.z();
+    yade_store_shear(h, f, n);
     return f;
   }
 };

@@ -66,8 +66,7 @@ struct YadeMindlinTangential {
     } else {
       ft = f - (nrm.damp_prefactor * c.cs_over_cn) * vs;  // cs = 2 betas sqrt(m* ks), cn = 2 betan sqrt(m* kn)
     }
-    h[0] = f.x(); h[1] = f.y(); h[2] = f.z();
-    h[3] = n.x(); h[4] = n.y(); h[5] = n.z();
+    yade_store_shear(h, f, n);
     return ft;
   }
 };

@@ -1,7 +1,7 @@
 // What YADE's ScGeom gives its incremental shear laws, shared by YadeIncrementalTangential (the shear box's laws) and
 // YadeMindlinTangential (the silo's Hertz-Mindlin), both checked against YADE's own single-contact traces
 // (tests/kernel/test_yade_laws.cpp, test_yade_mindlin.cpp):
-// - yade_rotated_shear (ScGeom::rotate): a stored shear vector turned with the contact frame,
+// - yade_rotated_shear (ScGeom::rotate): a stored shear vector (yade_store_shear) turned with the contact frame,
 //   F -= F x (n_old x n), then F -= F x ((dt/2) (n_old . (w_i + w_j)) n_old); zero for a new contact;
 // - yade_incident_velocity (ScGeom::getIncidentVel with the "granular ratcheting" correction): the velocity of sphere
 //   i relative to j,
@@ -23,6 +23,12 @@ namespace demcal::kernel {
   f -= f.cross(n_old.cross(n));
   f -= f.cross((0.5 * dt * n_old.dot(k.omega_i + k.omega_j)) * n_old);
   return f;
+}
+
+/// Stores a shear vector and the normal it belongs to, in the layout yade_rotated_shear reads.
+[[gnu::always_inline]] inline void yade_store_shear(double* h, const Vec3& f, const Vec3& n) {
+  h[0] = f.x(); h[1] = f.y(); h[2] = f.z();
+  h[3] = n.x(); h[4] = n.y(); h[5] = n.z();
 }
 
 [[gnu::always_inline]] inline Vec3 yade_incident_velocity(const ContactGeometry& g, const ContactKinematics& k,

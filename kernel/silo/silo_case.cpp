@@ -929,11 +929,23 @@ SiloCaseResult run_on_its_law(const SiloCaseSettings& s, const std::function<voi
 
 }  // namespace
 
+const std::map<std::string, SiloContactLaw>& silo_contact_laws() {
+    static const std::map<std::string, SiloContactLaw> laws = {{"edem", SiloContactLaw::edem},
+                                                               {"yade", SiloContactLaw::yade}};
+    return laws;
+}
+
+std::string silo_contact_law_text(SiloContactLaw law) {
+    for (const auto& [name, value] : silo_contact_laws())
+        if (value == law) return name;
+    return "unknown (" + std::to_string(static_cast<int>(law)) + ")";
+}
+
 std::string contact_law_name(const SiloCaseSettings& s) {
     if (s.contact_law == SiloContactLaw::yade)
         return "YADE's Hertz-Mindlin (incremental tangential force, normal force clipped at zero), no rolling friction";
     return s.materials.cohesive() ? "Hertz-Mindlin with JKR cohesion, EDEM rolling friction"
-                        : "Hertz-Mindlin (no slip), EDEM rolling friction";
+                                  : "Hertz-Mindlin (no slip), EDEM rolling friction";
 }
 
 SiloCaseResult run_silo_case(const SiloCaseSettings& s, const std::function<void(const SiloProgress&)>& progress) {

@@ -14,6 +14,7 @@
 #include "kernel/walls.hpp"
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -54,6 +55,10 @@ enum class ContactsAtOpening : std::uint8_t { keep_history = 0, forget_history =
 // kernel/contact/yade_mindlin_*.hpp), so that a cross-check can run one law in both codes. It has no cohesion and no
 // rolling friction: materials with either are refused.
 enum class SiloContactLaw : std::uint8_t { edem = 0, yade = 1 };
+
+// The laws by the names the command line, summary.json and the cross-check use ("edem", "yade"): declared once here.
+const std::map<std::string, SiloContactLaw>& silo_contact_laws();
+std::string silo_contact_law_text(SiloContactLaw law);  // its name in silo_contact_laws()
 
 struct SiloCaseSettings {
     SiloGeometry geometry;
