@@ -67,6 +67,7 @@ struct SiloCrosscheckOptions {
     long max_runs = 10000;
     std::string fill_text = "same-bed";  // same-bed | own | both (checked by the option)
     std::string kernel_law = "edem";     // demcal silo --contact-law (a name of silo_contact_laws: the option checks)
+    std::string kernel_rotation = "richardson";  // demcal silo --discharge-rotation (silo_clump_rotations)
     FillMode fill() const { return kFillModes.at(fill_text); }
 };
 
@@ -96,6 +97,7 @@ std::vector<std::string> kernel_argv(const SiloCrosscheckOptions& o, double thet
     if (!o.material.empty()) a.insert(a.end(), {"--material", fs::absolute(o.material).string()});
     if (!o.geometry.empty()) a.insert(a.end(), {"--geometry", fs::absolute(o.geometry).string()});
     if (o.kernel_law != "edem") a.insert(a.end(), {"--contact-law", o.kernel_law});
+    if (o.kernel_rotation != "richardson") a.insert(a.end(), {"--discharge-rotation", o.kernel_rotation});
     return a;
 }
 
@@ -220,6 +222,7 @@ std::vector<orchestrator::StoredJob> kernel_jobs(const SiloCrosscheckOptions& o,
                              {"geometry_sha256", file_hash(o.geometry)}};
         // only when not the default: the runs of campaigns made before the choice keep their identity
         if (o.kernel_law != "edem") params["contact_law"] = o.kernel_law;
+        if (o.kernel_rotation != "richardson") params["discharge_rotation"] = o.kernel_rotation;
         auto job = orchestrator::stored_job(theta_name(theta) + " kernel", params,
                                             {{"theta_deg", theta}, {"code", "kernel"}}, d / "kernel",
                                             kernel_argv(o, theta, d / "kernel", d / "bed.json", program),
@@ -282,6 +285,7 @@ crosscheck_silo::ReportSettings report_settings(const SiloCrosscheckOptions& o, 
     r.yade_material_file = o.yade_material;
     r.fill_text = o.fill_text;
     r.kernel_law = kernel::silo::silo_contact_laws().at(o.kernel_law);
+    r.kernel_rotation = kernel::silo::silo_clump_rotations().at(o.kernel_rotation);
     r.yade_runs = yade_runs(o.fill());
     r.plot_format = o.plot_format;
     return r;
@@ -357,6 +361,12 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
                      "the kernel's contact law (demcal silo --contact-law): edem, its own; yade, YADE's Hertz-Mindlin, "
                      "so that both codes run one law (the material's rolling friction must then be 0)")
         ->check(CLI::IsMember(kernel::silo::silo_contact_laws()))
+        ->capture_default_str();
+    silo->add_option("--kernel-rotation", o->kernel_rotation,
+                     "how the kernel's grains turn in the discharge (demcal silo --discharge-rotation): richardson, "
+                     "its own; yade, YADE's aspherical leapfrog, so that both codes integrate the clumps alike (the "
+                     "bed is the same either way)")
+        ->check(CLI::IsMember(kernel::silo::silo_clump_rotations()))
         ->capture_default_str();
     silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (3 with --fill both; a guard against typos)")
         ->check(integer_in(1, 1000000000))

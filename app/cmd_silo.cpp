@@ -77,6 +77,7 @@ struct SiloCli {
     std::string export_cloud;  // the generated cloud before filling, for yade_scripts/silo.py to fill on its own
     bool forget_contact_history = false;  // at the opening, as a bed imported into YADE starts
     std::string contact_law = "edem";     // edem | yade (checked by the option)
+    std::string discharge_rotation = "richardson";  // richardson | yade (checked by the option)
 };
 
 // Exit status of a run stopped at --wall-limit (EX_TEMPFAIL): not finished, resume it. A job script can loop on it.
@@ -364,6 +365,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.contacts_at_opening =
         o.forget_contact_history ? ks::ContactsAtOpening::forget_history : ks::ContactsAtOpening::keep_history;
     s.contact_law = ks::silo_contact_laws().at(o.contact_law);  // a name the option checked
+    s.discharge_clump_rotation = ks::silo_clump_rotations().at(o.discharge_rotation);
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
     try {
@@ -552,6 +554,8 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
               << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string() << "\n  contact law: "
               << ks::contact_law_name(s);
     if (s.vibration.vibrates()) std::cout << "\n  vibration: " << vibration_text(s);
+    if (s.discharge_clump_rotation != kernel::ClumpRotation::richardson)
+        std::cout << "\n  clump rotation in the discharge: YADE's aspherical leapfrog (the filling: the kernel's own)";
     if (!s.checkpoint_file.empty())
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
                   << " (continue an interrupted run with `demcal silo --resume " << dir.string() << "`)";
@@ -696,6 +700,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                                                  ? "forget_history"
                                                  : "keep_history"},
                      {"contact_law_family", ks::silo_contact_law_text(s.contact_law)},
+                     {"discharge_clump_rotation", ks::silo_clump_rotation_text(s.discharge_clump_rotation)},
                      // as a --material file gives it (silo_material.cpp), unscaled: demcal silo --material reads it back
                      {"material", silo_material_json(s.materials)},
                      {"contact_law", r.contact_law}};
@@ -810,6 +815,12 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
                     "2023.02a's Hertz-Mindlin as yade_scripts/silo.py runs it (incremental tangential force, no "
                     "rolling resistance: the material's rolling friction must be 0), for a cross-check on one law")
         ->check(CLI::IsMember(ks::silo_contact_laws()))
+        ->capture_default_str();
+    sub->add_option("--discharge-rotation", o.discharge_rotation,
+                    "how the grains turn from the opening on: richardson (the kernel's quaternion update) or yade "
+                    "(YADE 2023.02a's aspherical leapfrog); the filling always runs the kernel's own, so the bed is the "
+                    "same either way: for a cross-check that removes the integrators' difference")
+        ->check(CLI::IsMember(ks::silo_clump_rotations()))
         ->capture_default_str();
     sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o.checkpoint_every,

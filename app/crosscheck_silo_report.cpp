@@ -46,9 +46,13 @@ const char* const kYadeLawDifferences[] = {
     "contact history at the opening: YADE starts the imported bed's contacts afresh (tangential forces at zero), the "
     "kernel keeps its own",
 };
-const char* const kDifferencesOnEitherLaw[] = {
+const char* const kOwnRotationDifference =
     "integrators: YADE's leapfrog with its aspherical rotation for clumps, the kernel's velocity Verlet with a "
-    "Richardson quaternion update",
+    "Richardson quaternion update (--kernel-rotation yade discharges with YADE's rotation instead)";
+const char* const kYadeRotationDifference =
+    "integrators: the kernel discharges with YADE's aspherical clump rotation (--kernel-rotation yade; it follows "
+    "YADE's own trace of a spinning clump to rounding); velocity Verlet and YADE's leapfrog step positions alike";
+const char* const kDifferencesOnEitherLaw[] = {
     "walls: YADE's cone and cylinder are facet polygons (72 sides), the kernel's are exact surfaces of revolution",
 };
 
@@ -56,6 +60,8 @@ std::vector<std::string> known_differences(const ReportSettings& s) {
     const bool yade_law = s.kernel_law == kernel::silo::SiloContactLaw::yade;
     std::vector<std::string> d(yade_law ? std::begin(kYadeLawDifferences) : std::begin(kOwnLawDifferences),
                                yade_law ? std::end(kYadeLawDifferences) : std::end(kOwnLawDifferences));
+    d.push_back(s.kernel_rotation == kernel::ClumpRotation::yade_leapfrog ? kYadeRotationDifference
+                                                                          : kOwnRotationDifference);
     d.insert(d.end(), std::begin(kDifferencesOnEitherLaw), std::end(kDifferencesOnEitherLaw));
     return d;
 }
@@ -319,6 +325,9 @@ std::string closing_text(const ReportSettings& s, const Verdict& v) {
     md << "\nThe kernel ran "
        << (s.kernel_law == kernel::silo::SiloContactLaw::yade ? "YADE's Hertz-Mindlin (--kernel-law yade)"
                                                               : "its own contact law (--kernel-law edem)")
+       << (s.kernel_rotation == kernel::ClumpRotation::yade_leapfrog
+               ? ", its grains turning by YADE's clump rotation in the discharge (--kernel-rotation yade)"
+               : "")
        << ".\n\nRates agree when YADE / kernel lies within 1 +/- " << g(s.tolerance)
        << (v.all_agree ? ": they do at every angle." : ": **they do not at every angle**.");
     if (!s.yade_material.is_null())
@@ -343,6 +352,7 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
                    {"seed", s.seed},
                    {"angles", json::array()},
                    {"kernel_contact_law", kernel::silo::silo_contact_law_text(s.kernel_law)},
+                   {"kernel_discharge_rotation", kernel::silo::silo_clump_rotation_text(s.kernel_rotation)},
                    {"known_differences", known_differences(s)}};
     report["tolerance"] = s.tolerance;
     if (!s.yade_material.is_null()) report["yade_material"] = s.yade_material;

@@ -40,6 +40,7 @@ struct ReportSettings {
     std::string yade_material_file;      // its file, for the report's note
     std::string fill_text;               // same-bed | own | both
     kernel::silo::SiloContactLaw kernel_law = kernel::silo::SiloContactLaw::edem;  // demcal silo --contact-law
+    kernel::ClumpRotation kernel_rotation = kernel::ClumpRotation::richardson;     // demcal silo --discharge-rotation
     std::vector<YadeRunKind> yade_runs;  // the first is compared with the kernel; a second is YADE's own filling
     std::string plot_format = "png";
 };

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "kernel/clump.hpp"
+#include "kernel/clump_rotation_scheme.hpp"
 #include "kernel/contact/contact_law.hpp"
 #include "kernel/material.hpp"
 #include "kernel/neighbor.hpp"
@@ -111,6 +112,11 @@ class BasicSimulation {
   /// YADE's quasi-static tests; it is not a physical dissipation.
   void set_local_damping(double damping);
   double local_damping() const { return local_damping_; }
+  /// How clumps turn: the kernel's Richardson quaternion update (default; LAMMPS/LIGGGHTS) or YADE's aspherical
+  /// leapfrog (kernel/clump_rotation_yade.hpp), for cross-checks that remove the integrators' difference. A setting
+  /// like the damping: not part of the saved state.
+  void set_clump_rotation(ClumpRotation scheme) { clump_rotation_ = scheme; }
+  ClumpRotation clump_rotation() const { return clump_rotation_; }
   /// Laws with bonds (YadeCohesiveFrictional): the contacts acting at the next force evaluation are bonded, where
   /// their pair has a cohesion (YADE's setCohesionNow). Forces are evaluated again at the next step() without
   /// advancing time (as after any state change).
@@ -249,6 +255,7 @@ class BasicSimulation {
   std::vector<Vec3> wall_disp_built_;  // each wall's displacement at the last neighbour build
   bool walls_move_ = false;            // some wall has a motion law or a velocity
   double local_damping_ = 0;           // YADE's non-viscous damping coefficient
+  ClumpRotation clump_rotation_ = ClumpRotation::richardson;
   bool bond_next_evaluation_ = false;  // bond the contacts of the next force evaluation
   std::vector<ClumpTemplate> templates_;
 

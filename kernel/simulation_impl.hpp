@@ -12,6 +12,7 @@
 #include <string>
 
 #include "kernel/clump_rotation.hpp"
+#include "kernel/clump_rotation_yade.hpp"
 #include "kernel/state_io.hpp"
 
 #include "kernel/simulation.hpp"
@@ -359,18 +360,30 @@ bool BasicSimulation<Law>::kick_drift(double kick) {
         L.x[k] = cL_[c].x(); L.y[k] = cL_[c].y(); L.z[k] = cL_[c].z();
         inv_I.x[k] = iI.x(); inv_I.y[k] = iI.y(); inv_I.z[k] = iI.z();
       }
-      cr::richardson(q, L, inv_I, dt);
-      // one rotation matrix for the new omega and the members
-      const cr::MatPack R = cr::rotation_matrix(q);
-      const cr::VecPack w = cr::angular_velocity(R, L, inv_I);
+      if (clump_rotation_ == ClumpRotation::yade_leapfrog) {
+        // YADE's scheme, one clump at a time (a cross-check's option, not the kernel's hot path)
+        for (int k = 0; k < lanes; ++k) {
+          const std::int64_t c = c0 + k;
+          cw_[c] = cr::yade_leapfrog(cq_[c], cL_[c] - (0.5 * dt) * cT_[c], cL_[c], cI_[c], dt);
+          update_members(std::size_t(c), cq_[c].toRotationMatrix(), true);
+        }
+      } else {
+        cr::richardson(q, L, inv_I, dt);
+        // one rotation matrix for the new omega and the members
+        const cr::MatPack R = cr::rotation_matrix(q);
+        const cr::VecPack w = cr::angular_velocity(R, L, inv_I);
+        for (int k = 0; k < lanes; ++k) {
+          const std::int64_t c = c0 + k;
+          cq_[c] = Quat(q.w[k], q.x[k], q.y[k], q.z[k]);
+          cw_[c] = Vec3(w.x[k], w.y[k], w.z[k]);
+          Mat3 Rk;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) Rk(i, j) = R.m[i][j][k];
+          update_members(std::size_t(c), Rk, true);
+        }
+      }
       for (int k = 0; k < lanes; ++k) {
         const std::int64_t c = c0 + k;
-        cq_[c] = Quat(q.w[k], q.x[k], q.y[k], q.z[k]);
-        cw_[c] = Vec3(w.x[k], w.y[k], w.z[k]);
-        Mat3 Rk;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) Rk(i, j) = R.m[i][j][k];
-        update_members(std::size_t(c), Rk, true);
         if (Law::uses_omega_norm) {
           const double wn = cw_[c].norm();  // the members' omega is the clump's
           for (std::uint32_t m = cmem_start_[c]; m < cmem_start_[c + 1]; ++m) wnorm[cmem_[m]] = wn;

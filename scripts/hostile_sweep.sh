@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Hostile-input sweep of the commands added since the last hardening pass (issue 23): shear-run, shear --engine
 # kernel, crosscheck shear, crosscheck silo (--fill, --kernel-law), scale, cutoff, vibration, silo --export-bed /
-# --export-cloud, --forget-contact-history, --contact-law and the --vibration-* options (--vibration-part, --part),
+# --export-cloud, --forget-contact-history, --contact-law, --discharge-rotation (crosscheck --kernel-rotation) and the --vibration-* options (--vibration-part, --part),
 # diagnose silo-dem --max-runs.
 # Then the examples the issue itself lists, on the older commands (predict, silo --fill-mass, status and resume on a
 # store that is not demcal's, calibrate targets, enlarge).
@@ -156,6 +156,8 @@ S=(crosscheck silo --campaign camp --particles 100)
 run_case crosscheck-silo/theta-nan   2 "theta"           -- "${S[@]}" --theta nan
 run_case crosscheck-silo/kernel-law-unknown 2 "--kernel-law" -- "${S[@]}" --theta 30 --kernel-law lammps
 run_case crosscheck-silo/kernel-law-rolling 2 "rolling_friction" -- "${S[@]}" --theta 30 --kernel-law yade
+run_case crosscheck-silo/kernel-rotation-unknown 2 "--kernel-rotation" -- "${S[@]}" --theta 30 --kernel-rotation omelyan
+run_case crosscheck-silo/kernel-rotation-empty 2 "--kernel-rotation" -- "${S[@]}" --theta 30 --kernel-rotation ""
 run_case crosscheck-silo/theta-subnormal 2 "theta"       -- "${S[@]}" --theta 1e-320
 run_case crosscheck-silo/theta-90    2 "theta"           -- "${S[@]}" --theta 90
 run_case crosscheck-silo/theta-huge  2 "theta"           -- "${S[@]}" --theta "$huge"
@@ -270,6 +272,8 @@ run_case silo/forget-history-resume  2 "--forget-contact-history" -- silo --resu
 run_case silo/contact-law-unknown     2 "--contact-law"   -- "${L[@]}" --contact-law lammps
 run_case silo/contact-law-rolling     2 "grain_grain.rolling_friction = 0.01" -- "${L[@]}" --contact-law yade
 run_case silo/contact-law-resume      2 "--contact-law"   -- silo --resume somewhere --contact-law yade
+run_case silo/rotation-unknown        2 "--discharge-rotation" -- "${L[@]}" --discharge-rotation "$hugestr"
+run_case silo/rotation-resume         2 "--discharge-rotation" -- silo --resume somewhere --discharge-rotation yade
 run_case silo/out-readonly           2 "out"     "$ro"   -- "${L[@]}" --out "$ro/o"
 run_case silo/out-file               2 "out"             -- "${L[@]}" --out "$tiny"
 run_case silo/vtk-readonly           2 "vtk"     "$ro"   -- "${L[@]}" --vtk "$ro/v"

@@ -256,6 +256,10 @@ void validate(const SiloCaseSettings& s) {
     validate(s.vibration);
     if (s.contact_law != SiloContactLaw::edem && s.contact_law != SiloContactLaw::yade)
         reject_setting("contact_law", static_cast<double>(s.contact_law), "must be edem (0) or yade (1)");
+    if (s.discharge_clump_rotation != ClumpRotation::richardson &&
+        s.discharge_clump_rotation != ClumpRotation::yade_leapfrog)
+        reject_setting("discharge_clump_rotation", static_cast<double>(s.discharge_clump_rotation),
+                       "must be richardson (0) or yade (1)");
     if (s.contact_law == SiloContactLaw::yade) {
         // YADE's Hertz-Mindlin (as silo.py runs it) has neither: a value would be silently dropped
         for (const auto& [p, name] : {std::pair{&s.materials.wheat_wheat, "grain_grain"},
@@ -313,6 +317,7 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
+// Version 10: the discharge's clump rotation scheme at the end of the settings (versions 4 to 9 are read, richardson).
 // Version 9: the contact law (edem / yade) at the end of the settings (versions 4 to 8 are read, on the edem law).
 // Version 8: the grain's aspect ratio at the end of the settings (versions 4 to 7 are read, with the seed's grain).
 // Version 5: the pairs' surface energies (JKR cohesion) at the end of the settings; version 4, the same without them
@@ -320,7 +325,8 @@ namespace {
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 9;
+constexpr int kCheckpointVersion = 10;
+constexpr int kCheckpointVersionWithoutRotationChoice = 9;  // discharge_clump_rotation: richardson
 constexpr int kCheckpointVersionWithoutLawChoice = 8;      // contact_law: edem
 constexpr int kCheckpointVersionWithoutGrainShape = 7;     // grain_aspect_ratio: the seed's
 constexpr int kCheckpointVersionWithoutVibratingPart = 6;  // vibration_part: bin; no outlet-flow frames
@@ -393,6 +399,8 @@ void for_each_setting(S& s, F&& f) {
     f("grain_aspect_ratio", s.materials.grain_aspect_ratio);
     // since version 9 (edem before)
     f("contact_law", s.contact_law);
+    // since version 10 (richardson before)
+    f("discharge_clump_rotation", s.discharge_clump_rotation);
 }
 
 void write_settings(StateWriter& w, const SiloCaseSettings& s) {
@@ -411,6 +419,8 @@ SiloCaseSettings read_settings(StateReader& r, int version) {
         if (version <= kCheckpointVersionWithoutVibratingPart && std::string_view(name) == "vibration_part") return;
         if (version <= kCheckpointVersionWithoutGrainShape && std::string_view(name) == "grain_aspect_ratio") return;
         if (version <= kCheckpointVersionWithoutLawChoice && std::string_view(name) == "contact_law") return;
+        if (version <= kCheckpointVersionWithoutRotationChoice && std::string_view(name) == "discharge_clump_rotation")
+            return;
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
         else r.value(v, name);
     });
@@ -537,6 +547,7 @@ public:
         if (bin_motion_ && phase_ == Phase::discharge) bin_motion_->open_at(t_open_);  // the law the run was on
         plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_, s_.vibration.part);
         if (phase_ == Phase::discharge) {
+            sim_.set_clump_rotation(s_.discharge_clump_rotation);
             make_discharge_recorders();
             classifier_->load(r);
             r_.section->load(r);
@@ -712,6 +723,7 @@ private:
     void open() {
         if (s_.at_opening) s_.at_opening(bed_snapshot());
         if (s_.contacts_at_opening == ContactsAtOpening::forget_history) sim_.forget_contact_history();
+        sim_.set_clump_rotation(s_.discharge_clump_rotation);
         sim_.set_wall_enabled(plate_, false);
         t_open_ = sim_.time();
         if (bin_motion_) bin_motion_->open_at(t_open_);
@@ -885,22 +897,13 @@ SiloCaseSettings settings_of(std::istream& is, const std::string& file, int& ver
     const std::string prefix = kCheckpointTagPrefix;
     version = 0;
     const std::string current = prefix + std::to_string(kCheckpointVersion);
-    if (tag == current) {
-        version = kCheckpointVersion;
-    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutLawChoice)) {
-        version = kCheckpointVersionWithoutLawChoice;
-    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutGrainShape)) {
-        version = kCheckpointVersionWithoutGrainShape;
-    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutVibratingPart)) {
-        version = kCheckpointVersionWithoutVibratingPart;
-    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutHistoryChoice)) {
-        version = kCheckpointVersionWithoutHistoryChoice;
-    } else if (tag == prefix + std::to_string(kCheckpointVersionWithoutCohesion)) {
-        version = kCheckpointVersionWithoutCohesion;
-    } else if (tag == prefix + "1" || tag == prefix + "2" || tag == prefix + "3") {
+    // every version from 4 on is read (the settings added since take their former values)
+    for (int v = kCheckpointVersionWithoutCohesion; v <= kCheckpointVersion; ++v)
+        if (tag == prefix + std::to_string(v)) version = v;
+    if (version == 0 && (tag == prefix + "1" || tag == prefix + "2" || tag == prefix + "3")) {
         r.fail("format tag", "written by an older demcal (" + tag + "; this one reads " + current +
                                  "): finish that run with the demcal that started it, or start it again");
-    } else {
+    } else if (version == 0) {
         r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a silo checkpoint (" + current + ")");
     }
     SiloCaseSettings settings = read_settings(r, version);
@@ -933,6 +936,18 @@ const std::map<std::string, SiloContactLaw>& silo_contact_laws() {
     static const std::map<std::string, SiloContactLaw> laws = {{"edem", SiloContactLaw::edem},
                                                                {"yade", SiloContactLaw::yade}};
     return laws;
+}
+
+const std::map<std::string, ClumpRotation>& silo_clump_rotations() {
+    static const std::map<std::string, ClumpRotation> schemes = {{"richardson", ClumpRotation::richardson},
+                                                                 {"yade", ClumpRotation::yade_leapfrog}};
+    return schemes;
+}
+
+std::string silo_clump_rotation_text(ClumpRotation scheme) {
+    for (const auto& [name, value] : silo_clump_rotations())
+        if (value == scheme) return name;
+    return "unknown (" + std::to_string(static_cast<int>(scheme)) + ")";
 }
 
 std::string silo_contact_law_text(SiloContactLaw law) {

@@ -11,6 +11,7 @@
 #include "kernel/silo/silo_output.hpp"
 #include "kernel/silo/wheat.hpp"
 #include "kernel/clump.hpp"
+#include "kernel/clump_rotation_scheme.hpp"
 #include "kernel/walls.hpp"
 
 #include <functional>
@@ -58,6 +59,13 @@ enum class SiloContactLaw : std::uint8_t { edem = 0, yade = 1 };
 
 // The laws by the names the command line, summary.json and the cross-check use ("edem", "yade"): declared once here.
 const std::map<std::string, SiloContactLaw>& silo_contact_laws();
+
+// How the clumps turn in the discharge, by name ("richardson": the kernel's own; "yade": YADE 2023.02a's aspherical
+// leapfrog, kernel/clump_rotation_yade.hpp). The filling always runs the kernel's own, so that the bed at the opening
+// (the one YADE imports in a cross-check) is the same whichever scheme discharges it: a paired comparison then
+// measures what the integrators alone change.
+const std::map<std::string, ClumpRotation>& silo_clump_rotations();
+std::string silo_clump_rotation_text(ClumpRotation scheme);  // its name in silo_clump_rotations()
 std::string silo_contact_law_text(SiloContactLaw law);  // its name in silo_contact_laws()
 
 struct SiloCaseSettings {
@@ -87,6 +95,7 @@ struct SiloCaseSettings {
     BinVibration vibration;
     ContactsAtOpening contacts_at_opening = ContactsAtOpening::keep_history;
     SiloContactLaw contact_law = SiloContactLaw::edem;
+    ClumpRotation discharge_clump_rotation = ClumpRotation::richardson;  // from the opening on (see above)
     // Verlet skin [m]; 0: automatic, 40 dt x 1 m/s within [0.2 mm, 1 mm] (grains leave the outlet at ~1 m/s: the list
     // then lasts tens of steps; measured on the reduced 70 deg case, dt = 66 us: 1 mm ran 1.7 times faster than the
     // kernel's default 0.1 r; at the seed's dt = 2.1 us a 0.2 mm skin keeps fewer pairs in the list).

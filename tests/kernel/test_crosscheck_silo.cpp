@@ -83,7 +83,8 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     fs::remove_all(dir);
 }
 
-TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindlin, the report says so", "[yade]") {
+TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindlin (and with --kernel-rotation yade its "
+          "clump rotation), the report says so", "[yade]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-xsilo-law-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -110,6 +111,19 @@ TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindl
     const auto& a = report["angles"][0];
     CHECK(a["rate_ratio_yade_over_kernel"].get<double>() > 0.8);
     CHECK(a["rate_ratio_yade_over_kernel"].get<double>() < 1.25);
+    CHECK(report["kernel_discharge_rotation"] == "richardson");
+    // the kernel discharging with YADE's clump rotation from the same bed: the kernel runs again, YADE's run of that
+    // bed is reused, and the report names the scheme in place of the integrators' difference
+    REQUIRE(run_demcal(args + " --kernel-rotation yade", dir / "rotation.log") == 0);
+    CHECK_THAT(read_file(dir / "rotation.log"), Catch::Contains("started  theta_45 kernel"));
+    CHECK(read_file(dir / "rotation.log").find("started  theta_45 yade") == std::string::npos);
+    const auto rotated = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
+    CHECK(rotated["kernel_discharge_rotation"] == "yade");
+    CHECK_THAT(rotated["known_differences"].dump(), Catch::Contains("YADE's aspherical clump rotation"));
+    const auto rotated_summary =
+        nlohmann::json::parse(read_file(dir / "c" / "theta_45" / "kernel" / "summary.json"));
+    CHECK(rotated_summary["settings"]["discharge_clump_rotation"] == "yade");
+    CHECK(rotated_summary["filled_mass_kg"] == summary["filled_mass_kg"]);
     // the default material (rolling friction 0.01) on YADE's law: refused before anything runs, the field named
     const std::string bad = "crosscheck silo --theta 45 --particles 300 --kernel-law yade -c '" +
                             (dir / "bad").string() + "'";

@@ -16,7 +16,8 @@ TEST_CASE("the committed single-contact traces are what real YADE computes, byte
   const fs::path src = fs::path(DEMCAL_SOURCE_DIR);
   const fs::path dir = fs::temp_directory_path() / ("demcal-test-yade-traces-" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  for (const char* name : {"ss_bond_shear_tension", "sb_frict", "sb_dynamic_damped", "hm_pair", "hm_facet"}) {
+  for (const char* name : {"ss_bond_shear_tension", "sb_frict", "sb_dynamic_damped", "cb_clump_damped", "hm_pair",
+                           "hm_facet"}) {
     INFO(name);
     const fs::path params = src / "tests/data/yade_contact" / (std::string(name) + ".json");
     const fs::path out = dir / (std::string(name) + ".csv");

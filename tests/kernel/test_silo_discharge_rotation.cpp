@@ -1,0 +1,49 @@
+// The silo case's discharge rotation scheme (demcal silo --discharge-rotation yade): the clumps turn by YADE's
+// aspherical leapfrog from the opening on and only then, so the bed is the one the kernel's own scheme fills (the bed a
+// cross-check gives YADE); the run resumes from checkpoints bit for bit with the choice stored, and a value that is not
+// a scheme is refused by name.
+#include "kernel/silo/silo_case.hpp"
+#include "silo_resume_check.hpp"
+
+#include "tiny_silo.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace demcal::kernel::silo;
+using demcal::kernel::ClumpRotation;
+
+TEST_CASE("silo case: YADE's clump rotation in the discharge leaves the filling and changes the discharge only a little",
+          "[silo][clump-rotation]") {
+    SiloCaseSettings s = demcal::test::tiny_silo_case();
+    const SiloCaseResult own = run_silo_case(s);
+    s.discharge_clump_rotation = ClumpRotation::yade_leapfrog;
+    const SiloCaseResult yade = run_silo_case(s);
+    CHECK(yade.fill_steps == own.fill_steps);
+    CHECK(yade.fill_kinetic_energy == own.fill_kinetic_energy);
+    CHECK(yade.filled_mass == own.filled_mass);
+    CHECK_FALSE(demcal::test::same_discharge(yade, own));
+    REQUIRE(yade.fit.ok);
+    REQUIRE(own.fit.ok);
+    // two second-order integrators at the same step: the same flow within a run's own scatter
+    INFO("rate with YADE's rotation " << yade.fit.rate << " kg/s, the kernel's " << own.fit.rate << " kg/s");
+    CHECK(yade.fit.rate / own.fit.rate == Approx(1.0).margin(0.15));
+}
+
+TEST_CASE("silo case: a run discharging on YADE's clump rotation resumes bit for bit, the choice stored",
+          "[silo][clump-rotation][checkpoint]") {
+    SiloCaseSettings s = demcal::test::tiny_silo_case();
+    s.discharge_clump_rotation = ClumpRotation::yade_leapfrog;
+    // killed while filling (the resumed session must switch at the opening), then in the discharge (it must switch again)
+    const SiloCaseSettings stored = demcal::test::check_resumes_bit_for_bit(s, "yade-rotation", 0.05);
+    CHECK(stored.discharge_clump_rotation == ClumpRotation::yade_leapfrog);
+}
+
+TEST_CASE("silo case: a discharge rotation that is not a scheme is refused by name; the names are one table",
+          "[silo][clump-rotation]") {
+    SiloCaseSettings s = demcal::test::tiny_silo_case();
+    s.discharge_clump_rotation = static_cast<ClumpRotation>(5);
+    CHECK_THROWS_WITH(validate(s), Catch::Contains("discharge_clump_rotation") && Catch::Contains("5"));
+    for (const auto& [name, scheme] : silo_clump_rotations()) CHECK(silo_clump_rotation_text(scheme) == name);
+    CHECK(silo_clump_rotations().at("yade") == ClumpRotation::yade_leapfrog);
+    CHECK(silo_clump_rotations().at("richardson") == ClumpRotation::richardson);
+}
