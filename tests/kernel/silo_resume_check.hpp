@@ -22,6 +22,15 @@ inline bool same_discharge(const kernel::silo::SiloCaseResult& a, const kernel::
     return true;
 }
 
+// A switch that acts at the opening (and only then): the same filling as without it, another discharge.
+inline void check_same_fill_other_discharge(const kernel::silo::SiloCaseResult& switched,
+                                            const kernel::silo::SiloCaseResult& plain) {
+    CHECK(switched.fill_steps == plain.fill_steps);
+    CHECK(switched.fill_kinetic_energy == plain.fill_kinetic_energy);
+    CHECK(switched.filled_mass == plain.filled_mass);
+    CHECK_FALSE(same_discharge(switched, plain));
+}
+
 // `s` runs whole, then again killed at its 5th checkpoint (while filling, with checkpoints after every record
 // interval) and, resumed on another thread count, killed once the discharge passed `second_kill_after` s; the third
 // session finishes. Returns the checkpoint's stored settings for the caller's own checks.
