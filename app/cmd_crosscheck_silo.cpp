@@ -38,7 +38,6 @@ using nlohmann::json;
 using crosscheck_silo::kYadeOwnFill;
 using crosscheck_silo::kYadeSameBed;
 using crosscheck_silo::kYadeFramesFile;
-using crosscheck_silo::theta_name;
 using crosscheck_silo::YadeRunKind;
 
 namespace {
@@ -69,6 +68,13 @@ struct SiloCrosscheckOptions {
     std::string kernel_law = "edem";     // demcal silo --contact-law (a name of silo_contact_laws: the option checks)
     std::string kernel_rotation = "richardson";  // demcal silo --discharge-rotation (silo_clump_rotations)
     FillMode fill() const { return kFillModes.at(fill_text); }
+    // an angle's folder and its kernel run's (names the options checked)
+    std::string angle(double theta) const {
+        return crosscheck_silo::angle_folder(theta, kernel::silo::silo_contact_laws().at(kernel_law));
+    }
+    std::string kernel_run() const {
+        return crosscheck_silo::kernel_folder(kernel::silo::silo_clump_rotations().at(kernel_rotation));
+    }
 };
 
 std::vector<YadeRunKind> yade_runs(FillMode mode) {
@@ -208,8 +214,8 @@ std::vector<orchestrator::StoredJob> kernel_jobs(const SiloCrosscheckOptions& o,
                                                  const std::string& program) {
     std::vector<orchestrator::StoredJob> jobs;
     for (double theta : o.thetas) {
-        const fs::path d = root / theta_name(theta);
-        fs::create_directories(d / "kernel");
+        const fs::path d = root / o.angle(theta), kd = d / o.kernel_run();
+        fs::create_directories(kd);
         // the identity: what the run computes, without paths (a campaign moved elsewhere keeps its runs)
         json params = {{"code", "kernel"},
                              {"what", "demcal silo, its bed at the opening and its generated cloud exported"},
@@ -223,9 +229,9 @@ std::vector<orchestrator::StoredJob> kernel_jobs(const SiloCrosscheckOptions& o,
         // only when not the default: the runs of campaigns made before the choice keep their identity
         if (o.kernel_law != "edem") params["contact_law"] = o.kernel_law;
         if (o.kernel_rotation != "richardson") params["discharge_rotation"] = o.kernel_rotation;
-        auto job = orchestrator::stored_job(theta_name(theta) + " kernel", params,
-                                            {{"theta_deg", theta}, {"code", "kernel"}}, d / "kernel",
-                                            kernel_argv(o, theta, d / "kernel", d / "bed.json", program),
+        auto job = orchestrator::stored_job(o.angle(theta) + " " + o.kernel_run(), params,
+                                            {{"theta_deg", theta}, {"code", "kernel"}}, kd,
+                                            kernel_argv(o, theta, kd, d / "bed.json", program),
                                             "summary.json", o.timeout_s);
         job.outputs = {d / "bed.json", d / "cloud.json"};
         jobs.push_back(std::move(job));
@@ -242,8 +248,8 @@ std::vector<orchestrator::StoredJob> yade_jobs(const SiloCrosscheckOptions& o, c
     std::vector<orchestrator::StoredJob> jobs;
     for (double theta : o.thetas)
         for (const YadeRunKind& kind : yade_runs(o.fill())) {
-            const fs::path d = root / theta_name(theta), run = d / kind.folder;
-            if (!fs::exists(d / kind.bed_file) || !fs::exists(d / "kernel" / "summary.json")) continue;
+            const fs::path d = root / o.angle(theta), run = d / kind.folder;
+            if (!fs::exists(d / kind.bed_file) || !fs::exists(d / o.kernel_run() / "summary.json")) continue;
             const json bed = analytics::read_json_input(d / kind.bed_file, "bed");
             const json params = yade_params(bed, o, in.yade_material, kind);
             fs::create_directories(run);
@@ -256,7 +262,7 @@ std::vector<orchestrator::StoredJob> yade_jobs(const SiloCrosscheckOptions& o, c
                                    {"params", params},
                                    {"bed_sha256", file_hash((d / kind.bed_file).string())}};
             jobs.push_back(orchestrator::stored_job(
-                theta_name(theta) + " " + kind.folder, identity, {{"theta_deg", theta}, {"code", kind.folder}}, run,
+                o.angle(theta) + " " + kind.folder, identity, {{"theta_deg", theta}, {"code", kind.folder}}, run,
                 {in.yade, "-n", "-j1", "-x", "run_clean.py", "silo.py", "params.json", "result.json"}, "result.json",
                 o.timeout_s));
         }

@@ -24,6 +24,16 @@ std::string theta_name(double theta) {
     return o.str();
 }
 
+std::string angle_folder(double theta, kernel::silo::SiloContactLaw law) {
+    if (law == kernel::silo::SiloContactLaw::edem) return theta_name(theta);
+    return theta_name(theta) + "_law-" + kernel::silo::silo_contact_law_text(law);
+}
+
+std::string kernel_folder(kernel::ClumpRotation rotation) {
+    if (rotation == kernel::ClumpRotation::richardson) return "kernel";
+    return "kernel-rotation-" + kernel::silo::silo_clump_rotation_text(rotation);
+}
+
 namespace {
 
 // The differences between the two codes' set-ups that YADE cannot remove (yade_scripts/README.md measures them): those
@@ -169,13 +179,13 @@ struct KernelSide {
     Curve curve;
 };
 
-KernelSide read_kernel_side(const fs::path& angle_dir) {
+KernelSide read_kernel_side(const fs::path& kernel_dir) {
     KernelSide k;
-    k.summary = analytics::read_json_input(angle_dir / "kernel" / "summary.json", "kernel summary");
+    k.summary = analytics::read_json_input(kernel_dir / "summary.json", "kernel summary");
     k.rate = k.summary.at("rate").at("rate_kg_s").get<double>();
     k.filled = k.summary.at("filled_mass_kg").get<double>();
     k.cpu = k.summary.at("cpu_s").get<double>();
-    k.curve = kernel_curve(angle_dir / "kernel" / "discharge.csv");
+    k.curve = kernel_curve(kernel_dir / "discharge.csv");
     return k;
 }
 
@@ -363,13 +373,13 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
     md << kComparisonHeader;
     Verdict verdict;
     for (double theta : s.thetas) {
-        const fs::path d = root / theta_name(theta);
-        if (!fs::exists(d / "kernel" / "summary.json") || !fs::exists(d / primary.folder / "result.json")) {
+        const fs::path d = root / angle_folder(theta, s.kernel_law), kd = d / kernel_folder(s.kernel_rotation);
+        if (!fs::exists(kd / "summary.json") || !fs::exists(d / primary.folder / "result.json")) {
             md << "| " << theta << " | (a run failed: see " << d.string() << ") ||||||||||\n";
             out.complete = false;
             continue;
         }
-        const KernelSide k = read_kernel_side(d);
+        const KernelSide k = read_kernel_side(kd);
         const YadeSide y = read_yade_side(d, primary);
         const Comparison c = compare(theta, k, y, s.tolerance);
         verdict.add(c);
@@ -390,7 +400,7 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
             }
         }
         try {
-            write_curve_plot(d, theta, k.curve, y.curve, own_curve, s.plot_format);
+            write_curve_plot(kd, theta, k.curve, y.curve, own_curve, s.plot_format);  // beside the kernel run it compares
         } catch (const std::exception& e) {
             std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
         }

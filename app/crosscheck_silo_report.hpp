@@ -29,6 +29,13 @@ inline constexpr const char* kYadeFramesFile = "frames.bin";
 
 // The folder of one angle's runs in the campaign: theta_<deg>.
 std::string theta_name(double theta);
+// The folder of one angle's runs on a kernel contact law: theta_<deg> on the kernel's own (the layout of campaigns
+// made before the choice), theta_<deg>_law-<name> otherwise: the kernel fills with its law, so the bed, YADE's runs of
+// it and the kernel's run all belong to the law, and a campaign switching laws must not mix them.
+std::string angle_folder(double theta, kernel::silo::SiloContactLaw law);
+// The kernel run's folder within an angle's, per discharge rotation: "kernel" for the kernel's own, kernel-rotation-
+// <name> otherwise. The filling is the same whichever scheme discharges, so the bed and YADE's runs of it are shared.
+std::string kernel_folder(kernel::ClumpRotation rotation);
 
 struct ReportSettings {
     std::vector<double> thetas;
@@ -50,7 +57,8 @@ struct Report {
     bool complete = true;  // every angle's runs gave results
 };
 
-// Reads the runs of every angle under `root`, writes root/crosscheck_silo.{json,md} and root/<theta>/mass_time.<fmt>.
+// Reads the runs of every angle under `root`, writes root/crosscheck_silo.{json,md} and, beside each kernel run,
+// root/<angle_folder>/<kernel_folder>/mass_time.<fmt>.
 Report write_report(const std::filesystem::path& root, const ReportSettings& settings);
 
 }  // namespace demcal::crosscheck_silo

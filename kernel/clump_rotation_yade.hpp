@@ -14,6 +14,14 @@
 
 namespace demcal::kernel::clump_rotation {
 
+/// The body-frame angular velocity of a body-frame angular momentum, YADE's cwiseQuotient by the principal moments;
+/// a zero moment (a template built by hand) gives 0 about that axis, as the kernel's own scheme does, not inf.
+inline Vec3 yade_body_omega(const Vec3& L_body, const Vec3& inertia) {
+  Vec3 w;
+  for (int k = 0; k < 3; ++k) w[k] = inertia[k] > 0 ? L_body[k] / inertia[k] : 0.0;
+  return w;
+}
+
 /// YADE's DotQ: dq/dt = 1/2 q (0, w_body) for a body-frame angular velocity w_body.
 inline Quat yade_dot_q(const Vec3& w_body, const Quat& q) {
   Quat d;
@@ -29,10 +37,10 @@ inline Quat yade_dot_q(const Vec3& w_body, const Quat& q) {
 /// n - 1/2 plus dt torque); `inertia`: the principal moments. Returns the world angular velocity at n + 1/2.
 inline Vec3 yade_leapfrog(Quat& q, const Vec3& L_n, const Vec3& L_half, const Vec3& inertia, double dt) {
   const Mat3 A = q.conjugate().toRotationMatrix();  // world -> body at n
-  const Vec3 w_body_n = (A * L_n).cwiseQuotient(inertia);
+  const Vec3 w_body_n = yade_body_omega(A * L_n, inertia);
   const Quat dq_n = yade_dot_q(w_body_n, q);
   const Quat q_half(q.coeffs() + dt / 2. * dq_n.coeffs());
-  const Vec3 w_body_half = (A * L_half).cwiseQuotient(inertia);
+  const Vec3 w_body_half = yade_body_omega(A * L_half, inertia);
   const Quat dq_half = yade_dot_q(w_body_half, q_half);
   q = Quat(q.coeffs() + dt * dq_half.coeffs());
   const Vec3 omega = q * w_body_half;  // (q not yet normalised, as in YADE)

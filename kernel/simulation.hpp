@@ -114,7 +114,9 @@ class BasicSimulation {
   double local_damping() const { return local_damping_; }
   /// How clumps turn: the kernel's Richardson quaternion update (default; LAMMPS/LIGGGHTS) or YADE's aspherical
   /// leapfrog (kernel/clump_rotation_yade.hpp), for cross-checks that remove the integrators' difference. A setting
-  /// like the damping: not part of the saved state.
+  /// like the damping: not part of the saved state. (A force refresh after a setting changed between steps takes
+  /// omega back to the half step from L with the new orientation, as the kernel's own scheme does; YADE's step had
+  /// used the old one's body frame: O(dt) apart in omega for that one evaluation. The silo never refreshes so.)
   void set_clump_rotation(ClumpRotation scheme) { clump_rotation_ = scheme; }
   ClumpRotation clump_rotation() const { return clump_rotation_; }
   /// Laws with bonds (YadeCohesiveFrictional): the contacts acting at the next force evaluation are bonded, where

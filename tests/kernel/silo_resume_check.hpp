@@ -44,11 +44,14 @@ inline kernel::silo::SiloCaseSettings check_resumes_bit_for_bit(kernel::silo::Si
     s.checkpoint_file = (dir / "checkpoint.bin").string();
     s.checkpoint_interval = 0;  // after every record interval
     long seen = 0;
+    bool opened = false;  // the first kill must come while filling: the resumed session then opens the outlet itself
     CHECK_THROWS_AS(run_silo_case(s,
                                   [&](const SiloProgress& p) {
+                                      opened = opened || p.phase == "discharge";
                                       if (p.phase == "checkpoint" && ++seen == 5) throw SimulatedCrash{};
                                   }),
                     SimulatedCrash);
+    CHECK_FALSE(opened);
     const SiloCaseSettings stored = read_checkpoint_settings(s.checkpoint_file);
     CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0},
                                      [&](const SiloProgress& p) {

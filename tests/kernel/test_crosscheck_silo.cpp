@@ -105,7 +105,8 @@ TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindl
     const auto report = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
     CHECK(report["kernel_contact_law"] == "yade");
     CHECK_THAT(report["known_differences"].dump(), Catch::Contains("YADE 2023.02a's Hertz-Mindlin"));
-    const auto summary = nlohmann::json::parse(read_file(dir / "c" / "theta_45" / "kernel" / "summary.json"));
+    const auto summary =
+        nlohmann::json::parse(read_file(dir / "c" / "theta_45_law-yade" / "kernel" / "summary.json"));
     CHECK(summary["settings"]["contact_law_family"] == "yade");
     CHECK_THAT(summary["settings"]["contact_law"].get<std::string>(), Catch::Contains("YADE"));
     const auto& a = report["angles"][0];
@@ -115,15 +116,23 @@ TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindl
     // the kernel discharging with YADE's clump rotation from the same bed: the kernel runs again, YADE's run of that
     // bed is reused, and the report names the scheme in place of the integrators' difference
     REQUIRE(run_demcal(args + " --kernel-rotation yade", dir / "rotation.log") == 0);
-    CHECK_THAT(read_file(dir / "rotation.log"), Catch::Contains("started  theta_45 kernel"));
-    CHECK(read_file(dir / "rotation.log").find("started  theta_45 yade") == std::string::npos);
+    CHECK_THAT(read_file(dir / "rotation.log"), Catch::Contains("started  theta_45_law-yade kernel-rotation-yade"));
+    CHECK(read_file(dir / "rotation.log").find("started  theta_45_law-yade yade") == std::string::npos);
     const auto rotated = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
     CHECK(rotated["kernel_discharge_rotation"] == "yade");
     CHECK_THAT(rotated["known_differences"].dump(), Catch::Contains("YADE's aspherical clump rotation"));
-    const auto rotated_summary =
-        nlohmann::json::parse(read_file(dir / "c" / "theta_45" / "kernel" / "summary.json"));
+    const auto rotated_summary = nlohmann::json::parse(
+        read_file(dir / "c" / "theta_45_law-yade" / "kernel-rotation-yade" / "summary.json"));
     CHECK(rotated_summary["settings"]["discharge_clump_rotation"] == "yade");
     CHECK(rotated_summary["filled_mass_kg"] == summary["filled_mass_kg"]);
+    // back to the kernel's own rotation in the same campaign: nothing runs, and the report is the first one's, not
+    // built from the other scheme's run
+    REQUIRE(run_demcal(args, dir / "back.log") == 0);
+    CHECK(read_file(dir / "back.log").find("started") == std::string::npos);
+    const auto back = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
+    CHECK(back["kernel_discharge_rotation"] == "richardson");
+    CHECK(back["angles"][0]["kernel"]["rate_kg_s"] == a["kernel"]["rate_kg_s"]);
+    CHECK(back["angles"][0]["kernel"]["rate_kg_s"] != rotated["angles"][0]["kernel"]["rate_kg_s"]);
     // the default material (rolling friction 0.01) on YADE's law: refused before anything runs, the field named
     const std::string bad = "crosscheck silo --theta 45 --particles 300 --kernel-law yade -c '" +
                             (dir / "bad").string() + "'";
