@@ -35,7 +35,7 @@ TEST_CASE("silo case: a run discharging on YADE's clump rotation resumes bit for
     CHECK(stored.discharge_clump_rotation == ClumpRotation::yade_leapfrog);
 }
 
-TEST_CASE("silo case: a discharge rotation that is not a scheme is refused by name; the names are one table",
+TEST_CASE("silo case: a discharge rotation that is not a scheme is refused by name, and the names are one table",
           "[silo][clump-rotation]") {
     SiloCaseSettings s = demcal::test::tiny_silo_case();
     s.discharge_clump_rotation = static_cast<ClumpRotation>(5);
