@@ -286,6 +286,13 @@ class BasicSimulation {
     return w;
   }
   std::vector<std::uint64_t> wall_cand_;                    // per sphere: walls within reach at the last build
+  // Past kMaxWallCandidates walls (the facets of a mesh wall) the candidates are a list per sphere instead (CSR, in
+  // ascending wall order). Not saved in a state: derived again from the build positions after a load.
+  std::vector<std::uint32_t> wall_list_row_;
+  std::vector<std::int32_t> wall_list_;
+  bool wall_lists_stale_ = false;                           // a state was loaded: derive the lists before the next use
+  void find_wall_candidate_lists(const std::vector<Vec3>& centres, double reach,
+                                 const std::vector<Vec3>& wall_displacement);
 
   // per clump
   std::vector<Vec3> cx_, cv_, cw_, cL_, cI_, cF_, cT_;

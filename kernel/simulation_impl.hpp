@@ -513,8 +513,15 @@ void BasicSimulation<Law>::find_wall_candidates() {
   wall_cand_.assign(std::size_t(n), 0);
   wall_disp_built_.resize(walls_.size());
   for (std::size_t k = 0; k < walls_.size(); ++k) wall_disp_built_[k] = walls_[k].displacement;
-  if (nw == 0 || nw > kMaxWallCandidates) return;
+  wall_list_row_.clear();
+  wall_list_.clear();
+  wall_lists_stale_ = false;
+  if (nw == 0) return;
   const double reach = 0.5 * skin_ + (walls_move_ ? 0.5 * skin_ : 0.0) + law_reach_;
+  if (nw > kMaxWallCandidates) {
+    find_wall_candidate_lists(x_, reach, wall_disp_built_);
+    return;
+  }
 #pragma omp parallel for num_threads(nt()) schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     std::uint64_t m = 0;
@@ -527,11 +534,49 @@ void BasicSimulation<Law>::find_wall_candidates() {
 }
 
 template <class Law>
+void BasicSimulation<Law>::find_wall_candidate_lists(const std::vector<Vec3>& centres, double reach,
+                                                     const std::vector<Vec3>& wall_displacement) {
+  // Each thread lists the walls of its contiguous block of spheres (schedule static, no chunk: blocks in thread
+  // order), then the blocks are joined in that order: ascending spheres, ascending walls, whatever the thread count.
+  const std::int64_t n = std::int64_t(centres.size());
+  const int nw = int(walls_.size());
+  std::vector<std::uint32_t> count(std::size_t(n), 0);
+  std::vector<std::vector<std::int32_t>> block(static_cast<std::size_t>(nt()));
+#pragma omp parallel num_threads(nt())
+  {
+    std::vector<std::int32_t>& mine = block[std::size_t(omp_get_thread_num())];
+    Vec3 nrm;
+    double dn, dist;
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i)
+      for (int wdx = 0; wdx < nw; ++wdx) {
+        // the wall where it stood at the build: contact() takes off its displacement now
+        const Vec3 p = centres[std::size_t(i)] + (walls_[wdx].displacement - wall_displacement[std::size_t(wdx)]);
+        if (walls_[wdx].contact(p, r_[std::size_t(i)] + reach, nrm, dn, dist)) {
+          mine.push_back(wdx);
+          ++count[std::size_t(i)];
+        }
+      }
+  }
+  wall_list_row_.assign(std::size_t(n) + 1, 0);
+  for (std::int64_t i = 0; i < n; ++i) wall_list_row_[std::size_t(i) + 1] = wall_list_row_[std::size_t(i)] + count[std::size_t(i)];
+  wall_list_.clear();
+  wall_list_.reserve(wall_list_row_.back());
+  for (const auto& b : block) wall_list_.insert(wall_list_.end(), b.begin(), b.end());
+}
+
+template <class Law>
 void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   if (rebuild || !nl_.valid() || nl_.built_positions().size() != x_.size()) {
     if (reorder_every_ > 0 && builds_since_reorder_ % reorder_every_ == 0) reorder_spheres();
     ++builds_since_reorder_;
     rebuild_neighbors();
+  } else if (wall_lists_stale_) {
+    // a loaded state: the lists its run had, or more walls (the largest reach, the radii now): a wider filter finds
+    // the same contacts in the same order, so the run goes on bit for bit
+    if (int(walls_.size()) > kMaxWallCandidates)
+      find_wall_candidate_lists(nl_.built_positions(), skin_ + law_reach_, wall_disp_built_);
+    wall_lists_stale_ = false;
   }
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
   pair_load_.resize(nl_.num_pairs());
@@ -629,12 +674,17 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         double ns[kWallSlots][kH];
         Vec3 nf[kWallSlots];
         int used = 0;
-        // only the walls within reach at the last neighbour build (all of them past kMaxWallCandidates walls), in
-        // ascending order either way: the set bits of the candidate mask, not a test of every wall
-        const bool tracked = nw <= kMaxWallCandidates;
-        std::uint64_t candidates = tracked ? wall_cand_[i] : 0;
-        for (int wdx = tracked ? next_wall_candidate(candidates) : 0; wdx < nw;
-             wdx = tracked ? next_wall_candidate(candidates) : wdx + 1) {
+        // only the walls within reach at the last neighbour build, in ascending order: the set bits of the candidate
+        // mask, or past kMaxWallCandidates walls the sphere's candidate list; not a test of every wall
+        const bool masked = nw <= kMaxWallCandidates;
+        std::uint64_t candidates = masked ? wall_cand_[i] : 0;
+        std::uint32_t listed = masked ? 0 : wall_list_row_[i];
+        const std::uint32_t listed_end = masked ? 0 : wall_list_row_[i + 1];
+        auto next_candidate = [&]() -> int {
+          if (masked) return next_wall_candidate(candidates);
+          return listed < listed_end ? wall_list_[listed++] : nw;
+        };
+        for (int wdx = next_candidate(); wdx < nw; wdx = next_candidate()) {
           const Wall& wall = walls_[wdx];
           if (!wall.enabled) continue;
           Vec3 nrm;
@@ -1226,6 +1276,7 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   rebuild_body_index();
   prepared_ = false;  // pair coefficients are derived from the configuration again
   list_from_state_ = true;  // and the law's reach (prepare), which must not discard the list loaded here
+  wall_lists_stale_ = true;
 }
 
 template <class Law>

@@ -1,5 +1,5 @@
 // Walls: one type per shape (kernel/walls/: PlaneWall, RectangleWall, BoxWall, AxisymmetricWall for cylinders, cones,
-// disks), each with its closest-point query; a Wall adds what every wall has: a material, an on/off switch, and a
+// disks, TriangleWall for the facets of a mesh), each with its closest-point query; a Wall adds what every wall has: a material, an on/off switch, and a
 // translation (displacement and velocity) that follows a prescribed law (kernel/walls/wall_motion.hpp) or a velocity
 // a driver sets. Contacts see the wall's velocity. The per-particle wall loop visits the shape through std::visit
 // (a jump table, like the switch it replaced); the contact law is shared with sphere-sphere contacts.
@@ -14,12 +14,13 @@
 #include "kernel/walls/box_wall.hpp"
 #include "kernel/walls/plane_wall.hpp"
 #include "kernel/walls/rectangle_wall.hpp"
+#include "kernel/walls/triangle_wall.hpp"
 #include "kernel/walls/wall_motion.hpp"
 
 namespace demcal::kernel {
 
 struct Wall {
-  using Shape = std::variant<PlaneWall, RectangleWall, BoxWall, AxisymmetricWall>;
+  using Shape = std::variant<PlaneWall, RectangleWall, BoxWall, AxisymmetricWall, TriangleWall>;
   Shape shape;
   int material = 0;      ///< material id (Simulation::add_material); its pairs with particle materials apply
   bool enabled = true;   ///< a disabled wall exerts no force (its tangential histories are dropped)
@@ -66,6 +67,10 @@ struct Wall {
   static Wall rectangle_from_corners(const Vec3& a, const Vec3& b, const Vec3& c, int material) {
     const Vec3 e1 = b - a, e2 = c - a;
     return rectangle(a + 0.5 * (e1 + e2), e1.cross(e2), e1, 0.5 * e1.norm(), 0.5 * e2.norm(), material);
+  }
+  /// Triangular facet with vertices a, b, c (two-sided; YADE's facet contact: kernel/walls/triangle_wall.hpp).
+  static Wall triangle(const Vec3& a, const Vec3& b, const Vec3& c, int material) {
+    return make(TriangleWall::from_vertices(a, b, c), material);
   }
   /// Solid axis-aligned box between corners lo and hi.
   static Wall box(const Vec3& lo, const Vec3& hi, int material) {

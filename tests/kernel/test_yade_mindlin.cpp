@@ -63,3 +63,11 @@ TEST_CASE("YADE Hertz-Mindlin: a sphere on one of silo.py's wall facets gives YA
   // with hertzian facets (R* = r / (1 + 1e-8)): approach, slide with spin, slide back rolling, press, fast lift-off
   check_only_yade_law_matches("hm_facet");
 }
+
+TEST_CASE("YADE Hertz-Mindlin: a sphere driven off a facet across its edges and past a vertex gives YADE's forces to 1e-6",
+          "[kernel][yade-laws][yade-mindlin][walls]") {
+  // the kernel's triangular wall (YADE's facet geometry: face, edge and vertex contacts, kernel/walls/triangle_wall.hpp)
+  // on a facet smaller than the sphere, as silo.py's are: face, vertex (lost and found again), edge, lost, edge, face,
+  // lift-off; the contact starts and ends where YADE's does (the replay checks each sampled step's contact state)
+  check_only_yade_law_matches("hm_facet_edges");
+}

@@ -17,7 +17,7 @@ TEST_CASE("the committed single-contact traces are what real YADE computes, byte
   const fs::path dir = fs::temp_directory_path() / ("demcal-test-yade-traces-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   for (const char* name : {"ss_bond_shear_tension", "sb_frict", "sb_dynamic_damped", "cb_clump_damped", "hm_pair",
-                           "hm_facet"}) {
+                           "hm_facet", "hm_facet_edges"}) {
     INFO(name);
     const fs::path params = src / "tests/data/yade_contact" / (std::string(name) + ".json");
     const fs::path out = dir / (std::string(name) + ".csv");

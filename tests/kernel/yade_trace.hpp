@@ -79,21 +79,12 @@ inline double sphere_mass(const json& p, const std::string& body, double r) {
   return p["materials"][p[body]["material"].get<std::string>()]["density"].get<double>() * 4.0 / 3.0 * M_PI * r * r * r;
 }
 
-/// A horizontal facet (fixed.vertices at one z) as the top face of a box under it, as wide as the facet's bounds:
-/// the same contact as the facet's wherever the sphere is over the facet's interior.
-inline BoxWall facet_as_box(const json& fixed) {
+/// The trace's fixed facet (fixed.vertices) as the kernel's triangular wall: YADE's facet contact, edges and vertices
+/// included (kernel/walls/triangle_wall.hpp).
+inline Wall facet_wall(const json& fixed) {
   const json& v = fixed["vertices"];
   REQUIRE(v.size() == 3);
-  const double z = v[0][2].get<double>();
-  Vec3 lo = vec(v[0]), hi = vec(v[0]);
-  for (const json& p : v) {
-    REQUIRE(p[2].get<double>() == z);  // horizontal: its normal is +z
-    lo = lo.cwiseMin(vec(p));
-    hi = hi.cwiseMax(vec(p));
-  }
-  const double depth = 0.01;
-  return BoxWall{Vec3(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), z - depth),
-                 Vec3(0.5 * (hi.x() - lo.x()), 0.5 * (hi.y() - lo.y()), depth)};
+  return Wall::triangle(vec(v[0]), vec(v[1]), vec(v[2]), 0);
 }
 
 template <class Law>
@@ -101,19 +92,18 @@ double replay(const std::string& name, const std::function<typename Law::Params(
   const json p = read_params(name);
   const Trace t = read_trace(kData + name + ".csv");
   const double dt = p["dt"];
-  // a wall: a box, or a facet replayed as the top face of a box below it (the path keeps off the facet's edges)
+  // a wall: a box or a facet
   const bool box = p["case"] == "sphere_box" || p["case"] == "sphere_facet";
   const json& mat_i = p["materials"][p["moving"]["material"].get<std::string>()];
   const json& mat_j = p["materials"][p["fixed"]["material"].get<std::string>()];
   const typename Law::Coeffs coeffs = Law::mix(material(mat_i), material(mat_j), pair_params(mat_i, mat_j));
   const double ri = p["moving"]["radius"];
   const double rj = box ? 0.0 : p["fixed"]["radius"].get<double>();
-  const Vec3 xj = p["case"] == "sphere_facet" ? facet_as_box(p["fixed"]).centre
-                                              : vec(box ? p["fixed"]["center"] : p["fixed"]["pos"]);
+  const Vec3 xj = p["case"] == "sphere_facet" ? Vec3::Zero() : vec(box ? p["fixed"]["center"] : p["fixed"]["pos"]);
   const double mi = sphere_mass(p, "moving", ri), mj = box ? 0.0 : sphere_mass(p, "fixed", rj);
-  BoxWall wall;
-  if (p["case"] == "sphere_facet") wall = facet_as_box(p["fixed"]);
-  else if (box) wall = BoxWall{xj, vec(p["fixed"]["extents"])};
+  Wall wall;
+  if (p["case"] == "sphere_facet") wall = facet_wall(p["fixed"]);
+  else if (box) wall = Wall::box(xj - vec(p["fixed"]["extents"]), xj + vec(p["fixed"]["extents"]), 0);
   std::vector<std::pair<Vec3, Vec3>> path;  // velocity, angular velocity per step
   for (const json& seg : p["path"])
     for (int k = 0; k < seg["steps"].get<int>(); ++k) path.emplace_back(vec(seg["vel"]), vec(seg.value("angvel", json::array({0, 0, 0}))));
@@ -130,8 +120,8 @@ double replay(const std::string& name, const std::function<typename Law::Params(
     ContactGeometry g{};
     bool touching;
     if (box) {
-      Vec3 n;
-      double dn, dist;
+      Vec3 n = Vec3::Zero();
+      double dn = 0, dist = 0;
       touching = wall.contact(xi, ri, n, dn, dist);
       g = {n, dn, ri, mi, ri, 0.0, ri - 0.5 * dn, 0.0};
     } else {
