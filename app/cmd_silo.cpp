@@ -78,6 +78,7 @@ struct SiloCli {
     bool forget_contact_history = false;  // at the opening, as a bed imported into YADE starts
     std::string contact_law = "edem";     // edem | yade (checked by the option)
     std::string discharge_rotation = "richardson";  // richardson | yade (checked by the option)
+    int discharge_wall_facets = 0;                  // 0: exact walls (validate() checks the rest)
 };
 
 // Exit status of a run stopped at --wall-limit (EX_TEMPFAIL): not finished, resume it. A job script can loop on it.
@@ -366,6 +367,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
         o.forget_contact_history ? ks::ContactsAtOpening::forget_history : ks::ContactsAtOpening::keep_history;
     s.contact_law = ks::silo_contact_laws().at(o.contact_law);  // a name the option checked
     s.discharge_clump_rotation = ks::silo_clump_rotations().at(o.discharge_rotation);
+    s.discharge_wall_facets = o.discharge_wall_facets;
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
     try {
@@ -556,6 +558,9 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (s.vibration.vibrates()) std::cout << "\n  vibration: " << vibration_text(s);
     if (s.discharge_clump_rotation != kernel::ClumpRotation::richardson)
         std::cout << "\n  clump rotation in the discharge: YADE's aspherical leapfrog (the filling: the kernel's own)";
+    if (s.discharge_wall_facets > 0)
+        std::cout << "\n  walls in the discharge: cone and cylinder of " << s.discharge_wall_facets
+                  << " facets around, as YADE's silo.py (the filling: exact walls)";
     if (!s.checkpoint_file.empty())
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
                   << " (continue an interrupted run with `demcal silo --resume " << dir.string() << "`)";
@@ -701,6 +706,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                                                  : "keep_history"},
                      {"contact_law_family", ks::silo_contact_law_text(s.contact_law)},
                      {"discharge_clump_rotation", ks::silo_clump_rotation_text(s.discharge_clump_rotation)},
+                     {"discharge_wall_facets", s.discharge_wall_facets},
                      // as a --material file gives it (silo_material.cpp), unscaled: demcal silo --material reads it back
                      {"material", silo_material_json(s.materials)},
                      {"contact_law", r.contact_law}};
@@ -821,6 +827,12 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
                     "(YADE 2023.02a's aspherical leapfrog); the filling always runs the kernel's own, so the bed is the "
                     "same either way: for a cross-check that removes the integrators' difference")
         ->check(CLI::IsMember(ks::silo_clump_rotations()))
+        ->capture_default_str();
+    sub->add_option("--discharge-wall-facets", o.discharge_wall_facets,
+                    "0: exact cone and cylinder; N (12 to 2000): from the opening on, the conical silo's cone and "
+                    "cylinder as N-sided polygons of triangular facets with YADE's facet contact, built as "
+                    "yade_scripts/silo.py builds its walls; the filling runs on the exact walls, so the bed is the same "
+                    "either way: for a cross-check that removes the walls' difference")
         ->capture_default_str();
     sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o.checkpoint_every,

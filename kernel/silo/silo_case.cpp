@@ -148,14 +148,21 @@ typename Law::Params to_kernel(const PairCoefficients& p) {
     return k;
 }
 
-// The walls in the order silo_walls gives them; returns the outlet plate's wall id.
+// The walls in the order silo_walls gives them, then (facets > 0) the facet walls of silo_facet_walls, switched off
+// until the opening (silo_exact_wall_count, open()); returns the outlet plate's wall id.
 template <class Sim>
 int add_silo_walls(Sim& sim, const SiloGeometry& g, int steel, double wall_top,
-                   const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part) {
+                   const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part, int facets) {
     int plate = -1;
     for (const Wall& w : silo_walls(g, steel, wall_top, bin_motion, part)) plate = sim.add_wall(w);
+    if (facets > 0)
+        for (const Wall& w : silo_facet_walls(g, steel, wall_top, facets, bin_motion, part))
+            sim.set_wall_enabled(sim.add_wall(w), false);
     return plate;
 }
+
+// The walls the facets replace at the opening: silo_walls' cone and cylinder, ids 0 and 1.
+constexpr int silo_exact_wall_count = 2;
 
 }  // namespace
 
@@ -186,6 +193,36 @@ std::vector<Wall> silo_walls(const SiloGeometry& g, int steel, double wall_top,
                                           steel));
     }
     hopper(Wall::rectangle(Vec3(0, 0, 0), Vec3::UnitZ(), Vec3::UnitX(), a2 * 1.001, b2, steel));
+    return walls;
+}
+
+std::vector<Wall> silo_facet_walls(const SiloGeometry& g, int steel, double wall_top, int sides,
+                                   const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part) {
+    if (g.shape != SiloShape::conical)
+        throw std::invalid_argument("silo_facet_walls: facet walls are built for the conical silo only");
+    // a polygon of `sides` whose sides lie at mean distance `radius` from the axis (silo.py's ring())
+    const auto ring = [sides](double radius, double z) {
+        const double vertex_radius = radius * (pi / sides) / std::sin(pi / sides);
+        std::vector<Vec3> v;
+        for (int k = 0; k < sides; ++k)
+            v.emplace_back(vertex_radius * std::cos(2 * pi * k / sides), vertex_radius * std::sin(2 * pi * k / sides), z);
+        return v;
+    };
+    const double hh = g.hopper_height();
+    const std::vector<Vec3> outlet = ring(g.outlet_half(), 0.0), body = ring(g.top_half(), hh),
+                            top = ring(g.top_half(), wall_top);
+    std::vector<Wall> walls;
+    // two triangles per side between two rings (silo.py's band_facets): (a, b, c) and (a, c, d)
+    const auto band = [&](const std::vector<Vec3>& lower, const std::vector<Vec3>& upper, bool moves) {
+        for (int k = 0; k < sides; ++k) {
+            const int m = (k + 1) % sides;
+            for (const Wall& w : {Wall::triangle(lower[k], lower[m], upper[m], steel),
+                                  Wall::triangle(lower[k], upper[m], upper[k], steel)})
+                walls.push_back(moves ? w.moving(bin_motion) : w);
+        }
+    };
+    band(outlet, body, bin_motion != nullptr);                                  // the cone: the hopper
+    band(body, top, bin_motion != nullptr && part == VibratingPart::bin);       // the cylinder: the body
     return walls;
 }
 
@@ -256,6 +293,14 @@ void validate(const SiloCaseSettings& s) {
     validate(s.vibration);
     if (s.contact_law != SiloContactLaw::edem && s.contact_law != SiloContactLaw::yade)
         reject_setting("contact_law", static_cast<double>(s.contact_law), "must be edem (0) or yade (1)");
+    if (s.discharge_wall_facets != 0) {
+        if (!(s.discharge_wall_facets >= 12 && s.discharge_wall_facets <= 2000))
+            reject_setting("discharge_wall_facets", s.discharge_wall_facets,
+                           "must be 0 (exact walls) or lie in [12, 2000] (facets around)");
+        if (s.geometry.shape != SiloShape::conical)
+            reject_setting("discharge_wall_facets", s.discharge_wall_facets,
+                           "facet walls are built for the conical silo only (0 for a rectangular one)");
+    }
     if (s.discharge_clump_rotation != ClumpRotation::richardson &&
         s.discharge_clump_rotation != ClumpRotation::yade_leapfrog)
         reject_setting("discharge_clump_rotation", static_cast<double>(s.discharge_clump_rotation),
@@ -317,6 +362,7 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
+// Version 11: the discharge's wall facets at the end of the settings (versions 4 to 10 are read, exact walls).
 // Version 10: the discharge's clump rotation scheme at the end of the settings (versions 4 to 9 are read, richardson).
 // Version 9: the contact law (edem / yade) at the end of the settings (versions 4 to 8 are read, on the edem law).
 // Version 8: the grain's aspect ratio at the end of the settings (versions 4 to 7 are read, with the seed's grain).
@@ -325,7 +371,8 @@ namespace {
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 10;
+constexpr int kCheckpointVersion = 11;
+constexpr int kCheckpointVersionWithoutWallFacets = 10;    // discharge_wall_facets: 0 (exact walls)
 constexpr int kCheckpointVersionWithoutRotationChoice = 9;  // discharge_clump_rotation: richardson
 constexpr int kCheckpointVersionWithoutLawChoice = 8;      // contact_law: edem
 constexpr int kCheckpointVersionWithoutGrainShape = 7;     // grain_aspect_ratio: the seed's
@@ -401,6 +448,8 @@ void for_each_setting(S& s, F&& f) {
     f("contact_law", s.contact_law);
     // since version 10 (richardson before)
     f("discharge_clump_rotation", s.discharge_clump_rotation);
+    // since version 11 (exact walls before)
+    f("discharge_wall_facets", s.discharge_wall_facets);
 }
 
 void write_settings(StateWriter& w, const SiloCaseSettings& s) {
@@ -421,6 +470,7 @@ SiloCaseSettings read_settings(StateReader& r, int version) {
         if (version <= kCheckpointVersionWithoutLawChoice && std::string_view(name) == "contact_law") return;
         if (version <= kCheckpointVersionWithoutRotationChoice && std::string_view(name) == "discharge_clump_rotation")
             return;
+        if (version <= kCheckpointVersionWithoutWallFacets && std::string_view(name) == "discharge_wall_facets") return;
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) v = r.text(name);
         else r.value(v, name);
     });
@@ -456,7 +506,8 @@ public:
         Generator gen(s_.geometry, tmpl_, s_.seed);
         const auto placed = gen.generate(n, 0.003, 30.0);
         wall_top_ = std::max(s_.geometry.top(), gen.top() + 0.01);
-        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_, s_.vibration.part);
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_, s_.vibration.part,
+                                s_.discharge_wall_facets);
         for (const auto& p : placed) sim_.add_clump(grain_, wheat_, p.com, p.q);
         r_.grains = long(placed.size());
         const double dt = s_.time_step > 0 ? s_.time_step : s_.time_step_fraction * sim_.rayleigh_timestep();
@@ -545,7 +596,8 @@ public:
         r.array(r_.discharge, "discharge record");
         if (phase_ != Phase::filling && phase_ != Phase::discharge) r.fail("phase", "unknown value");
         if (bin_motion_ && phase_ == Phase::discharge) bin_motion_->open_at(t_open_);  // the law the run was on
-        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_, s_.vibration.part);
+        plate_ = add_silo_walls(sim_, s_.geometry, steel_, wall_top_, bin_motion_, s_.vibration.part,
+                                s_.discharge_wall_facets);
         if (phase_ == Phase::discharge) {
             sim_.set_clump_rotation(s_.discharge_clump_rotation);
             make_discharge_recorders();
@@ -725,6 +777,8 @@ private:
         if (s_.contacts_at_opening == ContactsAtOpening::forget_history) sim_.forget_contact_history();
         sim_.set_clump_rotation(s_.discharge_clump_rotation);
         sim_.set_wall_enabled(plate_, false);
+        if (s_.discharge_wall_facets > 0)  // the exact cone and cylinder give way to their facets
+            for (int w = 0; w < int(sim_.num_walls()); ++w) sim_.set_wall_enabled(w, w >= silo_exact_wall_count && w != plate_);
         t_open_ = sim_.time();
         if (bin_motion_) bin_motion_->open_at(t_open_);
         make_discharge_recorders();

@@ -96,6 +96,11 @@ struct SiloCaseSettings {
     ContactsAtOpening contacts_at_opening = ContactsAtOpening::keep_history;
     SiloContactLaw contact_law = SiloContactLaw::edem;
     ClumpRotation discharge_clump_rotation = ClumpRotation::richardson;  // from the opening on (see above)
+    // 0: the conical silo's cone and cylinder are exact surfaces of revolution. N (12 to 2000): from the opening on
+    // they are N-sided polygons of triangular facets (kernel/walls/triangle_wall.hpp, YADE's facet contact), built as
+    // yade_scripts/silo.py builds its walls (silo_facet_walls); the filling always runs on the exact walls, so the
+    // bed at the opening is the same either way: what a YADE run started from the kernel's bed meets.
+    int discharge_wall_facets = 0;
     // Verlet skin [m]; 0: automatic, 40 dt x 1 m/s within [0.2 mm, 1 mm] (grains leave the outlet at ~1 m/s: the list
     // then lasts tens of steps; measured on the reduced 70 deg case, dt = 66 us: 1 mm ran 1.7 times faster than the
     // kernel's default 0.1 r; at the seed's dt = 2.1 us a 0.2 mm skin keeps fewer pairs in the list).
@@ -137,6 +142,12 @@ void validate(const SiloCaseSettings& s);
 // the vibrating `part` move on `bin_motion` (null: every wall still).
 std::vector<Wall> silo_walls(const SiloGeometry& g, int steel, double wall_top,
                              const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part);
+// The conical silo's cone and cylinder as yade_scripts/silo.py builds them from facets: `sides` facets around, each
+// side of the cone (outlet to body) and of the cylinder (body to wall_top) split into two triangles, the polygons'
+// vertices at the radius that puts the facets' mean distance from the axis at the wall's radius; moving as the exact
+// walls they stand for (bin_motion, part).
+std::vector<Wall> silo_facet_walls(const SiloGeometry& g, int steel, double wall_top, int sides,
+                                   const std::shared_ptr<const WallMotion>& bin_motion, VibratingPart part);
 
 // The Rayleigh time step of the grain's smallest sphere at the materials' (scaled) stiffness [s], and the time step a
 // run of these settings plans from it (time_step, or time_step_fraction of it): what the checks of a run's settings
