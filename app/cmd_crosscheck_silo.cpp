@@ -67,13 +67,16 @@ struct SiloCrosscheckOptions {
     std::string fill_text = "same-bed";  // same-bed | own | both (checked by the option)
     std::string kernel_law = "edem";     // demcal silo --contact-law (a name of silo_contact_laws: the option checks)
     std::string kernel_rotation = "richardson";  // demcal silo --discharge-rotation (silo_clump_rotations)
+    int wall_facets = 0;  // demcal silo --discharge-wall-facets and silo.py's run.facet_segments (0: exact / 72)
+    bool start_as_yade_import = false;  // demcal silo --start-as-yade-import
     FillMode fill() const { return kFillModes.at(fill_text); }
     // an angle's folder and its kernel run's (names the options checked)
     std::string angle(double theta) const {
         return crosscheck_silo::angle_folder(theta, kernel::silo::silo_contact_laws().at(kernel_law));
     }
     std::string kernel_run() const {
-        return crosscheck_silo::kernel_folder(kernel::silo::silo_clump_rotations().at(kernel_rotation));
+        return crosscheck_silo::kernel_folder(kernel::silo::silo_clump_rotations().at(kernel_rotation), wall_facets,
+                                              start_as_yade_import);
     }
 };
 
@@ -104,6 +107,8 @@ std::vector<std::string> kernel_argv(const SiloCrosscheckOptions& o, double thet
     if (!o.geometry.empty()) a.insert(a.end(), {"--geometry", fs::absolute(o.geometry).string()});
     if (o.kernel_law != "edem") a.insert(a.end(), {"--contact-law", o.kernel_law});
     if (o.kernel_rotation != "richardson") a.insert(a.end(), {"--discharge-rotation", o.kernel_rotation});
+    if (o.wall_facets > 0) a.insert(a.end(), {"--discharge-wall-facets", std::to_string(o.wall_facets)});
+    if (o.start_as_yade_import) a.push_back("--start-as-yade-import");
     return a;
 }
 
@@ -124,6 +129,8 @@ json yade_params(const json& bed, const SiloCrosscheckOptions& o, const json& ya
                      {"frame_interval_s", bed.at("flow_pattern_sampling").at("frame_interval_s")},
                      {"frames_file", kYadeFramesFile}}}};
     if (kind.fills) params["run"]["fill"] = 1;  // silo.py's default is 0: a same-bed run's params stay as they were
+    // silo.py's default is 72 sides: a run on them keeps the identity it had before the choice
+    if (o.wall_facets > 0 && o.wall_facets != 72) params["run"]["facet_segments"] = o.wall_facets;
     return params;
 }
 
@@ -229,6 +236,8 @@ std::vector<orchestrator::StoredJob> kernel_jobs(const SiloCrosscheckOptions& o,
         // only when not the default: the runs of campaigns made before the choice keep their identity
         if (o.kernel_law != "edem") params["contact_law"] = o.kernel_law;
         if (o.kernel_rotation != "richardson") params["discharge_rotation"] = o.kernel_rotation;
+        if (o.wall_facets > 0) params["discharge_wall_facets"] = o.wall_facets;
+        if (o.start_as_yade_import) params["contacts_at_opening"] = "yade_import";
         auto job = orchestrator::stored_job(o.angle(theta) + " " + o.kernel_run(), params,
                                             {{"theta_deg", theta}, {"code", "kernel"}}, kd,
                                             kernel_argv(o, theta, kd, d / "bed.json", program),
@@ -292,6 +301,8 @@ crosscheck_silo::ReportSettings report_settings(const SiloCrosscheckOptions& o, 
     r.fill_text = o.fill_text;
     r.kernel_law = kernel::silo::silo_contact_laws().at(o.kernel_law);
     r.kernel_rotation = kernel::silo::silo_clump_rotations().at(o.kernel_rotation);
+    r.wall_facets = o.wall_facets;
+    r.start_as_yade_import = o.start_as_yade_import;
     r.yade_runs = yade_runs(o.fill());
     r.plot_format = o.plot_format;
     return r;
@@ -374,6 +385,17 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
                      "bed is the same either way)")
         ->check(CLI::IsMember(kernel::silo::silo_clump_rotations()))
         ->capture_default_str();
+    silo->add_option("--wall-facets", o->wall_facets,
+                     "0: the kernel's exact cone and cylinder beside YADE's 72-sided facet polygons; N (12 to 2000): "
+                     "both codes discharge between the same N-sided facet polygons (demcal silo "
+                     "--discharge-wall-facets N, silo.py's run.facet_segments N), so that the walls differ no more")
+        ->check(CLI::Range(0, 2000))
+        ->capture_default_str();
+    silo->add_flag("--kernel-start-as-yade-import", o->start_as_yade_import,
+                   "the kernel starts the discharge as YADE's import of the bed does (demcal silo "
+                   "--start-as-yade-import: contacts afresh, their springs advanced in the first force evaluation, a "
+                   "whole first kick); with --kernel-law yade --kernel-rotation yade --wall-facets 72 both codes then "
+                   "run the same dynamics from the same state");
     silo->add_option("--max-runs", o->max_runs, "most runs this command may plan, 2 per angle (3 with --fill both; a guard against typos)")
         ->check(integer_in(1, 1000000000))
         ->capture_default_str();

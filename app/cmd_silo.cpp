@@ -74,8 +74,10 @@ struct SiloCli {
     double wall_limit = 0;
     std::string resume;
     std::string export_bed;  // the filled bed at the opening, for yade_scripts/silo.py
+    std::string export_final_bed;  // the grains left when the discharge ends
     std::string export_cloud;  // the generated cloud before filling, for yade_scripts/silo.py to fill on its own
     bool forget_contact_history = false;  // at the opening, as a bed imported into YADE starts
+    bool start_as_yade_import = false;    // that, and the discharge starts as YADE's run of the exported bed
     std::string contact_law = "edem";     // edem | yade (checked by the option)
     std::string discharge_rotation = "richardson";  // richardson | yade (checked by the option)
     int discharge_wall_facets = 0;                  // 0: exact walls (validate() checks the rest)
@@ -363,8 +365,9 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.stop_fraction = o.stop_fraction;
     s.skin = o.skin;
     s.vibration = vibration_from(o, sub);
-    s.contacts_at_opening =
-        o.forget_contact_history ? ks::ContactsAtOpening::forget_history : ks::ContactsAtOpening::keep_history;
+    s.contacts_at_opening = o.start_as_yade_import     ? ks::ContactsAtOpening::yade_import
+                            : o.forget_contact_history ? ks::ContactsAtOpening::forget_history
+                                                       : ks::ContactsAtOpening::keep_history;
     s.contact_law = ks::silo_contact_laws().at(o.contact_law);  // a name the option checked
     s.discharge_clump_rotation = ks::silo_clump_rotations().at(o.discharge_rotation);
     s.discharge_wall_facets = o.discharge_wall_facets;
@@ -524,6 +527,12 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         check_output_file(o.export_bed, "--export-bed");
         s.at_opening = [file = o.export_bed, settings = s](const ks::BedSnapshot& bed) {
             write_silo_bed(file, bed, settings, BedMoment::opening, "export-bed");
+        };
+    }
+    if (!o.export_final_bed.empty()) {
+        check_output_file(o.export_final_bed, "--export-final-bed");
+        s.at_end = [file = o.export_final_bed, settings = s](const ks::BedSnapshot& bed) {
+            write_silo_bed(file, bed, settings, BedMoment::end, "export-final-bed");
         };
     }
     if (!o.export_cloud.empty()) {
@@ -701,7 +710,8 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"stop_fraction", s.stop_fraction},
                      {"skin_m", s.skin},
                      {"removal_depth_m", s.removal_depth},
-                     {"contacts_at_opening", s.contacts_at_opening == ks::ContactsAtOpening::forget_history
+                     {"contacts_at_opening", s.contacts_at_opening == ks::ContactsAtOpening::yade_import ? "yade_import"
+                                             : s.contacts_at_opening == ks::ContactsAtOpening::forget_history
                                                  ? "forget_history"
                                                  : "keep_history"},
                      {"contact_law_family", ks::silo_contact_law_text(s.contact_law)},
@@ -810,12 +820,22 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--export-bed", o.export_bed,
                     "write the filled bed at the opening (every grain's centre, orientation, velocities; the clump, "
                     "materials, geometry) to this JSON file, for yade_scripts/silo.py");
+    sub->add_option("--export-final-bed", o.export_final_bed,
+                    "write the grains left when the discharge ends (the same format as --export-bed, moment \"end\"), "
+                    "e.g. to compare them with YADE's after the same steps from the same bed (silo.py's "
+                    "run.final_bed_file)");
     sub->add_option("--export-cloud", o.export_cloud,
                     "write the generated grains before the filling (the same format as --export-bed), for "
                     "yade_scripts/silo.py to fill the silo on its own from the same cloud");
     sub->add_flag("--forget-contact-history", o.forget_contact_history,
                   "at the opening every contact forgets its past (tangential springs at zero), as the bed does when "
                   "YADE's silo.py imports it: measures that one difference of a cross-check");
+    sub->add_flag("--start-as-yade-import", o.start_as_yade_import,
+                  "at the opening every contact forgets its past and the discharge starts as YADE's silo.py starts from "
+                  "the exported bed (leapfrog: the first kick a whole step, the fresh contacts' springs advanced in the "
+                  "first force evaluation): with --contact-law yade --discharge-rotation yade --discharge-wall-facets "
+                  "72 the kernel then follows YADE's own run of the bed step for step until chaos parts them")
+        ->excludes("--forget-contact-history");
     sub->add_option("--contact-law", o.contact_law,
                     "edem: the kernel's Hertz-Mindlin (JKR when cohesive) with EDEM's rolling friction; yade: YADE "
                     "2023.02a's Hertz-Mindlin as yade_scripts/silo.py runs it (incremental tangential force, no "
@@ -865,7 +885,7 @@ ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options,
         throw UserError("silo options of " + owner + ": " + e.what());
     }
     // what only a `demcal silo` run of its own has: its outputs, its sessions
-    for (const char* own : {"--out", "--vtk", "--vtk-every", "--export-bed", "--export-cloud", "--no-plots", "--checkpoint-every",
+    for (const char* own : {"--out", "--vtk", "--vtk-every", "--export-bed", "--export-final-bed", "--export-cloud", "--no-plots", "--checkpoint-every",
                             "--no-checkpoint", "--check", "--wall-limit", "--resume"})
         if (parser.count(own))
             throw UserError(std::string("silo option ") + own + " does not apply to " + owner +

@@ -29,9 +29,13 @@ std::string angle_folder(double theta, kernel::silo::SiloContactLaw law) {
     return theta_name(theta) + "_law-" + kernel::silo::silo_contact_law_text(law);
 }
 
-std::string kernel_folder(kernel::ClumpRotation rotation) {
-    if (rotation == kernel::ClumpRotation::richardson) return "kernel";
-    return "kernel-rotation-" + kernel::silo::silo_clump_rotation_text(rotation);
+std::string kernel_folder(kernel::ClumpRotation rotation, int wall_facets, bool start_as_yade_import) {
+    std::string folder = "kernel";
+    if (rotation != kernel::ClumpRotation::richardson)
+        folder += "-rotation-" + kernel::silo::silo_clump_rotation_text(rotation);
+    if (wall_facets > 0) folder += "-facets-" + std::to_string(wall_facets);
+    if (start_as_yade_import) folder += "-yade-import";
+    return folder;
 }
 
 namespace {
@@ -53,26 +57,37 @@ const char* const kOwnLawDifferences[] = {
 const char* const kYadeLawDifferences[] = {
     "contact law: the kernel runs YADE 2023.02a's Hertz-Mindlin (kernel/contact/yade_mindlin_*.hpp, equal to YADE's "
     "own single-contact traces to 1e-6, two spheres and a sphere on a hertzian facet)",
-    "contact history at the opening: YADE starts the imported bed's contacts afresh (tangential forces at zero), the "
-    "kernel keeps its own",
 };
+const char* const kKeptHistoryDifference =
+    "contact history at the opening: YADE starts the imported bed's contacts afresh (tangential forces at zero), the "
+    "kernel keeps its own (--kernel-start-as-yade-import starts it as YADE does)";
+const char* const kYadeImportStart =
+    "start: the kernel starts the discharge as YADE's import of the bed does (--kernel-start-as-yade-import: contacts "
+    "afresh, their springs advanced in the first force evaluation, a whole first kick); with YADE's law, rotation and "
+    "walls the two codes then follow one trajectory (4000 grains: 1e-9 of the displacement after 150 steps) until "
+    "chaos parts them";
 const char* const kOwnRotationDifference =
     "integrators: YADE's leapfrog with its aspherical rotation for clumps, the kernel's velocity Verlet with a "
     "Richardson quaternion update (--kernel-rotation yade discharges with YADE's rotation instead)";
 const char* const kYadeRotationDifference =
     "integrators: the kernel discharges with YADE's aspherical clump rotation (--kernel-rotation yade; it follows "
     "YADE's own trace of a spinning clump to rounding); velocity Verlet and YADE's leapfrog step positions alike";
-const char* const kDifferencesOnEitherLaw[] = {
-    "walls: YADE's cone and cylinder are facet polygons (72 sides), the kernel's are exact surfaces of revolution",
-};
+const char* const kExactWallsDifference =
+    "walls: YADE's cone and cylinder are facet polygons (72 sides), the kernel's are exact surfaces of revolution "
+    "(--wall-facets N runs both on N facets)";
 
 std::vector<std::string> known_differences(const ReportSettings& s) {
     const bool yade_law = s.kernel_law == kernel::silo::SiloContactLaw::yade;
     std::vector<std::string> d(yade_law ? std::begin(kYadeLawDifferences) : std::begin(kOwnLawDifferences),
                                yade_law ? std::end(kYadeLawDifferences) : std::end(kOwnLawDifferences));
+    if (yade_law) d.push_back(s.start_as_yade_import ? kYadeImportStart : kKeptHistoryDifference);
     d.push_back(s.kernel_rotation == kernel::ClumpRotation::yade_leapfrog ? kYadeRotationDifference
                                                                           : kOwnRotationDifference);
-    d.insert(d.end(), std::begin(kDifferencesOnEitherLaw), std::end(kDifferencesOnEitherLaw));
+    d.push_back(s.wall_facets > 0 ? "walls: the same " + std::to_string(s.wall_facets) +
+                                        "-sided facet polygons in both codes from the opening on (--wall-facets; the "
+                                        "kernel's facet contact follows YADE's own trace across a facet's edges and "
+                                        "vertices to 1e-6); the kernel fills on exact walls, so the bed is the same"
+                                  : std::string(kExactWallsDifference));
     return d;
 }
 
@@ -338,6 +353,11 @@ std::string closing_text(const ReportSettings& s, const Verdict& v) {
        << (s.kernel_rotation == kernel::ClumpRotation::yade_leapfrog
                ? ", its grains turning by YADE's clump rotation in the discharge (--kernel-rotation yade)"
                : "")
+       << (s.start_as_yade_import ? ", starting the discharge as YADE's import of the bed (--kernel-start-as-yade-import)"
+                                  : "")
+       << (s.wall_facets > 0 ? ", between YADE's facet walls in the discharge (--wall-facets " +
+                                   std::to_string(s.wall_facets) + ")"
+                             : std::string())
        << ".\n\nRates agree when YADE / kernel lies within 1 +/- " << g(s.tolerance)
        << (v.all_agree ? ": they do at every angle." : ": **they do not at every angle**.");
     if (!s.yade_material.is_null())
@@ -363,6 +383,8 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
                    {"angles", json::array()},
                    {"kernel_contact_law", kernel::silo::silo_contact_law_text(s.kernel_law)},
                    {"kernel_discharge_rotation", kernel::silo::silo_clump_rotation_text(s.kernel_rotation)},
+                   {"wall_facets", s.wall_facets},
+                   {"kernel_start_as_yade_import", s.start_as_yade_import},
                    {"known_differences", known_differences(s)}};
     report["tolerance"] = s.tolerance;
     if (!s.yade_material.is_null()) report["yade_material"] = s.yade_material;
@@ -373,7 +395,7 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
     md << kComparisonHeader;
     Verdict verdict;
     for (double theta : s.thetas) {
-        const fs::path d = root / angle_folder(theta, s.kernel_law), kd = d / kernel_folder(s.kernel_rotation);
+        const fs::path d = root / angle_folder(theta, s.kernel_law), kd = d / kernel_folder(s.kernel_rotation, s.wall_facets, s.start_as_yade_import);
         if (!fs::exists(kd / "summary.json") || !fs::exists(d / primary.folder / "result.json")) {
             md << "| " << theta << " | (a run failed: see " << d.string() << ") ||||||||||\n";
             out.complete = false;

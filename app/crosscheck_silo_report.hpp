@@ -35,7 +35,7 @@ std::string theta_name(double theta);
 std::string angle_folder(double theta, kernel::silo::SiloContactLaw law);
 // The kernel run's folder within an angle's, per discharge rotation: "kernel" for the kernel's own, kernel-rotation-
 // <name> otherwise. The filling is the same whichever scheme discharges, so the bed and YADE's runs of it are shared.
-std::string kernel_folder(kernel::ClumpRotation rotation);
+std::string kernel_folder(kernel::ClumpRotation rotation, int wall_facets = 0, bool start_as_yade_import = false);
 
 struct ReportSettings {
     std::vector<double> thetas;
@@ -48,6 +48,8 @@ struct ReportSettings {
     std::string fill_text;               // same-bed | own | both
     kernel::silo::SiloContactLaw kernel_law = kernel::silo::SiloContactLaw::edem;  // demcal silo --contact-law
     kernel::ClumpRotation kernel_rotation = kernel::ClumpRotation::richardson;     // demcal silo --discharge-rotation
+    int wall_facets = 0;  // 0: the kernel's exact walls beside YADE's 72 facets; N: both codes on N facets around
+    bool start_as_yade_import = false;  // demcal silo --start-as-yade-import
     std::vector<YadeRunKind> yade_runs;  // the first is compared with the kernel; a second is YADE's own filling
     std::string plot_format = "png";
 };

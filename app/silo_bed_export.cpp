@@ -70,12 +70,14 @@ json silo_bed_json(const ks::BedSnapshot& bed, const ks::SiloCaseSettings& s, Be
     json geometry = silo_geometry_json(s.geometry);
     geometry["wall_top_m"] = bed.wall_top;
     const bool opening = moment == BedMoment::opening;
+    const char* name = opening ? "opening" : moment == BedMoment::generation ? "generation" : "end";
+    const char* what = opening ? "the kernel's bed at the opening of the outlet, before the first discharge step"
+                       : moment == BedMoment::generation
+                           ? "the kernel's generated cloud of grains, before the first filling step (the outlet closed)"
+                           : "the grains left in the kernel's silo when its discharge ended (time_s: since the start)";
     return {{"schema", kSiloBedSchema},
-            {"moment", opening ? "opening" : "generation"},
-            {"note", std::string(opening ? "the kernel's bed at the opening of the outlet, before the first discharge "
-                                           "step"
-                                         : "the kernel's generated cloud of grains, before the first filling step "
-                                           "(the outlet closed)") +
+            {"moment", name},
+            {"note", std::string(what) +
                          "; SI units; orientation_wxyz: unit quaternion of the clump's principal frame "
                          "(clump_template.frame) to the world; velocities on-step (velocity Verlet); "
                          "sphere_centres_m: the kernel's own member centres, for checking an import"},
@@ -86,7 +88,7 @@ json silo_bed_json(const ks::BedSnapshot& bed, const ks::SiloCaseSettings& s, Be
               {"rule", "the filling ends at the first record interval after time_min_s where the mean kinetic "
                        "energy per grain (translational and rotational) is below rest_energy_per_grain_J, or at "
                        "time_max_s"}}},
-            {"opening_time_s", bed.time},
+            {moment == BedMoment::end ? "time_s" : "opening_time_s", bed.time},
             {"time_step_s", bed.time_step},
             {"time_step_fraction", s.time_step_fraction},
             {"gravity_m_s2", s.gravity},

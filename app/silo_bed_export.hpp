@@ -16,8 +16,9 @@ inline constexpr const char* kSiloBedSchema = "demcal.silo_bed/1";
 /// the derived hopper height: one spelling for summary.json and the bed file.
 nlohmann::json silo_geometry_json(const kernel::silo::SiloGeometry& g);
 
-/// When a bed was taken: at the opening (the bed to discharge) or at the generation (the cloud to fill).
-enum class BedMoment { opening, generation };
+/// When a bed was taken: at the opening (the bed to discharge), at the generation (the cloud to fill), or when the
+/// discharge ended (the grains left, to compare with another code's run of the same bed).
+enum class BedMoment { opening, generation, end };
 
 /// The bed with everything needed to rebuild the run elsewhere: the moment, geometry, materials as a --material file
 /// spells them (unscaled) and the stiffness scale, gravity, removal depth, time step, the filling's rest criterion,

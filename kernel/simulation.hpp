@@ -108,6 +108,13 @@ class BasicSimulation {
   /// touched flag): each contact goes on as if it had just formed. A bed imported into another code starts so (YADE
   /// creates its interactions afresh); demcal silo --forget-contact-history measures what that changes.
   void forget_contact_history();
+  /// Goes on as a leapfrog code started from this state goes on, YADE importing the bed (yade_scripts/silo.py):
+  /// every contact forgets its past (forget_contact_history); the next force evaluation advances the fresh contacts'
+  /// springs by one step, as YADE's first InteractionLoop does on new interactions; the next step kicks the velocities
+  /// by a whole step, not half, as leapfrog takes the state's on-step velocities for its half-step ones. With YADE's
+  /// law, clump rotation and walls the kernel then follows YADE's own run of the state until chaos parts them
+  /// (tests/kernel/test_silo_yade_trajectory.cpp). Both effects are spent by the next step() (not saved in a state).
+  void restart_as_imported_leapfrog();
   /// YADE's non-viscous local damping (NewtonIntegrator(damping = d)), d in [0, 1); default 0 (none). For matching
   /// YADE's quasi-static tests; it is not a physical dissipation.
   void set_local_damping(double damping);
@@ -323,6 +330,8 @@ class BasicSimulation {
   // The change that invalidated the forces leaves the state (positions, velocities) as it was: the last half kick,
   // taken with the forces before the change, is taken again with the new ones (see refresh_forces).
   bool rekick_on_refresh_ = false;
+  bool import_spring_step_pending_ = false;  // restart_as_imported_leapfrog: the refresh advances the springs
+  bool import_full_kick_pending_ = false;    // restart_as_imported_leapfrog: the next step's first kick is whole
 };
 
 extern template class BasicSimulation<HertzMindlinEdem>;

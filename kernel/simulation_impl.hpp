@@ -124,6 +124,13 @@ void BasicSimulation<Law>::forget_contact_history() {
 }
 
 template <class Law>
+void BasicSimulation<Law>::restart_as_imported_leapfrog() {
+  forget_contact_history();
+  import_spring_step_pending_ = true;
+  import_full_kick_pending_ = true;
+}
+
+template <class Law>
 void BasicSimulation<Law>::set_wall_velocity(int id, const Vec3& velocity) {
   Wall& w = walls_.at(id);
   if (w.motion) throw std::logic_error("set_wall_velocity: wall " + std::to_string(id) + " follows a motion law");
@@ -841,7 +848,9 @@ void BasicSimulation<Law>::refresh_forces() {
   if (rekick) kick(-1.0);
   for (Wall& w : walls_)
     if (w.motion) w.velocity = w.motion->velocity(time_);
-  compute_forces(nl_.needs_rebuild(x_, nt()), 0.0);
+  // (dt: a state restarted as a leapfrog code imports it, whose first evaluation advances the fresh springs)
+  compute_forces(nl_.needs_rebuild(x_, nt()), import_spring_step_pending_ ? dt_ : 0.0);
+  import_spring_step_pending_ = false;
   if (rekick) kick(1.0);
   forces_valid_ = true;
 }
@@ -850,6 +859,10 @@ template <class Law>
 void BasicSimulation<Law>::step(long nsteps) {
   prepare();
   if (!forces_valid_) refresh_forces();
+  if (import_full_kick_pending_ && nsteps > 0) {  // the on-step velocities taken as half-step ones: a whole first kick
+    kick(1.0);
+    import_full_kick_pending_ = false;
+  }
   // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass
   for (long s = 0; s < nsteps; ++s) {
     const bool moved = kick_drift(s == 0 ? 1.0 : 2.0);

@@ -112,6 +112,13 @@ PARAM_SPECS = {
                        integer=True),
     "run.readback_file": text("if not empty: write the bed as YADE holds it at t = 0 (before any step) to this file",
                               default=""),
+    "run.collider_verlet_dist": number("-", -10.0, 10.0, "InsertionSortCollider.verletDist: bounds enlarged by this "
+                                       "(negative: times the smallest radius) so that the collider need not run every "
+                                       "step; YADE's default -0.5; 0: the collider runs every step", default=-0.5),
+    "run.final_bed_file": text("if not empty: write the grains left when the discharge ends, in the kernel's frame and "
+                               "the bed's column layout, with their indices in the bed (demcal silo "
+                               "--export-final-bed's counterpart: the same steps from the same bed, compared grain by "
+                               "grain)", default=""),
 }
 for _prefix, _what, _shape in (("material.grain", "grain", True), ("material.wall", "wall", False)):
     PARAM_SPECS.update(solid_specs(_prefix, _what, _shape))
@@ -600,7 +607,7 @@ class Contact:
         damping = self.per_pair(lambda pair: damping_ratio(p["material.%s.restitution" % pair]))
         O.engines = [
             ForceResetter(),
-            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb()]),
+            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb()], verletDist=p["run.collider_verlet_dist"]),
             InteractionLoop(
                 [Ig2_Sphere_Sphere_ScGeom(), Ig2_Facet_Sphere_ScGeom(hertzian=p["run.hertzian_facets"] == 1)],
                 [Ip2_FrictMat_FrictMat_MindlinPhys(
@@ -857,6 +864,12 @@ def main():
     frames = FlowFrames(p, record)
     stop_reason, stiffness = discharge(p, record, frames, contact)
     frames_written = frames.close()
+    if p["run.final_bed_file"]:
+        left = [(k, clump_id) for k, (clump_id, _) in enumerate(clumps) if clump_id in record.in_silo]
+        write_json_atomically(p["run.final_bed_file"], {
+            "schema": READBACK_SCHEMA, "moment": "end", "time_s": O.time, "steps": O.iter,
+            "bed_index": [k for k, _ in left],
+            "grains": dict(in_kernel_frame(state_columns([c for _, c in left]), frame), count=len(left))})
 
     fit = fit_rate(record.times, record.masses)
     result = {

@@ -319,9 +319,10 @@ void validate(const SiloCaseSettings& s) {
         }
     }
     if (s.contacts_at_opening != ContactsAtOpening::keep_history &&
-        s.contacts_at_opening != ContactsAtOpening::forget_history)
+        s.contacts_at_opening != ContactsAtOpening::forget_history &&
+        s.contacts_at_opening != ContactsAtOpening::yade_import)
         reject_setting("contacts_at_opening", static_cast<double>(s.contacts_at_opening),
-                       "must be keep_history (0) or forget_history (1)");
+                       "must be keep_history (0), forget_history (1) or yade_import (2)");
     if (s.vibration.vibrates()) {
         // a period resolved by fewer steps would alias: the walls jump rather than oscillate
         constexpr double kStepsPerPeriod = 20;
@@ -529,6 +530,7 @@ public:
             open();
         }
         if (!discharge()) return suspend();
+        if (s_.at_end) s_.at_end(bed_snapshot());
         finish();
         return r_;
     }
@@ -775,6 +777,7 @@ private:
     void open() {
         if (s_.at_opening) s_.at_opening(bed_snapshot());
         if (s_.contacts_at_opening == ContactsAtOpening::forget_history) sim_.forget_contact_history();
+        if (s_.contacts_at_opening == ContactsAtOpening::yade_import) sim_.restart_as_imported_leapfrog();
         sim_.set_clump_rotation(s_.discharge_clump_rotation);
         sim_.set_wall_enabled(plate_, false);
         if (s_.discharge_wall_facets > 0)  // the exact cone and cylinder give way to their facets

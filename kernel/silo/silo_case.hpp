@@ -47,8 +47,11 @@ struct BedSnapshot {
 
 // What the contacts keep of their past when the outlet opens. forget_history: every contact restarts as if just
 // formed (its tangential spring at zero), as a bed imported into a code without the kernel's contact history does
-// (YADE's silo.py creates its interactions afresh): the cross-check's switch for that one difference.
-enum class ContactsAtOpening : std::uint8_t { keep_history = 0, forget_history = 1 };
+// (YADE's silo.py creates its interactions afresh): the cross-check's switch for that one difference. yade_import:
+// that, and the discharge goes on as YADE's run of the exported bed starts (BasicSimulation::
+// restart_as_imported_leapfrog: the first force evaluation advances the fresh springs by a step, the first kick is a
+// whole step): with YADE's law, rotation and facet walls both codes then follow one trajectory until chaos parts them.
+enum class ContactsAtOpening : std::uint8_t { keep_history = 0, forget_history = 1, yade_import = 2 };
 
 // The contact law family the grains run on. edem: the kernel's own (Hertz-Mindlin with a total-displacement
 // tangential spring and EDEM's rolling friction; JKR when a pair is cohesive). yade: YADE 2023.02a's Hertz-Mindlin as
@@ -130,9 +133,12 @@ struct SiloCaseSettings {
     // Called once with the generated cloud before the first filling step (demcal silo --export-cloud). Not stored,
     // as at_opening.
     std::function<void(const BedSnapshot&)> at_generation;
+    // Called once with the grains left when the discharge ends (emptied, stopped, time limit; not when a session is
+    // suspended) (demcal silo --export-final-bed). Not stored, as at_opening.
+    std::function<void(const BedSnapshot&)> at_end;
 };
 // A new setting that changes the run must also be listed in for_each_setting (silo_case.cpp): the checkpoint stores
-// the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit, stop_request, at_opening and
+// the settings through that list. threads, checkpoint_file, checkpoint_interval, wall_limit, stop_request, at_opening, at_end and
 // at_generation are not stored: a resumed run takes them from its caller.
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions, the vibration).

@@ -84,7 +84,7 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
 }
 
 TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindlin (and with --kernel-rotation yade its "
-          "clump rotation), the report says so", "[yade]") {
+          "clump rotation, with --wall-facets YADE's walls), the report says so", "[yade]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-xsilo-law-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -125,6 +125,20 @@ TEST_CASE("crosscheck silo --kernel-law yade: the kernel runs YADE's Hertz-Mindl
         read_file(dir / "c" / "theta_45_law-yade" / "kernel-rotation-yade" / "summary.json"));
     CHECK(rotated_summary["settings"]["discharge_clump_rotation"] == "yade");
     CHECK(rotated_summary["filled_mass_kg"] == summary["filled_mass_kg"]);
+    // and between silo.py's walls too (72 facets, YADE's own count): the kernel runs again on the same bed, YADE's run
+    // is reused, the report names the walls as the same
+    REQUIRE(run_demcal(args + " --kernel-rotation yade --wall-facets 72", dir / "facets.log") == 0);
+    CHECK_THAT(read_file(dir / "facets.log"),
+               Catch::Contains("started  theta_45_law-yade kernel-rotation-yade-facets-72"));
+    CHECK(read_file(dir / "facets.log").find("started  theta_45_law-yade yade") == std::string::npos);
+    const auto faceted = nlohmann::json::parse(read_file(dir / "c" / "crosscheck_silo.json"));
+    CHECK(faceted["wall_facets"] == 72);
+    CHECK_THAT(faceted["known_differences"].dump(), Catch::Contains("the same 72-sided facet polygons"));
+    const auto faceted_summary = nlohmann::json::parse(
+        read_file(dir / "c" / "theta_45_law-yade" / "kernel-rotation-yade-facets-72" / "summary.json"));
+    CHECK(faceted_summary["settings"]["discharge_wall_facets"] == 72);
+    CHECK(faceted_summary["filled_mass_kg"] == summary["filled_mass_kg"]);
+    CHECK(faceted["angles"][0]["kernel"]["rate_kg_s"] != rotated["angles"][0]["kernel"]["rate_kg_s"]);
     // back to the kernel's own rotation in the same campaign: nothing runs, and the report is the first one's, not
     // built from the other scheme's run
     REQUIRE(run_demcal(args, dir / "back.log") == 0);
