@@ -1,6 +1,7 @@
-// The silo case's ContactsAtOpening switch (demcal silo --forget-contact-history): the contacts' memory is forgotten
-// at the opening and only then, as in a bed another code imports; the run resumes from checkpoints bit for bit, the
-// choice stored in them.
+// The silo case's ContactsAtOpening switch (demcal silo --forget-contact-history, --start-as-yade-import): the
+// contacts' memory is forgotten at the opening and only then, as in a bed another code imports (and with
+// yade_import the discharge starts as YADE's leapfrog does); the run resumes from checkpoints bit for bit, the choice
+// stored in them. That yade_import follows YADE's own run of the bed: test_silo_yade_trajectory.cpp.
 #include "kernel/silo/silo_case.hpp"
 #include "silo_resume_check.hpp"
 
@@ -34,6 +35,19 @@ TEST_CASE("silo case: a run forgetting its contact history at the opening resume
     // killed while filling (before the opening: the resumed session must still forget), then after it
     const SiloCaseSettings stored = demcal::test::check_resumes_bit_for_bit(s, "forget-history", 0.05);
     CHECK(stored.contacts_at_opening == ContactsAtOpening::forget_history);
+}
+
+TEST_CASE("silo case: starting the discharge as YADE's import leaves the filling and the rate", "[silo]") {
+    demcal::test::check_discharge_switch_keeps_rate(
+        tiny_case(), [](SiloCaseSettings& s) { s.contacts_at_opening = ContactsAtOpening::yade_import; }, 0.15);
+}
+
+TEST_CASE("silo case: a run started as YADE's import resumes bit for bit", "[silo][checkpoint]") {
+    SiloCaseSettings s = tiny_case();
+    s.contacts_at_opening = ContactsAtOpening::yade_import;
+    // killed while filling: the resumed session opens and starts as YADE's import itself
+    const SiloCaseSettings stored = demcal::test::check_resumes_bit_for_bit(s, "yade-import", 0.05);
+    CHECK(stored.contacts_at_opening == ContactsAtOpening::yade_import);
 }
 
 TEST_CASE("silo case: a contacts-at-opening value that is not a choice is refused by name", "[silo]") {
