@@ -278,9 +278,13 @@ class BasicSimulation {
   std::vector<double> wall_slot_s_;                         // kWallSlots * kHist per sphere: history
   std::vector<Vec3> wall_slot_f_;                           // kWallSlots per sphere: force on the sphere
   struct PairLoad {
-    Vec3 force_i, torque_j;  // one pair's force on i and torque on j, side by side for the gather's one read
+    // one pair's force on i and torques on j and i; force_i and torque_j side by side for the gather's one read,
+    // torque_i for a removal (remove_bodies_if takes a removed body's contacts out of its neighbours' loads)
+    Vec3 force_i, torque_j, torque_i;
   };
   std::vector<PairLoad> pair_load_;                         // per pair (written and gathered in compute_forces)
+  bool pair_torques_i_known_ = false;                       // pair_load_'s torque_i are the last evaluation's (not
+                                                            // stored in a state: false after load_state)
   std::vector<double> omega_norm_;                          // |w_| per sphere, for the rolling torques
   bool omega_norm_fresh_ = false;                           // kick_drift filled omega_norm_ for the current w_
   static constexpr int kMaxWallCandidates = 64;             // walls tracked per sphere (bit mask)
@@ -298,6 +302,9 @@ class BasicSimulation {
   std::vector<std::uint32_t> wall_list_row_;
   std::vector<std::int32_t> wall_list_;
   bool wall_lists_stale_ = false;                           // a state was loaded: derive the lists before the next use
+  // remove_bodies_if: the loads of the contacts with the spheres about to go, out of their neighbours' forces and
+  // the last half kick (forces stay valid)
+  void take_out_removed_contacts(const std::vector<char>& drop_sphere, const std::vector<char>& drop_clump);
   void find_wall_candidate_lists(const std::vector<Vec3>& centres, double reach,
                                  const std::vector<Vec3>& wall_displacement);
 

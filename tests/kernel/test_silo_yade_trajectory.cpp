@@ -1,8 +1,10 @@
-// The kernel and real YADE follow one trajectory: a tiny reduced silo filled by the kernel, discharged for two record
-// intervals (60 steps) by the kernel with YADE's Hertz-Mindlin, YADE's clump rotation, silo.py's 72-facet walls and
-// YADE's start (demcal silo --start-as-yade-import), and by yade_scripts/silo.py from the exported bed: every grain
-// ends where the other code put it, to a millionth of the grains' displacement. Without YADE's start the same kernel
-// run misses by far more: the test can tell a difference of the very first step.
+// The kernel and real YADE follow one trajectory: a tiny reduced silo filled by the kernel, discharged for 0.035 s
+// (540 steps, the first grains leaving the silo and removed) by the kernel with YADE's Hertz-Mindlin, YADE's clump
+// rotation, silo.py's 72-facet walls and YADE's start (demcal silo --start-as-yade-import), and by
+// yade_scripts/silo.py from the exported bed: every grain ends where the other code put it, to 1e-4 of the grains'
+// median displacement (measured 5e-6, the rest of a 1e-9 start grown by the flow's chaos). Without YADE's start the
+// same kernel run misses by far more. Before 2026-12-04 the kernel evaluated every force again after a removal, and
+// the two codes parted at the first grain removed (examples/crosscheck/README.md).
 #include "demcal_cli.hpp"
 #include "test_files.hpp"
 
@@ -70,8 +72,8 @@ TEST_CASE("kernel and YADE follow one trajectory from the same bed once the kern
     material["grain_grain"]["rolling_friction"] = 0;  // YADE's law has none
     material["grain_wall"]["rolling_friction"] = 0;
     write_json(dir / "material.json", material);
-    // two record intervals of the discharge (0.002 s each): the time limit is checked at the end of each
-    const std::string common = "silo --theta 45 --particles 300 --stiffness-scale 1e-3 --seed 3 --max-time 0.003 "
+    // the time limit is checked at the end of each record interval (0.002 s): 18 intervals, 540 steps
+    const std::string common = "silo --theta 45 --particles 300 --stiffness-scale 1e-3 --seed 3 --max-time 0.035 "
                                "--threads 1 --no-plots --no-checkpoint --geometry '" +
                                (src / "examples/silo/reduced_conical_70deg.json").string() + "' --material '" +
                                (dir / "material.json").string() +
@@ -94,7 +96,7 @@ TEST_CASE("kernel and YADE follow one trajectory from the same bed once the kern
                          {"run",
                           {{"stiffness_scale", bed["stiffness_scale"]},
                            {"time_step_fraction", bed["time_step_fraction"]},
-                           {"discharge_time_s", 0.003},
+                           {"discharge_time_s", 0.035},
                            {"sample_interval_s", bed["record_interval_s"]},
                            {"removal_depth_m", bed["removal_depth_m"]},
                            {"final_bed_file", "yade_end.json"}}}};
@@ -117,7 +119,10 @@ TEST_CASE("kernel and YADE follow one trajectory from the same bed once the kern
     const double same_start = largest_miss(bed, kernel_end, yade_end);
     const double plain_start = largest_miss(bed, read_json(dir / "plain_end.json"), yade_end);
     INFO("largest miss over the median displacement: YADE's start " << same_start << ", the kernel's own " << plain_start);
-    CHECK(same_start < 1e-6);
-    CHECK(plain_start > 1e-3);
+    CHECK(same_start < 1e-4);
+    CHECK(plain_start > 1e-2);
+    // grains left the silo and were removed in both codes: the trajectories agree through removals
+    CHECK(yade_end["grains"]["count"].get<int>() < 300);
+    CHECK(yade_end["grains"]["count"] == kernel_end["grains"]["count"]);
     fs::remove_all(dir);
 }
