@@ -175,7 +175,8 @@ class BasicSimulation {
   BodyState body(std::size_t i) const;
   /// Sets the velocity [m/s] and angular velocity [rad/s, world] of body i.
   void set_body_velocity(std::size_t i, const Vec3& velocity, const Vec3& omega);
-  /// Removes every body for which pred(state) is true; returns how many and their mass.
+  /// Removes every body for which pred(state) is true; returns how many and their mass. The rest goes on as if they
+  /// had gone before the last force evaluation (their contacts' loads and the half kick those gave taken out).
   RemovalResult remove_bodies_if(const std::function<bool(const BodyState&)>& pred);
 
   /// Spheres (single ones and clump members): 0..num_spheres()-1.

@@ -3,12 +3,14 @@
 # 70 deg seed 1) with the crosscheck's kernel settings (4000 grains, the reduced silo, stiffness 1e-3, the rolling-free
 # wheat) and YADE's Hertz-Mindlin, plus the options of one variant; the filling is the same whatever they are, so each
 # variant discharges the same beds. One line per bed into OUT/results.txt: theta seed LABEL rate[g/s] batch_SE[g/s]
-# cpu[s]. Usage: run_beds.sh OUT LABEL DEMCAL [demcal silo options of the variant ...]
+# cpu[s]. Usage: run_beds.sh OUT LABEL DEMCAL [demcal silo options of the variant ...]; BEDS="theta seed;..." runs
+# other beds (the same settings).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 out_dir=$(cd "$1" && pwd); label=$2; demcal=$3; shift 3
 [ -f "$out_dir/results.txt" ] || echo "# theta seed variant rate[g/s] batch_SE[g/s] cpu[s] (run_beds.sh, $(date -u +%Y-%m-%d))" > "$out_dir/results.txt"
-for case in "10 1" "10 2" "10 3" "30 1" "30 2" "30 3" "50 1" "70 1"; do
+IFS=';' read -r -a beds <<< "${BEDS:-10 1;10 2;10 3;30 1;30 2;30 3;50 1;70 1}"
+for case in "${beds[@]}"; do
   set -- $case "$@"
   theta=$1 seed=$2; shift 2
   out=$out_dir/t${theta}_s$seed
