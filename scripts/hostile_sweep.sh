@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Hostile-input sweep of the commands added since the last hardening pass (issue 23): shear-run, shear --engine
 # kernel, crosscheck shear, crosscheck silo (--fill, --kernel-law), scale, cutoff, vibration, silo --export-bed /
-# --export-cloud, --forget-contact-history, --contact-law, --discharge-rotation (crosscheck --kernel-rotation) and the --vibration-* options (--vibration-part, --part),
+# --export-cloud, --forget-contact-history, --contact-law, --discharge-rotation (crosscheck --kernel-rotation),
+# --discharge-wall-facets (--wall-facets), --start-as-yade-import (--kernel-start-as-yade-import), --export-final-bed and the --vibration-* options (--vibration-part, --part),
 # diagnose silo-dem --max-runs.
 # Then the examples the issue itself lists, on the older commands (predict, silo --fill-mass, status and resume on a
 # store that is not demcal's, calibrate targets, enlarge).
@@ -158,6 +159,9 @@ run_case crosscheck-silo/kernel-law-unknown 2 "--kernel-law" -- "${S[@]}" --thet
 run_case crosscheck-silo/kernel-law-rolling 2 "rolling_friction" -- "${S[@]}" --theta 30 --kernel-law yade
 run_case crosscheck-silo/kernel-rotation-unknown 2 "--kernel-rotation" -- "${S[@]}" --theta 30 --kernel-rotation omelyan
 run_case crosscheck-silo/kernel-rotation-empty 2 "--kernel-rotation" -- "${S[@]}" --theta 30 --kernel-rotation ""
+run_case crosscheck-silo/wall-facets-few 2 "discharge_wall_facets" -- "${S[@]}" --theta 30 --wall-facets 5
+run_case crosscheck-silo/wall-facets-huge 2 "--wall-facets" -- "${S[@]}" --theta 30 --wall-facets 3000
+run_case crosscheck-silo/yade-start-value 2 "--kernel-start-as-yade-import" -- "${S[@]}" --theta 30 --kernel-start-as-yade-import=maybe
 run_case crosscheck-silo/theta-subnormal 2 "theta"       -- "${S[@]}" --theta 1e-320
 run_case crosscheck-silo/theta-90    2 "theta"           -- "${S[@]}" --theta 90
 run_case crosscheck-silo/theta-huge  2 "theta"           -- "${S[@]}" --theta "$huge"
@@ -274,6 +278,15 @@ run_case silo/contact-law-rolling     2 "grain_grain.rolling_friction = 0.01" --
 run_case silo/contact-law-resume      2 "--contact-law"   -- silo --resume somewhere --contact-law yade
 run_case silo/rotation-unknown        2 "--discharge-rotation" -- "${L[@]}" --discharge-rotation "$hugestr"
 run_case silo/rotation-resume         2 "--discharge-rotation" -- silo --resume somewhere --discharge-rotation yade
+run_case silo/wall-facets-few         2 "discharge_wall_facets = 5" -- "${L[@]}" --discharge-wall-facets 5
+run_case silo/wall-facets-huge        2 "--discharge-wall-facets" -- "${L[@]}" --discharge-wall-facets 99999999999999
+run_case silo/wall-facets-text        2 "--discharge-wall-facets" -- "${L[@]}" --discharge-wall-facets many
+run_case silo/wall-facets-resume      2 "--discharge-wall-facets" -- silo --resume somewhere --discharge-wall-facets 72
+run_case silo/yade-start-and-forget   2 "--start-as-yade-import" -- "${L[@]}" --start-as-yade-import --forget-contact-history
+run_case silo/yade-start-resume       2 "--start-as-yade-import" -- silo --resume somewhere --start-as-yade-import
+run_case silo/final-bed-folder        2 "--export-final-bed" -- "${L[@]}" --export-final-bed "$work/folder.json"
+run_case silo/final-bed-readonly      2 "--export-final-bed" "$ro" -- "${L[@]}" --export-final-bed "$ro/e.json"
+run_case silo/final-bed-resume        2 "--export-final-bed" -- silo --resume somewhere --export-final-bed e.json
 run_case silo/out-readonly           2 "out"     "$ro"   -- "${L[@]}" --out "$ro/o"
 run_case silo/out-file               2 "out"             -- "${L[@]}" --out "$tiny"
 run_case silo/vtk-readonly           2 "vtk"     "$ro"   -- "${L[@]}" --vtk "$ro/v"
