@@ -175,8 +175,14 @@ class BasicSimulation {
   BodyState body(std::size_t i) const;
   /// Sets the velocity [m/s] and angular velocity [rad/s, world] of body i.
   void set_body_velocity(std::size_t i, const Vec3& velocity, const Vec3& omega);
-  /// Removes every body for which pred(state) is true; returns how many and their mass. The rest goes on as if they
-  /// had gone before the last force evaluation (their contacts' loads and the half kick those gave taken out).
+  /// Removes every body for which pred(state) is true; returns how many and their mass. With exact removals on
+  /// (set_exact_removal) the rest goes on as if they had gone before the last force evaluation (their contacts' loads
+  /// and the half kick those gave taken out); off, the forces of the rest are evaluated again.
+  /// Exact removals (default off): the pair loop then records each pair's torque on i (a few per cent of its time on
+  /// the peer case), which a removal needs to take a body's contacts out of its neighbours' loads. A case that removes
+  /// bodies as it runs (the silo's discharge) turns them on: evaluating every force again after a removal moves the
+  /// whole bed a little (kernel/README.md).
+  void set_exact_removal(bool on) { exact_removal_ = on; pair_torques_i_known_ = false; }
   RemovalResult remove_bodies_if(const std::function<bool(const BodyState&)>& pred);
 
   /// Spheres (single ones and clump members): 0..num_spheres()-1.
@@ -279,13 +285,14 @@ class BasicSimulation {
   std::vector<double> wall_slot_s_;                         // kWallSlots * kHist per sphere: history
   std::vector<Vec3> wall_slot_f_;                           // kWallSlots per sphere: force on the sphere
   struct PairLoad {
-    // one pair's force on i and torques on j and i; force_i and torque_j side by side for the gather's one read,
-    // torque_i for a removal (remove_bodies_if takes a removed body's contacts out of its neighbours' loads)
-    Vec3 force_i, torque_j, torque_i;
+    Vec3 force_i, torque_j;  // one pair's force on i and torque on j, side by side for the gather's one read
   };
   std::vector<PairLoad> pair_load_;                         // per pair (written and gathered in compute_forces)
-  bool pair_torques_i_known_ = false;                       // pair_load_'s torque_i are the last evaluation's (not
-                                                            // stored in a state: false after load_state)
+  // Each pair's torque on i, recorded when exact removals are on (set_exact_removal: a removal then takes a removed
+  // body's contacts out of its neighbours' loads); known: they are the last evaluation's (false after load_state)
+  bool exact_removal_ = false;
+  std::vector<Vec3> pair_torque_i_;
+  bool pair_torques_i_known_ = false;
   std::vector<double> omega_norm_;                          // |w_| per sphere, for the rolling torques
   bool omega_norm_fresh_ = false;                           // kick_drift filled omega_norm_ for the current w_
   static constexpr int kMaxWallCandidates = 64;             // walls tracked per sphere (bit mask)

@@ -588,6 +588,8 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   const std::int64_t n = std::int64_t(x_.size()), nc = std::int64_t(cx_.size());
   pair_load_.resize(nl_.num_pairs());
   PairLoad* load = pair_load_.data();
+  if (exact_removal_) pair_torque_i_.resize(nl_.num_pairs());
+  Vec3* torque_i = exact_removal_ ? pair_torque_i_.data() : nullptr;  // (recorded for an exact removal only)
   const int nm = nm_coeffs_;
   const double dt = dt_history;  // the tangential springs advance by vt * dt_history
   const int nw = int(walls_.size());
@@ -627,7 +629,9 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         const double reach = Law::beyond_contact ? rs + law_reach : rs;
         if (d2 >= reach * reach) {
           std::fill_n(h, kHist, 0.0);
-          load[p] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+          load[p].force_i.setZero();
+          load[p].torque_j.setZero();
+          if (torque_i) torque_i[p].setZero();
           continue;
         }
         const double dist = std::sqrt(d2);
@@ -647,7 +651,9 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         if constexpr (Law::beyond_contact) {
           if (!Law::acts(coeffs, geo, h)) {  // a gap the contact does not (or no longer) bridge
             std::fill_n(h, kHist, 0.0);
-            load[p] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+            load[p].force_i.setZero();
+            load[p].torque_j.setZero();
+            if (torque_i) torque_i[p].setZero();
             continue;
           }
         }
@@ -666,7 +672,9 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
         const ContactResult res = Law::compute(coeffs, geo, kin, h, dt, false, bond_now);
         fi += res.force_i;
         ti += res.torque_i;
-        load[p] = {res.force_i, res.torque_j, res.torque_i};
+        load[p].force_i = res.force_i;
+        load[p].torque_j = res.torque_j;
+        if (torque_i) torque_i[p] = res.torque_i;
       }
       // walls: up to kWallSlots simultaneous contacts keep a history
       if (nw > 0) {
@@ -766,7 +774,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
       cT_[c] = T;
     }
   }
-  pair_torques_i_known_ = true;
+  pair_torques_i_known_ = exact_removal_;
   if (local_damping_ > 0) apply_local_damping();
 }
 
@@ -1028,14 +1036,15 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
       for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) drop_sphere[cmem_[k]] = 1;
     }
   }
-  // The bodies go as if they had gone before the last force evaluation (as a leapfrog code erasing them between two
+  // With exact removals on, the bodies go as if they had gone before the last force evaluation (as a leapfrog code erasing them between two
   // steps, YADE's silo.py): their contacts' loads leave their neighbours' forces and the half kick those loads gave
   // is taken back, so the forces stay valid and nothing else changes. (Recomputing every force instead re-evaluated
   // each damped contact with the on-step velocities and re-capped its spring: at every removal the whole bed moved
   // otherwise, which slowed the silo's discharge by about 2 %, measured against YADE; examples/crosscheck/README.md.)
   // Not with local damping (the forces then hold the damping's rescaling): those forces are evaluated again.
-  const bool loads_known = forces_valid_ && local_damping_ == 0 && pair_torques_i_known_ &&
-                           pair_load_.size() == nl_.num_pairs() && nl_.row.size() == n + 1;
+  const bool loads_known = exact_removal_ && forces_valid_ && local_damping_ == 0 && pair_torques_i_known_ &&
+                           pair_load_.size() == nl_.num_pairs() && pair_torque_i_.size() == pair_load_.size() &&
+                           nl_.row.size() == n + 1;
   if (loads_known) take_out_removed_contacts(drop_sphere, drop_clump);
   std::vector<std::int32_t> s_old2new(n, -1), c_old2new(nc, -1);
   std::size_t ns = 0, ncn = 0;
@@ -1102,7 +1111,7 @@ void BasicSimulation<Law>::take_out_removed_contacts(const std::vector<char>& dr
       if (drop_sphere[i] == drop_sphere[j]) continue;  // both stay, or both go
       if (!drop_sphere[i]) {
         force_out[i] += pair_load_[p].force_i;
-        torque_out[i] += pair_load_[p].torque_i;
+        torque_out[i] += pair_torque_i_[p];
       } else {
         force_out[j] -= pair_load_[p].force_i;
         torque_out[j] += pair_load_[p].torque_j;
@@ -1317,7 +1326,7 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   r.array(pair_f, "pair forces"); r.array(pair_tj, "pair torques"); r.array(wall_cand_, "wall candidates");
   if (pair_f.size() != pair_tj.size()) r.fail("pair loads", "force and torque counts differ");
   pair_load_.resize(pair_f.size());
-  for (std::size_t p = 0; p < pair_f.size(); ++p) pair_load_[p] = {pair_f[p], pair_tj[p], Vec3::Zero()};
+  for (std::size_t p = 0; p < pair_f.size(); ++p) pair_load_[p] = {pair_f[p], pair_tj[p]};
   pair_torques_i_known_ = false;  // (not in the state: a removal before the next evaluation evaluates the forces)
   omega_norm_fresh_ = false;
   r.array(cmem_start_, "clump members"); r.array(cmem_, "clump members");

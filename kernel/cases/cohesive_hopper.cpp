@@ -73,6 +73,7 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
         ++placed;
       }
   sim.set_timestep(kTimestepFraction * sim.rayleigh_timestep());
+  sim.set_exact_removal(true);  // the discharged spheres leave every 500 steps
   while (sim.time() < c.settle) sim.step(100);
   sim.set_wall_enabled(plate, false);
   const double mass = sim.total_mass();

@@ -491,6 +491,7 @@ public:
         validate(s_);
         sim_.set_threads(s_.threads);
         sim_.set_gravity(Vec3(0, 0, -s_.gravity));
+        sim_.set_exact_removal(true);  // grains leave below the outlet all through the discharge
         wheat_ = sim_.add_material(to_kernel(s_.materials.wheat_scaled(), "wheat"));
         steel_ = sim_.add_material(to_kernel(s_.materials.steel_scaled(), "steel"));
         sim_.set_pair(wheat_, wheat_, to_kernel<Law>(s_.materials.wheat_wheat));
