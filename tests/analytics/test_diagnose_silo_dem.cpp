@@ -184,9 +184,9 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
     fs::remove_all(dir);
 }
 
-TEST_CASE("diagnose silo-dem: a raised wall friction is named or is the named effect's rival, with its value inside "
-          "its interval - the declared material's own rates get nothing - the same command again runs nothing - more "
-          "seeds reuse the campaign's runs",
+TEST_CASE("diagnose silo-dem: a raised wall friction or its mimic cohesion is named, the wall friction's fit holds its "
+          "value in its interval - the declared material's own rates get nothing - the same command again runs "
+          "nothing - more seeds reuse the campaign's runs",
           "[diagnose][silo-dem][slow]") {
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-silo-dem-" + std::to_string(::getpid()));
     fs::remove_all(dir);
