@@ -632,8 +632,12 @@ std::string cpu_text(const ks::SiloCaseResult& r) {
     std::string t = duration_text(r.cpu_s) + " CPU";
     if (r.cpu_sessions < r.sessions)
         t += " (the last " + std::to_string(r.cpu_sessions) + " of " + std::to_string(r.sessions) + " sessions)";
+    if (!r.suspended && std::isfinite(r.fill_cpu_s)) t += ", of which the discharge " + duration_text(r.cpu_s - r.fill_cpu_s);
     return t;
 }
+
+// A time that may be unknown (NaN) as JSON: the number or null.
+nlohmann::json seconds_or_null(double seconds) { return std::isfinite(seconds) ? nlohmann::json(seconds) : nullptr; }
 
 void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
     if (r.suspended) {  // nothing final to write: the checkpoint holds the run
@@ -657,8 +661,10 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                  {"rest_criterion_J", s.rest_energy_factor * r.grain_mass * s.gravity * ks::wheat_length},
                  {"height_m", r.fill_height},
                  {"steps", r.fill_steps},
-                 {"wall_s", r.fill_wall_s}};
+                 {"wall_s", r.fill_wall_s},
+                 {"cpu_s", seconds_or_null(r.fill_cpu_s)}};
     j["discharge"] = {{"time_s", r.discharge_time},
+                      {"cpu_s", seconds_or_null(r.cpu_s - r.fill_cpu_s)},
                       {"discharged_mass_kg", r.discharge.empty() ? 0.0 : r.discharge.back().mass},
                       {"grains_discharged", r.grains_discharged},
                       {"grains_left", r.grains_in_silo},
@@ -697,7 +703,8 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     j["cpu_sessions"] = r.cpu_sessions;
     j["time_note"] = "wall_s: every session's wall-clock time, pauses and waits for busy cores included; cpu_s: the "
                      "process's CPU time over all its threads, in the last cpu_sessions sessions (checkpoints before "
-                     "format 2 did not record it)";
+                     "format 2 did not record it); fill.cpu_s and discharge.cpu_s split it at the opening (null: "
+                     "unknown, a run resumed past its filling from a checkpoint before format 12)";
     j["checkpoints"] = r.checkpoints;
     j["settings"] = {{"threads", s.threads},
                      {"seed", s.seed},

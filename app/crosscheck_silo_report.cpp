@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 namespace demcal::crosscheck_silo {
@@ -191,6 +192,7 @@ json yade_flow_pattern(const fs::path& dir, const json& bed, const json& yade_re
 struct KernelSide {
     json summary;  // demcal silo's summary.json
     double rate = 0, filled = 0, cpu = 0;
+    double discharge_cpu = 0;  // the part of cpu after the opening (NaN: unknown), YADE's share of the work
     Curve curve;
 };
 
@@ -200,6 +202,8 @@ KernelSide read_kernel_side(const fs::path& kernel_dir) {
     k.rate = k.summary.at("rate").at("rate_kg_s").get<double>();
     k.filled = k.summary.at("filled_mass_kg").get<double>();
     k.cpu = k.summary.at("cpu_s").get<double>();
+    const json& discharge_cpu = k.summary.at("discharge").value("cpu_s", json(nullptr));  // (summaries before it: none)
+    k.discharge_cpu = discharge_cpu.is_number() ? discharge_cpu.get<double>() : std::numeric_limits<double>::quiet_NaN();
     k.curve = kernel_curve(kernel_dir / "discharge.csv");
     return k;
 }
@@ -247,6 +251,10 @@ Comparison compare(double theta, const KernelSide& k, const YadeSide& y, double 
     return c;
 }
 
+// A number that may be unknown (NaN): formatted, or "-" in a table and null in JSON.
+std::string known_or_dash(double x, int digits) { return std::isfinite(x) ? g(x, digits) : "-"; }
+json known_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
 std::string pattern_cell(const json& pattern) {
     return pattern.value("pattern", "?") + " (" + g(pattern.value("wall_to_axis_velocity_ratio", 0.0), 2) + ")";
 }
@@ -260,8 +268,9 @@ std::string comparison_row(const Comparison& c, const KernelSide& k, const YadeS
        << (c.agree ? "agree" : "**DIFFER**") << " | " << g(k.summary.at("discharge").at("time_s").get<double>(), 3)
        << " | " << g(y.result.at("discharge_time_s").get<double>(), 3) << " | "
        << pattern_cell(k.summary.at("flow_pattern")) << " | " << (marked ? "**" : "") << pattern_cell(y.pattern)
-       << (marked ? "**" : "") << " | " << g(100 * c.gap, 2) << " | " << g(k.cpu, 3) << " | " << g(y.cpu, 3)
-       << " | " << g(y.cpu / k.cpu, 3) << " |\n";
+       << (marked ? "**" : "") << " | " << g(100 * c.gap, 2) << " | " << g(k.cpu, 3) << " ("
+       << known_or_dash(k.discharge_cpu, 3) << ") | " << g(y.cpu, 3) << " | "
+       << known_or_dash(y.cpu / k.discharge_cpu, 3) << " (" << g(y.cpu / k.cpu, 3) << ") |\n";
     return md.str();
 }
 
@@ -272,6 +281,7 @@ json comparison_json(const Comparison& c, const KernelSide& k, const YadeSide& y
                         {"time_to_empty_s", k.summary.at("discharge").at("time_s")},
                         {"flow_pattern", k.summary.at("flow_pattern")},
                         {"cpu_s", k.cpu},
+                        {"discharge_cpu_s", known_or_null(k.discharge_cpu)},
                         {"wall_s", k.summary.at("wall_s")}}},
             {"yade", {{"rate_kg_s", y.rate},
                       {"rate_se_kg_s", y.result["rate"].value("rate_se_kg_s", 0.0)},
@@ -286,7 +296,8 @@ json comparison_json(const Comparison& c, const KernelSide& k, const YadeSide& y
             {"patterns_agree", c.patterns_determined ? json(c.patterns_agree) : json(nullptr)},
             {"yade_material_as_bed", y.result.value("material_as_bed", true)},
             {"largest_curve_gap_of_filled_mass", c.gap},
-            {"cpu_ratio_yade_over_kernel", y.cpu / k.cpu}};
+            {"cpu_ratio_yade_over_kernel", y.cpu / k.cpu},  // YADE's discharge over the kernel's fill and discharge
+            {"discharge_cpu_ratio_yade_over_kernel", known_or_null(y.cpu / k.discharge_cpu)}};
 }
 
 // --fill both: YADE's discharge of the bed it filled itself, beside the same-bed ratio. The filling's share of the
@@ -325,7 +336,8 @@ json own_fill_json(const Comparison& same_bed, const KernelSide& k, const YadeSi
 constexpr const char* kComparisonHeader =
     "| theta [deg] | kernel rate [g/s] (batch SE) | YADE rate [g/s] (slope SE) | YADE / kernel | rates | kernel empty "
     "[s] | YADE empty [s] | kernel pattern (wall/axis) | YADE pattern (wall/axis) | largest curve gap [% of fill] | "
-    "kernel CPU [s] | YADE CPU [s] | YADE / kernel CPU |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    "kernel CPU [s]: fill + discharge (discharge) | YADE CPU [s] (discharge) | YADE / kernel CPU: discharge (whole "
+    "kernel run) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 
 constexpr const char* kOwnFillSection =
     "\n## Each code fills on its own\n\nYADE fills the silo itself from the kernel's generated cloud (the same "

@@ -28,6 +28,7 @@
 #include "kernel/material.hpp"
 #include "kernel/neighbor.hpp"
 #include "kernel/types.hpp"
+#include "kernel/wall_grid.hpp"
 #include "kernel/walls.hpp"
 
 namespace demcal::kernel {
@@ -310,11 +311,14 @@ class BasicSimulation {
   std::vector<std::uint32_t> wall_list_row_;
   std::vector<std::int32_t> wall_list_;
   bool wall_lists_stale_ = false;                           // a state was loaded: derive the lists before the next use
+  WallGrid wall_grid_;                                      // the candidate searches' broad phase (scratch)
   // remove_bodies_if: the loads of the contacts with the spheres about to go, out of their neighbours' forces and
   // the last half kick (forces stay valid)
   void take_out_removed_contacts(const std::vector<char>& drop_sphere, const std::vector<char>& drop_clump);
   void find_wall_candidate_lists(const std::vector<Vec3>& centres, double reach,
                                  const std::vector<Vec3>& wall_displacement);
+  // wall_grid_ for the walls at these displacements from where they were built, spheres reaching r + reach
+  void build_wall_grid(const std::vector<Vec3>& wall_displacement, double reach);
 
   // per clump
   std::vector<Vec3> cx_, cv_, cw_, cL_, cI_, cF_, cT_;

@@ -529,15 +529,26 @@ void BasicSimulation<Law>::find_wall_candidates() {
     find_wall_candidate_lists(x_, reach, wall_disp_built_);
     return;
   }
+  build_wall_grid(wall_disp_built_, reach);
 #pragma omp parallel for num_threads(nt()) schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     std::uint64_t m = 0;
     Vec3 nrm;
     double dn, dist;
-    for (int wdx = 0; wdx < nw; ++wdx)
-      if (walls_[wdx].contact(x_[i], r_[i] + reach, nrm, dn, dist)) m |= std::uint64_t(1) << wdx;
+    const double ri = r_[i] + reach;
+    wall_grid_.for_each_candidate(x_[i], [&](int wdx) {
+      if (wall_grid_.near_box(wdx, x_[i], ri) && walls_[wdx].contact(x_[i], ri, nrm, dn, dist))
+        m |= std::uint64_t(1) << wdx;
+    });
     wall_cand_[std::size_t(i)] = m;
   }
+}
+
+template <class Law>
+void BasicSimulation<Law>::build_wall_grid(const std::vector<Vec3>& wall_displacement, double reach) {
+  double r_max = 0;
+  for (double r : r_) r_max = std::max(r_max, r);
+  wall_grid_.build(walls_, wall_displacement, r_max + reach);
 }
 
 template <class Law>
@@ -546,24 +557,28 @@ void BasicSimulation<Law>::find_wall_candidate_lists(const std::vector<Vec3>& ce
   // Each thread lists the walls of its contiguous block of spheres (schedule static, no chunk: blocks in thread
   // order), then the blocks are joined in that order: ascending spheres, ascending walls, whatever the thread count.
   const std::int64_t n = std::int64_t(centres.size());
-  const int nw = int(walls_.size());
   std::vector<std::uint32_t> count(std::size_t(n), 0);
   std::vector<std::vector<std::int32_t>> block(static_cast<std::size_t>(nt()));
+  build_wall_grid(wall_displacement, reach);
 #pragma omp parallel num_threads(nt())
   {
     std::vector<std::int32_t>& mine = block[std::size_t(omp_get_thread_num())];
     Vec3 nrm;
     double dn, dist;
 #pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < n; ++i)
-      for (int wdx = 0; wdx < nw; ++wdx) {
+    for (std::int64_t i = 0; i < n; ++i) {
+      const Vec3& c = centres[std::size_t(i)];
+      const double ri = r_[std::size_t(i)] + reach;
+      wall_grid_.for_each_candidate(c, [&](int wdx) {
+        if (!wall_grid_.near_box(wdx, c, ri)) return;
         // the wall where it stood at the build: contact() takes off its displacement now
-        const Vec3 p = centres[std::size_t(i)] + (walls_[wdx].displacement - wall_displacement[std::size_t(wdx)]);
-        if (walls_[wdx].contact(p, r_[std::size_t(i)] + reach, nrm, dn, dist)) {
+        const Vec3 p = c + (walls_[wdx].displacement - wall_displacement[std::size_t(wdx)]);
+        if (walls_[wdx].contact(p, ri, nrm, dn, dist)) {
           mine.push_back(wdx);
           ++count[std::size_t(i)];
         }
-      }
+      });
+    }
   }
   wall_list_row_.assign(std::size_t(n) + 1, 0);
   for (std::int64_t i = 0; i < n; ++i) wall_list_row_[std::size_t(i) + 1] = wall_list_row_[std::size_t(i)] + count[std::size_t(i)];

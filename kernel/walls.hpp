@@ -36,6 +36,12 @@ struct Wall {
     const Vec3 q = p - displacement;
     return std::visit([&](const auto& s) { return s.contact(q, r, n, dn, dist); }, shape);
   }
+  /// The axis-aligned box [lo, hi] that holds every point of the wall a contact can be with, the wall where it was
+  /// built (add its displacement); false for an unbounded wall (a plane). A sphere centre farther than r from the
+  /// box touches nothing of the wall (the broad phase of the wall candidates, kernel/wall_grid.hpp).
+  bool built_bounds(Vec3& lo, Vec3& hi) const {
+    return std::visit([&](const auto& s) { return s.bounds(lo, hi); }, shape);
+  }
   /// The shape's kind and numbers, the material and the motion law (the checkpoint's configuration check).
   void append_numbers(std::vector<double>& c) const {
     c.insert(c.end(), {double(shape.index()), double(material)});

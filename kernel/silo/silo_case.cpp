@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -363,6 +364,8 @@ void validate(const SiloCaseSettings& s) {
 
 namespace {
 
+// Version 12: the filling's CPU time after the discharge record's count of CPU sessions (versions 4 to 11 are read:
+// the filling's CPU unknown when the run was past it).
 // Version 11: the discharge's wall facets at the end of the settings (versions 4 to 10 are read, exact walls).
 // Version 10: the discharge's clump rotation scheme at the end of the settings (versions 4 to 9 are read, richardson).
 // Version 9: the contact law (edem / yade) at the end of the settings (versions 4 to 8 are read, on the edem law).
@@ -372,7 +375,8 @@ namespace {
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 11;
+constexpr int kCheckpointVersion = 12;
+constexpr int kCheckpointVersionWithoutFillCpu = 11;       // fill_cpu_s: unknown past the filling
 constexpr int kCheckpointVersionWithoutWallFacets = 10;    // discharge_wall_facets: 0 (exact walls)
 constexpr int kCheckpointVersionWithoutRotationChoice = 9;  // discharge_clump_rotation: richardson
 constexpr int kCheckpointVersionWithoutLawChoice = 8;      // contact_law: edem
@@ -556,7 +560,7 @@ public:
             w.value(r_.fill_kinetic_energy); w.value(r_.fill_height); w.value(r_.bulk_density); w.value(r_.filled_mass);
             w.value(r_.fill_steps); w.value(r_.fill_wall_s); w.value(r_.sessions); w.value(r_.checkpoints);
             w.value(r_.vtk_files);
-            w.value(cpu()); w.value(r_.cpu_sessions);
+            w.value(cpu()); w.value(r_.cpu_sessions); w.value(r_.fill_cpu_s);
             w.array(r_.discharge);
             const bool open = phase_ == Phase::discharge;
             if (open) {
@@ -596,6 +600,10 @@ public:
         r.value(r_.checkpoints, "checkpoints"); r.value(r_.vtk_files, "vtk files");
         r.value(cpu_before_, "cpu time");
         r.value(r_.cpu_sessions, "cpu sessions");
+        if (version > kCheckpointVersionWithoutFillCpu)
+            r.value(r_.fill_cpu_s, "fill cpu time");
+        else
+            r_.fill_cpu_s = std::numeric_limits<double>::quiet_NaN();  // (set again if the filling goes on)
         r.array(r_.discharge, "discharge record");
         if (phase_ != Phase::filling && phase_ != Phase::discharge) r.fail("phase", "unknown value");
         if (bin_motion_ && phase_ == Phase::discharge) bin_motion_->open_at(t_open_);  // the law the run was on
@@ -749,6 +757,7 @@ private:
         r_.fill_steps = sim_.steps_done();
         r_.fill_kinetic_energy = ke_;
         r_.fill_wall_s = wall();
+        r_.fill_cpu_s = cpu();
         // the filled bed: height and bulk density below 0.8 of its height
         double top = 0, mass_below = 0;
         for (size_t i = 0; i < sim_.num_bodies(); ++i) top = std::max(top, sim_.body(i).position.z());

@@ -212,6 +212,10 @@ struct SiloCaseResult {
     // or waited for cores other work held.
     double cpu_s = 0;
     int cpu_sessions = 0;
+    // The part of cpu_s spent until the end of the filling (NaN: unknown, a run resumed in its discharge from a
+    // checkpoint older than format 12): cpu_s - fill_cpu_s is the discharge's, the work a code that starts from the
+    // filled bed (YADE importing it) does.
+    double fill_cpu_s = 0;
     bool suspended = false;  // stopped at SiloCaseSettings::wall_limit or stop_request (stop_reason says which):
                              // resume it from its checkpoint
     std::string contact_law;             // the law the run was on (contact_law_name)

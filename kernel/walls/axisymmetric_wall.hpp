@@ -40,6 +40,12 @@ struct AxisymmetricWall {
     dn = r - dl; dist = dl;
     return true;
   }
+  /// Axis-aligned bounding box [lo, hi] of the surface of revolution.
+  bool bounds(Vec3& lo, Vec3& hi) const {
+    const double r = std::max(r0, r1);
+    lo = Vec3(cx - r, cy - r, std::min(z0, z1)); hi = Vec3(cx + r, cy + r, std::max(z0, z1));
+    return true;
+  }
   void append_numbers(std::vector<double>& c) const { c.insert(c.end(), {cx, cy, r0, z0, r1, z1}); }
 };
 

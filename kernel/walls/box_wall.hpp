@@ -34,6 +34,11 @@ struct BoxWall {
     dn = r - dist;
     return true;
   }
+  /// Axis-aligned bounding box [lo, hi]: the box itself (a centre inside it is a contact too).
+  bool bounds(Vec3& lo, Vec3& hi) const {
+    lo = centre - half; hi = centre + half;
+    return true;
+  }
   void append_numbers(std::vector<double>& c) const {
     c.insert(c.end(), {centre.x(), centre.y(), centre.z(), half.x(), half.y(), half.z()});
   }

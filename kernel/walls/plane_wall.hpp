@@ -17,6 +17,8 @@ struct PlaneWall {
     n = normal; dn = r - d; dist = d;
     return true;
   }
+  /// No bounding box: a plane is infinite (WallGrid offers it to every sphere).
+  bool bounds(Vec3&, Vec3&) const { return false; }
   void append_numbers(std::vector<double>& c) const {
     c.insert(c.end(), {point.x(), point.y(), point.z(), normal.x(), normal.y(), normal.z()});
   }

@@ -28,6 +28,12 @@ struct RectangleWall {
     dn = r - dl; dist = dl;
     return true;
   }
+  /// Axis-aligned bounding box [lo, hi] of the rectangle (every point a contact can be with lies in it).
+  bool bounds(Vec3& lo, Vec3& hi) const {
+    const Vec3 extent = half_u * u.cwiseAbs() + half_v * v.cwiseAbs();
+    lo = centre - extent; hi = centre + extent;
+    return true;
+  }
   void append_numbers(std::vector<double>& c) const {
     c.insert(c.end(), {centre.x(), centre.y(), centre.z(), normal.x(), normal.y(), normal.z(), u.x(), u.y(), u.z(),
                        v.x(), v.y(), v.z(), half_u, half_v});

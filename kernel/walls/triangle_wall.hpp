@@ -71,6 +71,13 @@ struct TriangleWall {
     dn = r - dist;
     return true;
   }
+  /// Axis-aligned bounding box [lo, hi] of the facet (a contact point is always on the closed triangle).
+  bool bounds(Vec3& lo, Vec3& hi) const {
+    lo = hi = vertex[0];
+    for (int k = 1; k < 3; ++k) { lo = lo.cwiseMin(vertex[k]); hi = hi.cwiseMax(vertex[k]); }
+    lo += centre; hi += centre;
+    return true;
+  }
   void append_numbers(std::vector<double>& c) const {
     c.insert(c.end(), {centre.x(), centre.y(), centre.z(), normal.x(), normal.y(), normal.z()});
     for (const Vec3& v : vertex) c.insert(c.end(), {v.x(), v.y(), v.z()});

@@ -47,6 +47,10 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     CHECK(a["rate_ratio_yade_over_kernel"].get<double>() < 1.25);
     CHECK(a["largest_curve_gap_of_filled_mass"].get<double>() < 0.2);
     CHECK(a["cpu_ratio_yade_over_kernel"].get<double>() > 1);
+    // like for like: YADE's discharge against the kernel's discharge, a part of the kernel's whole run
+    CHECK(a["kernel"]["discharge_cpu_s"].get<double>() > 0);
+    CHECK(a["kernel"]["discharge_cpu_s"].get<double>() < a["kernel"]["cpu_s"].get<double>());
+    CHECK(a["discharge_cpu_ratio_yade_over_kernel"].get<double>() > a["cpu_ratio_yade_over_kernel"].get<double>());
     CHECK(fs::exists(dir / "c" / "theta_45" / "bed.json"));
     CHECK(fs::exists(dir / "c" / "crosscheck_silo.md"));
     // the same command again: both runs reused

@@ -5,6 +5,7 @@
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -307,6 +308,12 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to th
     const std::string summary = read_file(out / "summary.json");
     CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 4"));
     CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 4"));
+    // the CPU split at the opening survives the sessions: the filling's part from the checkpoint
+    const auto j = nlohmann::json::parse(summary);
+    const double fill_cpu = j["fill"]["cpu_s"].get<double>(), discharge_cpu = j["discharge"]["cpu_s"].get<double>();
+    CHECK(fill_cpu > 0);
+    CHECK(discharge_cpu > 0);
+    CHECK(fill_cpu + discharge_cpu == Approx(j["cpu_s"].get<double>()).epsilon(1e-12));
     CHECK_FALSE(fs::exists(ckpt));  // removed once the outputs are written
     const Run finished_run = run_silo("--resume '" + out.string() + "'", dir);
     CHECK(finished_run.rc == 2);
