@@ -95,6 +95,12 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
     std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell_of_[i]]++] = std::uint32_t(i);  // ascending i per cell
   }
+  binned_.resize(n);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (std::int64_t k = 0; k < sn; ++k) {
+    const std::uint32_t i = cell_items_[std::size_t(k)];
+    binned_[std::size_t(k)] = {x[i], r[i], group[i], i};
+  }
   // One pass over the 27 cells around each sphere i finds its partners on both sides: j > i (its row of the half
   // list) and j < i (the pairs where i is the partner: its row of the transposed index). The test is symmetric
   // (|x_i - x_j|^2 and r_i + r_j + skin are the same bits either way), so the two sides agree exactly. Each thread
@@ -104,12 +110,14 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
   const int nthreads = std::max(1, threads);
   thread_fwd_.resize(std::size_t(nthreads));
   thread_bwd_.resize(std::size_t(nthreads));
+  thread_found_.resize(std::size_t(nthreads));
 #pragma omp parallel num_threads(nthreads)
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     const std::int64_t lo = sn * t / nt, hi = sn * (t + 1) / nt;  // this thread's block, in sphere order
     std::vector<std::int32_t>& fwd = thread_fwd_[std::size_t(t)];
     std::vector<std::int32_t>& bwd = thread_bwd_[std::size_t(t)];
+    std::vector<std::int32_t>& found = thread_found_[std::size_t(t)];
     fwd.clear();
     bwd.clear();
     for (std::int64_t i = lo; i < hi; ++i) {
@@ -119,19 +127,37 @@ void NeighborList::build(const std::vector<Vec3>& x, const std::vector<double>& 
       const Vec3 xi = x[std::size_t(i)];
       const double ri = r[std::size_t(i)];
       const std::int32_t gi = group[std::size_t(i)];
+      // the 3 x 3 rows of cells around i's cell: the three cells of a row are consecutive in cell order, so each row
+      // is one range of binned_ (9 ranges, not 27 short loops whose ends the branch predictor misses)
+      std::uint32_t range_begin[9], range_end[9];
+      int ranges = 0;
+      std::size_t candidates = 0;
+      const std::int64_t x0 = std::max<std::int64_t>(cx - 1, 0), x1 = std::min(cx + 1, nx - 1);
       for (std::int64_t z = std::max<std::int64_t>(cz - 1, 0); z <= std::min(cz + 1, nz - 1); ++z)
-        for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0); y <= std::min(cy + 1, ny - 1); ++y)
-          for (std::int64_t xx = std::max<std::int64_t>(cx - 1, 0); xx <= std::min(cx + 1, nx - 1); ++xx) {
-            const std::size_t cc = std::size_t((z * ny + y) * nx + xx);
-            for (std::uint32_t k = cell_start_[cc]; k < cell_start_[cc + 1]; ++k) {
-              const std::uint32_t j = cell_items_[k];
-              if (j == std::uint32_t(i) || (gi >= 0 && group[j] == gi)) continue;
-              const double cut = ri + r[j] + skin + reach;
-              if ((xi - x[j]).squaredNorm() < cut * cut) (j > std::uint32_t(i) ? fwd : bwd).push_back(std::int32_t(j));
-            }
-          }
-      std::sort(fwd.begin() + std::ptrdiff_t(f0), fwd.end());
-      std::sort(bwd.begin() + std::ptrdiff_t(b0), bwd.end());
+        for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0); y <= std::min(cy + 1, ny - 1); ++y) {
+          const std::size_t row_cell = std::size_t((z * ny + y) * nx);
+          range_begin[ranges] = cell_start_[row_cell + std::size_t(x0)];
+          range_end[ranges] = cell_start_[row_cell + std::size_t(x1) + 1];
+          candidates += range_end[ranges] - range_begin[ranges];
+          ++ranges;
+        }
+      if (found.size() < candidates) found.resize(2 * candidates);
+      // every candidate written, the count advanced only for a partner (no branch on the test's outcome)
+      std::size_t count = 0;
+      for (int q = 0; q < ranges; ++q)
+        for (std::uint32_t k = range_begin[q]; k < range_end[q]; ++k) {
+          const Binned& b = binned_[k];
+          const double cut = ri + b.r + skin + reach;
+          const bool partner = ((xi - b.x).squaredNorm() < cut * cut) & (b.index != std::uint32_t(i)) &
+                               !((gi >= 0) & (b.group == gi));
+          found[count] = std::int32_t(b.index);
+          count += partner;
+        }
+      // sorted once: the partners below i are its transposed row, those above its row of the half list
+      std::sort(found.begin(), found.begin() + std::ptrdiff_t(count));
+      const auto split = std::lower_bound(found.begin(), found.begin() + std::ptrdiff_t(count), std::int32_t(i));
+      bwd.insert(bwd.end(), found.begin(), split);
+      fwd.insert(fwd.end(), split, found.begin() + std::ptrdiff_t(count));
       row[std::size_t(i) + 1] = std::uint32_t(fwd.size() - f0);
       trow[std::size_t(i) + 1] = std::uint32_t(bwd.size() - b0);
     }

@@ -81,8 +81,18 @@ class NeighborList {
   std::size_t builds_ = 0;
   // cell grid scratch
   std::vector<std::uint32_t> cell_start_, cell_items_, cell_of_;
+  // The spheres' centres, radii and groups copied in cell order (cell_items_'s), so that the search streams through
+  // each cell's spheres instead of gathering them by index (the search's loads were most of a build's time).
+  struct Binned {
+    Vec3 x;
+    double r;
+    std::int32_t group;
+    std::uint32_t index;
+  };
+  std::vector<Binned> binned_;
   // build scratch: the partners each thread found for its block of spheres (j > i and j < i)
   std::vector<std::vector<std::int32_t>> thread_fwd_, thread_bwd_;
+  std::vector<std::vector<std::int32_t>> thread_found_;  // one sphere's candidates, partners first
 };
 
 /// All pairs (i < j, not in the same clump) whose spheres overlap (|x_i - x_j| < r_i + r_j), by brute force O(n^2).

@@ -12,6 +12,17 @@ constexpr std::int64_t kMaxCells = 1 << 16;   // rebuilt at every neighbour buil
 }  // namespace
 
 void WallGrid::build(const std::vector<Wall>& walls, const std::vector<Vec3>& displacement, double reach) {
+  // the same walls where they stood at the last build, the same reach: the same grid (fixed walls: built once)
+  std::vector<double> key;
+  key.reserve(walls.size() * 20 + 1);
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    walls[w].append_numbers(key);
+    key.insert(key.end(), {displacement[w].x(), displacement[w].y(), displacement[w].z()});
+  }
+  key.push_back(reach);
+  if (built_ && key == key_) return;
+  key_.swap(key);
+  built_ = true;
   const std::size_t nw = walls.size();
   boxes_.assign(nw, Box{});
   unbounded_.clear();

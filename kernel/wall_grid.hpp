@@ -50,6 +50,8 @@ class WallGrid {
   std::int64_t dims_[3] = {0, 0, 0};
   std::vector<std::uint32_t> start_;  // CSR over cells (x fastest)
   std::vector<std::int32_t> walls_;   // each cell's walls, ascending
+  std::vector<double> key_;           // the walls' numbers, displacements and reach the grid was built for
+  bool built_ = false;
 
   // -1: outside the grid (only unbounded walls can be within reach there)
   std::int64_t cell_of(const Vec3& p) const {
