@@ -1,4 +1,4 @@
-"""Shared by the compare.py scripts of the variant folders: the kernel's rates of a variant (its results.txt), YADE's
+"""Shared by compare_variants.py and more-beds/compare.py: the kernel's rates of a variant (its results.txt), YADE's
 rate of each bed (the --kernel-law yade crosschecks: yade-law/ for seed 1, yade-law-theta<t>-seed<s>/ for seeds 2
 and 3) and the mean with its SD and SE."""
 import json
