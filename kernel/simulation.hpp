@@ -176,14 +176,14 @@ class BasicSimulation {
   BodyState body(std::size_t i) const;
   /// Sets the velocity [m/s] and angular velocity [rad/s, world] of body i.
   void set_body_velocity(std::size_t i, const Vec3& velocity, const Vec3& omega);
-  /// Removes every body for which pred(state) is true; returns how many and their mass. With exact removals on
-  /// (set_exact_removal) the rest goes on as if they had gone before the last force evaluation (their contacts' loads
-  /// and the half kick those gave taken out); off, the forces of the rest are evaluated again.
   /// Exact removals (default off): the pair loop then records each pair's torque on i (a few per cent of its time on
   /// the peer case), which a removal needs to take a body's contacts out of its neighbours' loads. A case that removes
   /// bodies as it runs (the silo's discharge) turns them on: evaluating every force again after a removal moves the
   /// whole bed a little (kernel/README.md).
   void set_exact_removal(bool on) { exact_removal_ = on; pair_torques_i_known_ = false; }
+  /// Removes every body for which pred(state) is true; returns how many and their mass. With exact removals on
+  /// (set_exact_removal) the rest goes on as if they had gone before the last force evaluation (their contacts' loads
+  /// and the half kick those gave taken out); off, the forces of the rest are evaluated again.
   RemovalResult remove_bodies_if(const std::function<bool(const BodyState&)>& pred);
 
   /// Spheres (single ones and clump members): 0..num_spheres()-1.

@@ -1051,8 +1051,8 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
       for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) drop_sphere[cmem_[k]] = 1;
     }
   }
-  // With exact removals on, the bodies go as if they had gone before the last force evaluation (as a leapfrog code erasing them between two
-  // steps, YADE's silo.py): their contacts' loads leave their neighbours' forces and the half kick those loads gave
+  // With exact removals on, the bodies go as if they had gone before the last force evaluation (as a leapfrog code
+  // erasing them between two steps, YADE's silo.py): their contacts' loads leave their neighbours' forces and the half kick those loads gave
   // is taken back, so the forces stay valid and nothing else changes. (Recomputing every force instead re-evaluated
   // each damped contact with the on-step velocities and re-capped its spring: at every removal the whole bed moved
   // otherwise, which slowed the silo's discharge by about 2 %, measured against YADE; examples/crosscheck/README.md.)
