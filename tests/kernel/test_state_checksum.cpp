@@ -5,24 +5,13 @@
 #include <string>
 
 #include "kernel/simulation.hpp"
+#include "small_state.hpp"
 
 using namespace demcal::kernel;
 
 TEST_CASE("a kernel state with any one byte damaged is refused, never loaded", "[kernel][checkpoint]") {
-  auto make = [] {
-    Simulation sim;
-    const int a = sim.add_material({1e8, 0.3, 1500, "grain"});
-    sim.set_pair(a, a, {{0.5}, {0.4}, {0.01}});
-    sim.add_wall(Wall::plane({0, 0, 0}, {0, 0, 1}, a));
-    for (int k = 0; k < 20; ++k) sim.add_sphere({0.003 * (k % 5), 0.003 * (k / 5), 0.002 + 0.0001 * k}, 1e-3, a);
-    sim.set_timestep(0.2 * sim.rayleigh_timestep());
-    return sim;
-  };
-  Simulation sim = make();
-  sim.step(200);
-  std::ostringstream os;
-  sim.save_state(os);
-  const std::string good = os.str();
+  const auto make = demcal::test::small_state_simulation;
+  const std::string good = demcal::test::small_saved_state();
   {
     Simulation fresh = make();
     std::istringstream is(good);
