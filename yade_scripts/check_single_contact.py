@@ -466,6 +466,17 @@ def replay_clump(p, meta):
     return out, props_err
 
 
+def verdict(case, worst, problems, tol, rows, steps):
+    """Prints one case's verdict (its largest relative error per quantity, the first problems); returns (ok, error)."""
+    max_err = max(e for e, _ in worst.values())
+    ok = not problems and max_err <= tol
+    print("%-24s %s  max rel error %.3g  (%d rows, %d steps)" % (case, "OK  " if ok else "FAIL", max_err, rows, steps))
+    print("    " + ", ".join("%s %.2g@%s" % (k, e, n) for k, (e, n) in worst.items()))
+    for msg in problems[:10]:
+        print("    " + msg)
+    return ok, max_err
+
+
 def check_clump(case, p, rows, meta, tol):
     sim, props_err = replay_clump(p, meta)
     problems = []
@@ -502,14 +513,7 @@ def check_clump(case, p, rows, meta, tol):
             if e > e_max:
                 e_max, at = e, n
         worst[name] = (e_max, at)
-    max_err = max(e for e, _ in worst.values())
-    ok = not problems and max_err <= tol
-    print("%-24s %s  max rel error %.3g  (%d rows, %d steps)" % (case, "OK  " if ok else "FAIL", max_err, len(rows),
-                                                                 len(sim)))
-    print("    " + ", ".join("%s %.2g@%s" % (k, e, n) for k, (e, n) in worst.items()))
-    for msg in problems[:10]:
-        print("    " + msg)
-    return ok, max_err
+    return verdict(case, worst, problems, tol, len(rows), len(sim))
 
 
 VECTORS = {"fn": "fn_", "fs": "fs_", "f0": "b0_f_", "f1": "b1_f_", "t0": "b0_t_", "t1": "b1_t_", "x1": "b1_pos_",
@@ -565,14 +569,7 @@ def check(case, tol):
                 e = abs(s[k] - y) / max(abs(y), 1e-9 * peak[k], 1e-300)
                 if e > worst[k][0]:
                     worst[k] = (e, n)
-    max_err = max(e for e, _ in worst.values())
-    ok = not problems and max_err <= tol
-    print("%-24s %s  max rel error %.3g  (%d rows, %d steps)" % (case, "OK  " if ok else "FAIL", max_err, len(rows),
-                                                                 len(sim)))
-    print("    " + ", ".join("%s %.2g@%s" % (k, e, n) for k, (e, n) in worst.items()))
-    for msg in problems[:10]:
-        print("    " + msg)
-    return ok, max_err
+    return verdict(case, worst, problems, tol, len(rows), len(sim))
 
 
 def main():
