@@ -34,13 +34,13 @@ void holm(std::vector<CandidateTest>& tests) {
 // --- the search -------------------------------------------------------------------------------------------------
 
 // The base model fitted to s.rows, restarted once when GSL stops at its iteration limit.
-LeastSquaresFit fit_base(const Setting& s, const Model& m, std::vector<std::string>& warnings) {
+LeastSquaresFit fit_base(const Setting& s, const Model& m, std::vector<std::string>& undetermined) {
     LeastSquaresFit fit = fit_extended(s, m, m.start);
     if (!fit.converged) {
         // GSL also stops at its iteration limit when started at the optimum; only a restart that still improves the
         // sum of squares means the fit had not converged.
         const auto again = fit_rows(s, m, s.rows, fit.params);
-        if (again.sse < fit.sse * (1 - 1e-8)) warnings.push_back("the fit of " + m.name + " did not converge");
+        if (again.sse < fit.sse * (1 - 1e-8)) undetermined.push_back("the fit of " + m.name + " did not converge");
         if (again.sse < fit.sse) fit = again;
     }
     return fit;
@@ -56,8 +56,8 @@ struct Search {
 
 // The rounds of candidate tests on s.rows (F test, Holm, cross-validation), from the base model.
 Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions& options,
-                      std::vector<std::string>& warnings) {
-    Search out{base, fit_base(s, base, warnings), {}, 0, {}, {}};
+                      std::vector<std::string>& warnings, std::vector<std::string>& undetermined) {
+    Search out{base, fit_base(s, base, undetermined), {}, 0, {}, {}};
     Model& m = out.model;
     LeastSquaresFit& fit = out.fit;
     fit = out.base_fit;
@@ -67,7 +67,7 @@ Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions
     const double base_rms = std::sqrt(fit.sse / double(std::max<std::size_t>(n, 1)));
     if (std::isfinite(base_rms) && base_rms < kExactFitResidual) {
         out.cv_after = cross_validated_rmse(s, m, fit.params);
-        warnings.push_back("the " + m.name + " model fits every row to rounding (residual RMS " + short_number(base_rms) +
+        undetermined.push_back("the " + m.name + " model fits every row to rounding (residual RMS " + short_number(base_rms) +
                            "): the data carry no scatter to test an effect against (identical or noiseless rows?); "
                            "no effect was searched");
         return out;
@@ -298,10 +298,10 @@ SearchWithoutOutliers search_without_outliers(Setting& s, const Model& base, con
                                               DiagnoseResult& result) {
     const std::size_t n = s.data.rows();
     SearchWithoutOutliers out;
-    out.flagged = flagged_rows(s, base, fit_base(s, base, result.warnings).params, options.outlier_alpha);
+    out.flagged = flagged_rows(s, base, fit_base(s, base, result.undetermined).params, options.outlier_alpha);
     for (int pass = 0;; ++pass) {
         s.rows = rows_without(n, out.flagged);
-        out.search = search_effects(s, base, options, result.warnings);
+        out.search = search_effects(s, base, options, result.warnings, result.undetermined);
         s.rows = all_rows(n);
         out.all_rows_fit = fit_rows(s, out.search.model, s.rows, out.search.fit.params).params;
         auto again = flagged_rows(s, out.search.model, out.all_rows_fit, options.outlier_alpha);
@@ -354,7 +354,7 @@ void report_fits(Setting& s, const Model& base, const SearchWithoutOutliers& fou
     const Scored after = no_effect ? before : dropped ? score(s, search.model, search.fit.params) : with_all;
     for (double se : before.fit.std_errors)
         if (!std::isfinite(se)) {
-            result.warnings.push_back("some parameters of " + result.model +
+            result.undetermined.push_back("some parameters of " + result.model +
                                       " are not identifiable from these data (singular covariance)");
             break;
         }
@@ -411,10 +411,12 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
     const Scored with_all = report_outliers(s, found, options, result);
     report_fits(s, base, found, with_all, result);
     // Repeated searches repeat their warnings.
-    std::vector<std::string> unique;
-    for (auto& w : result.warnings)
-        if (std::find(unique.begin(), unique.end(), w) == unique.end()) unique.push_back(std::move(w));
-    result.warnings = std::move(unique);
+    for (auto* notes : {&result.warnings, &result.undetermined}) {
+        std::vector<std::string> unique;
+        for (auto& w : *notes)
+            if (std::find(unique.begin(), unique.end(), w) == unique.end()) unique.push_back(std::move(w));
+        *notes = std::move(unique);
+    }
     return result;
 }
 
@@ -479,6 +481,8 @@ nlohmann::json DiagnoseResult::to_json() const {
                      {"without_outliers", errors_json(outliers.without_outliers)},
                      {"dropped", outliers.dropped}};
     j["warnings"] = warnings;
+    j["determined"] = undetermined.empty();
+    j["undetermined"] = undetermined;
     nlohmann::json rows = nlohmann::json::array();
     for (std::size_t i = 0; i < observed.size(); ++i)
         rows.push_back({{"line", lines[i]},

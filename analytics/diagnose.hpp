@@ -126,6 +126,9 @@ struct DiagnoseResult {
     std::vector<std::string> flow_mode_of_row;  // "mass" | "mixed" | "funnel" per row, when it was
     OutlierReport outliers;
     std::vector<std::string> warnings;
+    // Why the diagnosis is not determined by these data (a base fit that did not converge, rows fitted to rounding,
+    // parameters not identifiable): empty when it is. The command then exits 1 unless asked to go on.
+    std::vector<std::string> undetermined;
     // {"model", "n", "before": {...}, "effects": [...], "after": {...}} plus details (parameters, tests, rounds).
     nlohmann::json to_json() const;
 };

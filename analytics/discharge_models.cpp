@@ -126,6 +126,12 @@ void validate(const SiloGeometry& g) {
     }
     positive("beverloo_C", g.beverloo_c);
     if (!(g.beverloo_k >= 0)) throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + " must be >= 0");
+    // Beverloo's empty annulus k d_p must leave an opening, or its rate is 0 for any silo (k is 1-3 in the literature)
+    const double opening = g.shape == SiloShape::rectangular ? std::min(g.outlet, g.depth) : g.outlet;
+    if (g.beverloo_k * g.particle_size >= opening)
+        throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + ": k d_p = " +
+                                    number_text(g.beverloo_k * g.particle_size) + " m is not smaller than the outlet (" +
+                                    number_text(opening) + " m): Beverloo's effective outlet would be empty");
     positive("slot_C", g.slot_c);
     positive("delta", g.arch_delta);
     if (!(g.stagnant_angle_deg > 0 && g.stagnant_angle_deg < 90))

@@ -181,6 +181,36 @@ void check_output_file_in_new_folders(const std::string& path, const std::string
     check_files_can_be_created_below(parent, option + " = '" + analytics::shortened_text(path, 200) + "'");
 }
 
+namespace {
+// The path as the file system resolves it (absolute, "." and ".." and links of its existing part resolved), so that
+// two spellings of one file compare equal.
+std::filesystem::path resolved(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+    if (ec) p = fs::absolute(path, ec).lexically_normal();
+    return p;
+}
+std::string quoted_path(const std::string& path) { return "'" + analytics::shortened_text(path, 200) + "'"; }
+}  // namespace
+
+void check_paths_apart(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs) {
+    std::vector<std::filesystem::path> out_resolved;
+    for (const NamedPath& o : outputs) out_resolved.push_back(o.path.empty() ? std::filesystem::path() : resolved(o.path));
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+        if (outputs[i].path.empty()) continue;
+        for (const NamedPath& in : inputs)
+            if (!in.path.empty() && resolved(in.path) == out_resolved[i])
+                throw UserError(outputs[i].option + " = " + quoted_path(outputs[i].path) + " is the input " + in.option +
+                                " (" + quoted_path(in.path) + "): it would be overwritten; give another path");
+        for (std::size_t k = 0; k < i; ++k)
+            if (!outputs[k].path.empty() && out_resolved[k] == out_resolved[i])
+                throw UserError(outputs[i].option + " = " + quoted_path(outputs[i].path) + " is also " +
+                                outputs[k].option + " (" + quoted_path(outputs[k].path) +
+                                "): one output would overwrite the other; give another path");
+    }
+}
+
 std::string duration_text(double seconds) {
     if (!(seconds >= 0)) return "?";
     char buf[32];

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace demcal {
 
@@ -44,6 +45,17 @@ void check_output_folder(const std::string& path, const std::string& option);
 // must allow files to be created (check_output_folder; the file, when it exists, as above). An empty path (output
 // not asked for) passes.
 void check_output_file_in_new_folders(const std::string& path, const std::string& option);
+
+// A path a command reads or writes, with the option (or field) that gave it, for the messages.
+struct NamedPath {
+    std::string path;    // empty: not given (skipped)
+    std::string option;  // e.g. "--json", "geometry (the input file)"
+};
+
+// Refuses, before any work starts, an output that is one of the inputs (it would be overwritten) and two outputs on
+// one path (one would overwrite the other, or a file would be written where a folder goes). Paths are compared as
+// the file system resolves them: relative or absolute, "..", symbolic links. Throws UserError naming both options.
+void check_paths_apart(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
 
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);

@@ -228,6 +228,7 @@ void add_calibrate(CLI::App& app) {
     cmd->callback([o] {
         const auto& camp = o->study.campaign;
         if (!o->output.empty()) check_output_file(o->output, "output");  // before hours of calibration, not after
+        check_paths_apart({{o->start_file, "start"}, {o->sensitivity_file, "sensitivity"}}, {{o->output, "output"}});
         const auto start = orchestrator::validate_material(read_json_file(o->start_file, "start"), o->start_file);
         const auto targets = targets_of(*o);
         const auto bounds = parse_ranges(o->bounds, "bounds");
@@ -335,8 +336,10 @@ void add_calibrate(CLI::App& app) {
                   << " +/- " << best.tau_c_half_width << " Pa (95 % intervals)\n"
                   << "calibration: " << result.evaluations << " failure lines, " << result.simulations_run
                   << " simulations run, " << result.simulations_reused << " reused, CPU " << cpu_duration(result.cpu_s)
-                  << "; sensitivity study: " << study.evaluations << " failure lines, " << study.simulations_run
-                  << " simulations run now\nmaterial: " << out.string() << "\n";
+                  << "; sensitivity study: " << study.evaluations << " failure lines, "
+                  << (o->sensitivity_file.empty() ? std::to_string(study.simulations_run) + " simulations run now"
+                                                  : "read from " + o->sensitivity_file + " (not run now)")
+                  << "\nmaterial: " << out.string() << "\n";
         if (result.status == CalibrationStatus::unreachable) throw UserError("calibration stopped: " + result.message);
         if (result.status != CalibrationStatus::converged) throw std::runtime_error(result.message);
     });
@@ -367,6 +370,9 @@ void add_enlarge(CLI::App& app) {
         if (fs::path(o->output).extension() != ".json")  // the plot and its data take the same name
             throw UserError("output = '" + o->output + "': must end in .json");
         check_output_file(o->output, "output");
+        std::vector<NamedPath> inputs;
+        for (const auto& file : o->materials) inputs.push_back({file, "material"});
+        check_paths_apart(inputs, {{o->output, "output"}});
         std::vector<double> r, e, nu;
         std::map<double, std::string> file_of_radius;
         for (const auto& file : o->materials) {

@@ -166,9 +166,11 @@ CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
     for (std::size_t i = 0; i < o.thetas.size(); ++i) {
         const double t = o.thetas[i];
         if (!(t > 0 && t < 90)) throw UserError("theta = " + g(t) + " deg must lie in (0, 90)");
-        // one folder per angle: a repeated angle would run twice into it
-        if (std::find(o.thetas.begin(), o.thetas.begin() + i, t) != o.thetas.begin() + i)
-            throw UserError("theta = " + g(t) + " deg is given twice");
+        // one folder per angle: a repeated angle, or two that its folder's name cannot tell apart, would run twice into it
+        for (std::size_t k = 0; k < i; ++k)
+            if (o.angle(o.thetas[k]) == o.angle(t))
+                throw UserError("theta = " + g(t) + " deg " + (o.thetas[k] == t ? "is given twice" : "shares its folder '" +
+                                o.angle(t) + "' with theta = " + g(o.thetas[k]) + " deg; give angles further apart"));
     }
     const double runs_per_angle = 1.0 + static_cast<double>(yade_runs(o.fill()).size());
     orchestrator::check_run_count(runs_per_angle * static_cast<double>(o.thetas.size()), o.max_runs,
@@ -190,7 +192,13 @@ CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
         if (!file.empty() && read_silo_material(file).cohesive())
             throw UserError(option + " = " + file + ": a cohesive material (surface_energy_J_m2 > 0): yade_scripts/silo.py "
                             "has no JKR cohesion to match the kernel's; cross-check cohesionless materials");
-    if (!o.geometry.empty()) analytics::read_json_input(o.geometry, "geometry");
+    if (!o.geometry.empty()) {
+        const json geometry = analytics::read_json_input(o.geometry, "geometry");
+        // yade_scripts/silo.py builds the conical silo only (its facet walls): a hopper would fail after the kernel's run
+        if (geometry.is_object() && geometry.contains("shape") && geometry["shape"] != "conical")
+            throw UserError("--geometry = '" + o.geometry + "': shape = " + geometry["shape"].dump() +
+                            ": yade_scripts/silo.py builds the conical silo only; cross-check a conical geometry");
+    }
     if (!o.yade_material.empty()) in.yade_material = analytics::read_json_input(o.yade_material, "yade-material");
     for (double theta : o.thetas) check_kernel_run(o, theta);
     return in;

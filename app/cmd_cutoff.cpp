@@ -97,6 +97,14 @@ kc::CutoffSearch search_from(const CutoffCli& o) {
     std::tie(search.lo, search.hi) = parse_bracket(o.bracket);
     search.tol = o.tol;
     search.seeds.assign(o.seeds.begin(), o.seeds.end());
+    // a seed twice is one bed counted twice in the majority (and one run folder for two runs)
+    for (std::size_t i = 0; i < o.seeds.size(); ++i)
+        if (std::find(o.seeds.begin(), o.seeds.begin() + i, o.seeds[i]) != o.seeds.begin() + i)
+            throw UserError("--seeds: seed " + std::to_string(o.seeds[i]) + " is given twice");
+    // without vibration every frequency is the same still bed: the search would bisect nothing
+    if (!(o.base.amplitude > 0))
+        throw UserError("--amplitude = " + analytics::number_text(o.base.amplitude) +
+                        " m: the cut-off search vibrates the bin; give an amplitude > 0");
     try {
         check_search_size(search, o.max_runs);
     } catch (const std::invalid_argument& e) {

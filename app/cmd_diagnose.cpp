@@ -59,6 +59,7 @@ std::string fixed(double v, int digits) {
 
 void run_predict(const std::string& geometry_path, const std::string& json_out) {
     check_output_file_in_new_folders(json_out, "--json");  // before anything is printed as a result
+    check_paths_apart({{geometry_path, "geometry"}}, {{json_out, "--json"}});
     analytics::SiloGeometry geometry;
     try {
         geometry = analytics::geometry_from_json(read_json_file(geometry_path, "predict"));
@@ -286,6 +287,11 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
                << (c.accepted ? "yes" : "") << " |\n";
         md << "\n";
     }
+    if (!r.undetermined.empty()) {
+        md << "## Not determined by these data\n\n";
+        for (const auto& w : r.undetermined) md << "- " << w << "\n";
+        md << "\n";
+    }
     if (!r.warnings.empty()) {
         md << "## Warnings\n\n";
         for (const auto& w : r.warnings) md << "- " << w << "\n";
@@ -301,6 +307,7 @@ struct DiagnoseArgs {
     analytics::DiagnoseOptions options;
     double effective_friction_deg = std::nan(""), wall_friction_deg = std::nan("");  // NaN: not given
     bool no_plots = false;
+    bool allow_undetermined = false;  // exit 0 even when the diagnosis is not determined by the data
     SiloDemArgs silo_dem;  // --model silo-dem: the kernel's silo as the model
 };
 
@@ -310,12 +317,15 @@ const char* const kSiloDemOptions[] = {"--material", "--campaign", "--jobs", "--
 // Options of the analytical search that silo-dem does not use (one effect from its table, no regimes or outliers yet):
 // refused rather than ignored.
 const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column", "--effective-friction-deg",
-                                              "--wall-friction-deg", "--outlier-alpha", "--drop-outliers"};
+                                              "--wall-friction-deg", "--outlier-alpha", "--drop-outliers",
+                                              "--allow-undetermined"};
 
-void run_diagnose(const DiagnoseArgs& a) {
+// 0, or 1 when the diagnosis is not determined by the data (and not --allow-undetermined): results are written.
+int run_diagnose(const DiagnoseArgs& a) {
     // outputs first (issue 23): a path that cannot be written is refused before any work
     check_output_file_in_new_folders(a.json_out, "--json");
     check_output_file_in_new_folders(a.report_out, "--report");
+    check_paths_apart({{a.data, "--data"}}, {{a.json_out, "--json"}, {a.report_out, "--report"}});
     analytics::MeasuredData data;
     analytics::DiagnoseResult r;
     try {
@@ -353,6 +363,7 @@ void run_diagnose(const DiagnoseArgs& a) {
                   << (r.outliers.dropped ? " (reported fits: without)" : " (reported fits: with; --drop-outliers)")
                   << "\n";
     for (const auto& w : r.warnings) std::cout << "warning: " << w << "\n";
+    for (const auto& w : r.undetermined) std::cout << "not determined: " << w << "\n";
     if (!a.json_out.empty()) write_text(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
         const std::filesystem::path report(a.report_out);
@@ -367,6 +378,9 @@ void run_diagnose(const DiagnoseArgs& a) {
         }
         write_text(a.report_out, markdown_report(r, a.data, before_name, after_name));
     }
+    if (r.undetermined.empty() || a.allow_undetermined) return 0;
+    std::cout << "the diagnosis is not determined by these data (exit 1; --allow-undetermined: exit 0)\n";
+    return 1;
 }
 
 }  // namespace
@@ -392,6 +406,8 @@ void add_discharge_commands(CLI::App& app) {
     diagnose->add_option("--report", args->report_out,
                          "write a Markdown report here, with residual plots (PNG) beside it");
     diagnose->add_flag("--no-plots", args->no_plots, "report without the gnuplot residual plots");
+    diagnose->add_flag("--allow-undetermined", args->allow_undetermined,
+                       "exit 0 even when the fit did not converge or the data cannot determine it (default: exit 1)");
     diagnose->add_option("--alpha", args->options.family_alpha,
                          "family-wise error rate of each round's candidate tests (Holm)")
         ->capture_default_str()
@@ -477,7 +493,7 @@ void add_discharge_commands(CLI::App& app) {
         if (!args->silo_dem.silo_args.empty())
             throw UserError("options after -- ('" + args->silo_dem.silo_args.front() +
                             "'): only --model silo-dem runs demcal silo");
-        run_diagnose(*args);
+        if (const int status = run_diagnose(*args); status != 0) throw CLI::RuntimeError(status);
     });
 }
 

@@ -64,14 +64,16 @@ void check_scale(const nlohmann::json& base, const ScaleCli& o, const calibratio
             throw UserError("output = '" + o.output + "': must end in .json");
         check_output_file(o.output, "output");
     }
+    check_paths_apart({{o.base_file, "base material"}}, {{output_of(o).string(), "output"}});
     calibration::check_enlargement(base, options);
     const auto& c = o.campaign;
+    // the design and every radius's material first: their messages name the cause, the run count only the total
+    for (double r : o.radii) check_campaign(c, calibration::material_at_radius(base, r));
     const double lines = calibration::planned_failure_lines(options);
     orchestrator::check_run_count(lines * c.normal_stresses.size() * c.replicates, c.exec.max_runs,
                                   "scale: at most " + analytics::number_text(lines, 10) + " failure lines x " +
                                       std::to_string(c.normal_stresses.size()) + " normal stresses x " +
                                       std::to_string(c.replicates) + " replicates");
-    for (double r : o.radii) check_campaign(c, calibration::material_at_radius(base, r));
 }
 
 // The JSON, the Markdown table beside it and the three plots (a missing gnuplot costs only the pictures).

@@ -87,6 +87,8 @@ struct SiloCli {
 constexpr int kExitSuspended = 75;
 
 constexpr const char* kCheckpointName = "checkpoint.bin";
+// Every file a run writes into its --out folder (write_outputs, the checkpoint): an exported bed must not take one.
+constexpr const char* kRunFiles[] = {kCheckpointName, "summary.json", "discharge.csv", "section.png", "discharge.png"};
 
 // SIGTERM (a batch system's time limit or scancel, kill) and SIGINT (Ctrl-C) during a checkpointed run: the run ends
 // its record interval, writes its checkpoint and exits 75, as at --wall-limit. The handler only records the signal
@@ -518,11 +520,19 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
+    if (o.no_checkpoint && sub.count("--checkpoint-every"))
+        throw UserError("--checkpoint-every " + ks::setting_text(o.checkpoint_every) +
+                        ": --no-checkpoint turns the checkpoint off; give one of the two");
     // every output place before the run (a run of hours into an unwritable folder failed at its end, and told the
     // user to resume from a checkpoint it could never write): the output folder (results, plots, checkpoint), the
     // VTK folder and the exported bed
     check_output_folder(dir.string(), "--out");
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk");
+    std::vector<NamedPath> outputs{{dir.string(), "--out"}};
+    for (const char* name : kRunFiles) outputs.push_back({(dir / name).string(), std::string("--out's ") + name});
+    outputs.insert(outputs.end(), {{o.export_bed, "--export-bed"}, {o.export_final_bed, "--export-final-bed"},
+                                   {o.export_cloud, "--export-cloud"}});
+    check_paths_apart({{o.material_file, "--material"}, {o.geometry_file, "--geometry"}}, outputs);
     if (!o.export_bed.empty()) {
         check_output_file(o.export_bed, "--export-bed");
         s.at_opening = [file = o.export_bed, settings = s](const ks::BedSnapshot& bed) {
@@ -788,7 +798,7 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--c", o.c, "rectangular: silo width c [m]")->capture_default_str();
     sub->add_option("--particles", o.particles, "number of grains")->capture_default_str();
     sub->add_option("--fill-mass", o.fill_mass, "mass of grain [kg] (instead of --particles)");
-    sub->add_option("--threads", o.threads, "OpenMP threads (default: every core)");
+    sub->add_option("--threads", o.threads, "OpenMP threads (default: every core)")->check(integer_in(1, 256));
     sub->add_option("--seed", o.seed, "random seed of the generation")->capture_default_str();
     sub->add_option("--out", o.out, "output directory (default silo_theta<DEG>)");
     sub->add_option("--vtk", o.vtk, "write VTK snapshots of the spheres into this directory");

@@ -4,6 +4,7 @@
 // same command again continues the campaign: finished runs are read, suspended ones resumed (--resume), the rest run.
 // The report: per angle and frequency the discharge rate's mean, standard deviation and count, and the flow pattern;
 // DIR/vibration.json, DIR/vibration.md and DIR/vibration.png (rate against frequency, one line per angle).
+#include "analytics/number_text.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
@@ -95,6 +96,20 @@ void check_options(const VibrationCli& o) {
         throw UserError(e.what());
     }
     check_output_folder(o.campaign, "--campaign");
+    // each cell runs in a folder of its name, and each angle's curve goes to a file of its name: two cells that these
+    // names cannot tell apart (an angle or frequency given twice, or closer than the names' 6 digits) would share them
+    std::map<std::string, RunSpec> cells;
+    for (double theta : o.thetas)
+        for (double f : o.frequencies) {
+            const RunSpec cell{theta, f, o.first_seed};
+            const auto [at, fresh] = cells.emplace(cell.name(), cell);
+            if (!fresh)
+                throw UserError("--theta " + analytics::number_text(theta, 10) + " --frequency " +
+                                analytics::number_text(f, 10) + ": the same run folder '" + cell.name() +
+                                "' as --theta " + analytics::number_text(at->second.theta, 10) + " --frequency " +
+                                analytics::number_text(at->second.frequency, 10) +
+                                " (a value given twice, or two closer than 6 digits)");
+        }
     bool vibrating = false;
     for (double f : o.frequencies) vibrating = vibrating || f > 0;
     if (vibrating && !(o.amplitude > 0)) throw UserError("--amplitude: a frequency above 0 needs an amplitude > 0 m");
@@ -187,7 +202,9 @@ void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<doubl
          << o.part << "'\nplot ";
     bool first = true;
     for (const auto& [theta, data] : data_by_theta) {
-        const fs::path file = dir / ("vibration_theta" + std::to_string(int(std::lround(theta))) + ".dat");
+        std::ostringstream name;  // the runs' own spelling of the angle (RunSpec::name): distinct for distinct cells
+        name << "vibration_theta" << theta << ".dat";
+        const fs::path file = dir / name.str();
         std::ofstream(file) << data;
         body << (first ? "" : ", ") << gnuplot_quote(file) << " using 1:2:3 with yerrorlines title 'theta = "
              << theta << " deg'";

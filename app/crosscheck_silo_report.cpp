@@ -199,7 +199,8 @@ struct KernelSide {
 KernelSide read_kernel_side(const fs::path& kernel_dir) {
     KernelSide k;
     k.summary = analytics::read_json_input(kernel_dir / "summary.json", "kernel summary");
-    k.rate = k.summary.at("rate").at("rate_kg_s").get<double>();
+    // (no rate where the run could not determine one: nothing discharged, no steady window)
+    k.rate = k.summary.at("rate").value("rate_kg_s", std::numeric_limits<double>::quiet_NaN());
     k.filled = k.summary.at("filled_mass_kg").get<double>();
     k.cpu = k.summary.at("cpu_s").get<double>();
     const json& discharge_cpu = k.summary.at("discharge").value("cpu_s", json(nullptr));  // (summaries before it: none)
@@ -219,7 +220,7 @@ YadeSide read_yade_side(const fs::path& angle_dir, const YadeRunKind& kind) {
     YadeSide y;
     y.result = analytics::read_json_input(angle_dir / kind.folder / "result.json",
                                           kind.fills ? "yade own-fill result" : "yade result");
-    y.rate = y.result.at("rate").at("rate_kg_s").get<double>();
+    y.rate = y.result.at("rate").value("rate_kg_s", std::numeric_limits<double>::quiet_NaN());
     y.cpu = y.result.at("cpu_time_s").get<double>();
     y.curve = yade_curve(y.result);
     y.pattern = yade_flow_pattern(angle_dir / kind.folder,

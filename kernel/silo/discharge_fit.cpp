@@ -10,6 +10,10 @@ DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, dou
     f.lower_fraction = lower_fraction;
     f.upper_fraction = upper_fraction;
     f.reference_mass = reference_mass;
+    if (!(reference_mass > 0)) {  // a window of zero mass holds every sample and fits a rate of 0 with R^2 = 1
+        f.message = "nothing was discharged";
+        return f;
+    }
     const double lo = lower_fraction * reference_mass, hi = upper_fraction * reference_mass;
     double st = 0, sm = 0;
     int n = 0;
@@ -39,6 +43,11 @@ DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, dou
         f.message = "the samples of the steady part all have the same time";
         return f;
     }
+    if (!(smm > 0)) {
+        f.message = "the discharged mass does not change between " + std::to_string(lower_fraction * 100) + " % and " +
+                    std::to_string(upper_fraction * 100) + " % of the reference mass";
+        return f;
+    }
     f.rate = stm / stt;
     f.intercept = mm - f.rate * tm;
     double sse = 0;
@@ -47,7 +56,7 @@ DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, dou
             const double e = s.mass - (f.intercept + f.rate * s.time);
             sse += e * e;
         }
-    f.r_squared = smm > 0 ? 1 - sse / smm : 1.0;
+    f.r_squared = 1 - sse / smm;
     f.rate_se = std::sqrt(sse / (n - 2) / stt);
     f.ok = std::isfinite(f.rate);
     // batch slopes over four equal time spans of the window (each needs 3 samples)

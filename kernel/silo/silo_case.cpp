@@ -360,6 +360,29 @@ void validate(const SiloCaseSettings& s) {
         reject_setting("wall_limit", s.wall_limit, "needs a checkpoint file: a run stopped at the limit resumes from it");
     if (!(s.steady_lower >= 0 && s.steady_lower < s.steady_upper && s.steady_upper <= 1))
         reject_setting("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
+    // Last (the checks above name a more specific cause first): contacts so soft that two grains meeting at the speed
+    // of a fall through the whole silo would overlap by more than the smallest sphere's radius pass through each other
+    // (a stiffness_scale of 1e-12 gave a 2 s time step and every grain fell through the walls). Hertz's impact
+    // overlap, two grains head on: delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5), m* = m/2, R* = r/2, E* = E/(2(1-nu^2)).
+    // The reduced cases' 1e-3 gives 0.6 r; 1e-4 would give 1.6 r.
+    double smallest_radius = 1;
+    for (const auto& sphere : elongated_wheat_clump(s.materials.grain_aspect_ratio))
+        smallest_radius = std::min(smallest_radius, sphere.radius);
+    const Material grain = s.materials.wheat_scaled();
+    const double young = 2 * grain.shear_modulus * (1 + grain.poisson);
+    const double e_star = young / (2 * (1 - grain.poisson * grain.poisson));
+    const double speed = std::sqrt(2 * 9.81 * s.geometry.top()) +
+                         (s.vibration.vibrates() ? 2 * M_PI * s.vibration.frequency * s.vibration.amplitude : 0.0);
+    const double impact_overlap =
+        std::pow(15 * 0.5 * grain_mass * speed * speed / (16 * e_star * std::sqrt(0.5 * smallest_radius)), 0.4);
+    if (!(impact_overlap <= smallest_radius))
+        reject_setting("stiffness_scale", s.materials.stiffness_scale,
+                       "makes the grains so soft that two meeting at " + setting_text(speed) +
+                           " m/s (a fall through the silo) would overlap by " + setting_text(impact_overlap / smallest_radius) +
+                           " sphere radii: they would pass through each other; at least " +
+                           setting_text(s.materials.stiffness_scale *
+                                        std::pow(impact_overlap / smallest_radius, 2.5)) +
+                           " for this material and silo");
 }
 
 namespace {
@@ -1056,6 +1079,10 @@ SiloCaseResult resume_silo_case(const std::string& file, const SiloSession& sess
         } catch (const std::runtime_error& e) {  // a damaged or foreign file is bad input, wherever the damage lies
             throw std::invalid_argument(e.what());
         }
+        // the checksums cover what was read: bytes after the end are a file appended to or pasted together
+        if (is.peek() != std::char_traits<char>::eof())
+            throw std::invalid_argument("checkpoint '" + file + "': bytes after its end (the file was appended to or "
+                                        "damaged); refused");
     });
 }
 

@@ -87,7 +87,7 @@ TEST_CASE("diagnose rejects data that do not suit the model", "[diagnose]") {
     CHECK_THROWS_WITH(diagnose(rect, "failure-line"), Catch::Contains("missing column sigma_Pa"));
 }
 
-TEST_CASE("diagnose of degenerate data - identical rows get no effect and a warning - one normal stress is refused",
+TEST_CASE("diagnose of degenerate data - identical rows get no effect and are not determined - one normal stress is refused",
           "[diagnose]") {
     // every row a copy of the first (a file pasted 36 times): nothing varies, nothing scatters
     auto same = make_synthetic_set(spec("oldal", "moisture", 0.2, 7));
@@ -97,9 +97,10 @@ TEST_CASE("diagnose of degenerate data - identical rows get no effect and a warn
     }
     const auto r = diagnose(same, "oldal");
     CHECK(r.effects.empty());
-    bool warned = false;
-    for (const auto& w : r.warnings) warned = warned || w.find("no scatter to test an effect against") != std::string::npos;
-    CHECK(warned);
+    bool said = false;
+    for (const auto& w : r.undetermined) said = said || w.find("no scatter to test an effect against") != std::string::npos;
+    CHECK(said);
+    CHECK(r.to_json().at("determined") == false);
     // a failure line with every stress equal has no slope to fit
     auto shear = make_synthetic_set(spec("failure-line", "none", 0, 3));
     auto& sigma = const_cast<demcal::analytics::DataColumn&>(shear.at("sigma_Pa"));

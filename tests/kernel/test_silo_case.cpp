@@ -212,6 +212,13 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
     CHECK(suspended.steps < whole.steps);
     CHECK_THAT(suspended.stop_reason, Catch::Matchers::Contains("wall limit"));
     CHECK(std::filesystem::exists(s.checkpoint_file));
+    {  // the same checkpoint with bytes appended (not covered by its checksums) is refused before any step
+        const auto appended = dir / "appended.bin";
+        std::filesystem::copy_file(s.checkpoint_file, appended);
+        std::ofstream(appended, std::ios::app | std::ios::binary) << "garbage";
+        CHECK_THROWS_WITH(resume_silo_case(appended.string(), {.threads = 1}),
+                          Catch::Matchers::Contains("appended.bin") && Catch::Matchers::Contains("bytes after its end"));
+    }
     // fourth session: to the end
     const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0});
     CHECK_FALSE(resumed.suspended);

@@ -112,6 +112,16 @@ TEST_CASE("discharge rate: least squares over the steady part", "[silo]") {
     CHECK(f.rate_batch_se > 0);
     CHECK(f.rate_batch_se < 0.01);
     CHECK(fit_discharge_rate({{0, 0}, {1, 1}}, 1).ok == false);
+    // nothing discharged: the window of a zero mass held every sample and fitted 0 g/s with R^2 = 1, "determined"
+    std::vector<DischargeSample> none;
+    for (int k = 0; k < 20; ++k) none.push_back({0.01 * k, 0.0});
+    const auto empty = fit_discharge_rate(none, 0.0);
+    CHECK_FALSE(empty.ok);
+    CHECK(empty.message == "nothing was discharged");
+    // a mass that does not change inside the window (all samples on one plateau) determines no rate either
+    std::vector<DischargeSample> plateau;
+    for (int k = 0; k < 20; ++k) plateau.push_back({0.01 * k, 0.05});
+    CHECK_FALSE(fit_discharge_rate(plateau, 0.1).ok);
 }
 
 TEST_CASE("flow pattern: synthetic mass, funnel and mixed velocity fields", "[silo]") {

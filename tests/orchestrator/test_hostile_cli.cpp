@@ -295,3 +295,89 @@ TEST_CASE("a shear result's seal: both writers follow one rule, and a flipped by
     }
     fs::remove_all(dir);
 }
+
+TEST_CASE("an output on an input's path or on another output's is refused before any work, nothing overwritten",
+          "[cli]") {
+    // predict --json GEOMETRY, enlarge -o MATERIAL, diagnose --report DATA overwrote their inputs with exit 0; a silo's
+    // --export-final-bed OUT ran the whole run and then failed, --export-final-bed OUT/summary.json lost the summary
+    const fs::path root = test::fresh_test_dir("hostile-paths"), dir = root / "work";
+    fs::create_directories(dir);
+    const auto copy = [&](const std::string& from, const std::string& name) {
+        fs::copy_file(test::source_path(from), dir / name);
+        return (dir / name).string();
+    };
+    const std::string geometry = copy("examples/diagnose/silo_105mm_wheat.json", "geometry.json");
+    const std::string data = copy("examples/diagnose/oldal_clean.csv", "data.csv");
+    const std::string m1 = copy("examples/materials/sand-tiny.json", "m1.json");
+    const std::string m2 = copy("examples/materials/sand.json", "m2.json");
+    const std::string out = (dir / "o").string(), same = (dir / "same.json").string();
+    const std::vector<std::string> silo{"silo", "--theta", "30", "--particles", "50", "--out", out, "--check"};
+    const auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> a = silo;
+        a.insert(a.end(), extra.begin(), extra.end());
+        return a;
+    };
+    refused({{{"predict", geometry, "--json", geometry}, {"--json", "is the input geometry", "would be overwritten"}},
+             {{"diagnose", "--model", "oldal", "--data", data, "--report", data}, {"--report", "is the input --data"}},
+             {{"diagnose", "--model", "oldal", "--data", data, "--json", same, "--report", same},
+              {"--report", "is also --json", "one output would overwrite the other"}},
+             {{"enlarge", "--no-plot", "-o", m1, m1, m2}, {"output", "is the input material"}},
+             {with({"--export-final-bed", out}), {"--export-final-bed", "is also --out"}},
+             {with({"--export-bed", same, "--export-final-bed", same}), {"--export-final-bed", "is also --export-bed"}},
+             {with({"--export-final-bed", out + "/summary.json"}), {"--export-final-bed", "--out's summary.json"}}},
+            dir);
+    CHECK(test::read_file(geometry) == test::read_file(test::source_path("examples/diagnose/silo_105mm_wheat.json")));
+    fs::remove_all(root);
+}
+
+TEST_CASE("repeats that share a run folder, a search without vibration and nonsense settings are refused", "[cli]") {
+    // vibration --theta 30,30.0000001 ran both cells into one folder; cutoff --seeds 1,1 counted one bed twice in its
+    // vote; --amplitude 0 bisected a still bed; a stiffness scale of 1e-12 let every grain fall through the walls
+    const fs::path root = test::fresh_test_dir("hostile-repeats"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string camp = (dir / "camp").string(), out = (dir / "o").string();
+    fs::copy_file(test::source_path("examples/diagnose/silo_105mm_wheat.json"), dir / "geometry.json");
+    nlohmann::json wide = nlohmann::json::parse(test::read_file(dir / "geometry.json"));
+    wide["beverloo_k"] = 100;  // k d_p wider than the outlet
+    std::ofstream(dir / "wide_k.json") << wide.dump();
+    refused({{{"vibration", "--theta", "30,30.0000001", "--frequency", "0", "--campaign", camp},
+              {"--theta 30.0000001", "the same run folder"}},
+             {{"crosscheck", "silo", "--theta", "30,30.0000001", "--campaign", camp}, {"shares its folder"}},
+             {{"crosscheck", "silo", "--theta", "30", "--campaign", camp, "--geometry",
+               test::source_path("examples/silo/rect_hopper_60deg.json").string()},
+              {"--geometry", "\"rectangular\"", "conical silo only"}},
+             {{"cutoff", "--bond-number", "10", "--seeds", "1,1"}, {"--seeds: seed 1 is given twice"}},
+             {{"cutoff", "--bond-number", "10", "--amplitude", "0"}, {"--amplitude = 0 m"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--stiffness-scale", "1e-12"},
+              {"stiffness_scale", "1e-12", "pass through each other"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--no-checkpoint", "--checkpoint-every", "5"},
+              {"--checkpoint-every 5", "--no-checkpoint"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--threads", "2147483647"}, {"--threads"}},
+             {{"predict", (dir / "wide_k.json").string()}, {"beverloo_k=100", "effective outlet would be empty"}}},
+            dir);
+    CHECK_FALSE(fs::exists(camp));
+    fs::remove_all(root);
+}
+
+TEST_CASE("diagnose: a fit the data cannot determine is reported as such and ends with exit 1", "[cli]") {
+    // five copies of one measurement were "fitted to rounding" and reported with exit 0
+    const fs::path root = test::fresh_test_dir("hostile-diagnose-undetermined"), dir = root / "work";
+    fs::create_directories(dir);
+    {
+        std::ofstream csv(dir / "same.csv");
+        csv << "geometry,D_m,outlet_m,theta_deg,d_p_m,rho_b_kg_m3,W_kg_s\n";
+        for (int i = 0; i < 5; ++i) csv << "conical,0.105,0.035,30,0.004,780,0.2\n";
+    }
+    const std::vector<std::string> args{"diagnose", "--model", "beverloo", "--data", (dir / "same.csv").string(),
+                                        "--json", (dir / "r.json").string(), "--no-plots"};
+    const int rc = test::run_demcal(args, root / "log");
+    INFO(test::read_file(root / "log"));
+    CHECK(rc == 1);
+    CHECK_THAT(test::read_file(root / "log"), Contains("not determined: the beverloo model fits every row to rounding"));
+    const auto j = nlohmann::json::parse(test::read_file(dir / "r.json"));  // the results are still written
+    CHECK(j.at("determined") == false);
+    std::vector<std::string> allowed = args;
+    allowed.push_back("--allow-undetermined");
+    CHECK(test::run_demcal(allowed, root / "log") == 0);
+    fs::remove_all(root);
+}
