@@ -215,8 +215,8 @@ std::int64_t ensure_campaign(orchestrator::CampaignStore& store, const SiloCross
                        {"yade_material", o.yade_material},
                        {"fill", o.fill_text}};
     return store
-        .ensure_campaign("crosscheck-silo-" + orchestrator::sha256_hex(spec.dump()).substr(0, 12), "crosscheck_silo",
-                         spec)
+        .ensure_campaign("crosscheck-silo-" + orchestrator::sha256_hex(spec.dump()).substr(0, 12),
+                         orchestrator::CampaignKind::crosscheck_silo, spec)
         .id;
 }
 

@@ -225,11 +225,11 @@ void add_shear_commands(CLI::App& app) {
                 ++by_state[to_string(r.state)];
                 wall += r.wall_s;
             }
-            std::cout << o.campaign.name << " [" << o.campaign.status << "] " << o.campaign.kind << ": "
+            std::cout << o.campaign.name << " [" << o.campaign.status << "] " << to_string(o.campaign.kind) << ": "
                       << o.runs.size() << " runs";
             for (const auto& [s, n] : by_state) std::cout << ", " << n << " " << s;
             std::cout << "; run time " << duration_text(wall) << ", CPU " << duration_text(o.cpu_s) << "\n";
-            const bool shear = o.campaign.kind == "shear";
+            const bool shear = o.campaign.kind == CampaignKind::shear;
             for (const auto& r : o.runs)
                 if (r.state == RunState::failed)
                     std::cout << "  failed: "

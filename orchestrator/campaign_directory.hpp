@@ -17,7 +17,8 @@ using FinishedResult = std::function<std::optional<nlohmann::json>(const RunReco
 
 class CampaignDirectory {
 public:
-    // Creates the folder if needed (std::invalid_argument naming it when it cannot be made), takes its lock
+    // Checks a store already there, reading only (std::invalid_argument for one this demcal refuses, with nothing
+    // written), creates the folder if needed (std::invalid_argument naming it when it cannot be made), takes its lock
     // (std::runtime_error when another demcal holds it), opens the store and recovers stale runs: a run marked running
     // belongs to a demcal that died (we hold the lock); its process group or SLURM task is stopped, and it is done if
     // `finished` finds its result, else back to pending.

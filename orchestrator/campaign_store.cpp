@@ -5,8 +5,13 @@
 
 #include <sqlite3.h>
 
+#include <cctype>
+#include <charconv>
 #include <chrono>
+#include <cstdio>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 namespace demcal::orchestrator {
 
@@ -30,6 +35,26 @@ RunState run_state_from_string(const std::string& s) {
     if (s == "done") return RunState::done;
     if (s == "failed") return RunState::failed;
     throw std::invalid_argument("store: unknown run state '" + analytics::shortened_text(s) + "' (a damaged store)");
+}
+
+namespace {
+constexpr std::pair<CampaignKind, const char*> kCampaignKindNames[] = {
+    {CampaignKind::shear, "shear"}, {CampaignKind::crosscheck_silo, "crosscheck_silo"}};
+}  // namespace
+
+std::string to_string(CampaignKind k) {
+    for (const auto& [kind, name] : kCampaignKindNames)
+        if (kind == k) return name;
+    return "?";
+}
+
+CampaignKind campaign_kind_from_string(const std::string& s) {
+    std::string known;
+    for (const auto& [kind, name] : kCampaignKindNames) {
+        if (s == name) return kind;
+        known += (known.empty() ? "" : ", ") + std::string(name);
+    }
+    throw std::invalid_argument("kind '" + analytics::shortened_text(s) + "' is not one demcal knows (" + known + ")");
 }
 
 namespace {
@@ -107,7 +132,7 @@ const char* kRunColumnsQuery = "SELECT " DEMCAL_RUN_COLUMNS " FROM runs r";
 
 // A JSON column as the store holds it, read under the same rules as every JSON input (a damaged store is bad input).
 nlohmann::json stored_json(const Statement& st, int column, const char* name) {
-    return analytics::parse_json_text(st.text(column), std::string("campaign store column ") + name);
+    return analytics::parse_json_text(st.text(column), name);
 }
 
 // Run folders are stored relative to the store's directory, so a campaign moved or copied (cluster to laptop) finds
@@ -144,11 +169,24 @@ RunRecord read_run(const Statement& st, bool with_label, const std::filesystem::
     return r;
 }
 
+#define DEMCAL_CAMPAIGN_QUERY "SELECT id, name, kind, spec, status, created_at FROM campaigns"
+CampaignRecord read_campaign(const Statement& st) {
+    CampaignRecord c;
+    c.id = st.integer(0);
+    c.name = st.text(1);
+    c.kind = campaign_kind_from_string(st.text(2));
+    c.spec = stored_json(st, 3, "campaigns.spec");
+    c.status = st.text(4);
+    c.created_at = st.real(5);
+    return c;
+}
+
 }  // namespace
 
 namespace {
 
 constexpr int kDemcalApplicationId = 0x64656d63;  // "demc" in the SQLite header: marks a file as a demcal store
+constexpr int kSchemaVersion = 1;                 // meta.schema_version of the stores this demcal writes
 
 // Refuses, reading only, a file that is not an intact demcal store: nothing may be written into a file that is not
 // ours (status and resume wrote demcal's tables into any SQLite file), and a damaged store must not be resumed as if
@@ -174,7 +212,7 @@ void check_existing_store(sqlite3* db, const std::string& name) {
                                     std::to_string(application_id) + ", " + (has_demcal_tables ? "" : "no ") +
                                     "demcal tables); nothing was written to it");
     // every column demcal reads is there (quick_check passes a schema whose text was damaged)
-    for (const char* columns : {"SELECT key, value FROM meta", "SELECT id, name, kind, spec, status, created_at FROM campaigns",
+    for (const char* columns : {"SELECT key, value FROM meta", DEMCAL_CAMPAIGN_QUERY,
                                 kRunColumnsQuery, "SELECT campaign_id, hash, label, position FROM campaign_runs",
                                 "SELECT id, hash, attempt, executor, started_at, finished_at, exit_code, cause, message, "
                                 "wall_s, cpu_s FROM attempts"}) {
@@ -195,22 +233,77 @@ void check_existing_store(sqlite3* db, const std::string& name) {
     if (verdict != "ok")
         throw std::invalid_argument(store + " is damaged (SQLite quick_check: " + analytics::shortened_text(verdict, 200) +
                                     "); restore it from a copy, or move it away to start the campaign afresh");
+    // a newer demcal's store may hold what this one cannot read or would write wrongly: refused, not migrated
+    Statement version(db, "SELECT value FROM meta WHERE key = 'schema_version'");
+    if (version.step()) {
+        const std::string v = version.text(0);
+        int n = 0;
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
+        if (ec != std::errc() || end != v.data() + v.size() || n < 1)
+            throw std::invalid_argument(store + ": schema_version '" + analytics::shortened_text(v) +
+                                        "' is not a version demcal writes; nothing was written to it");
+        if (n > kSchemaVersion)
+            throw std::invalid_argument(store + ": schema_version " + v + " is newer than this demcal's (" +
+                                        std::to_string(kSchemaVersion) + "); nothing was written to it");
+    }
+    // every row a command may read, read now: refused later, a resume would have taken the lock and written already
+    auto readable = [&](const std::string& what, const std::string& sql, auto&& read) {
+        Statement rows(db, sql);
+        while (rows.step()) {
+            try {
+                read(rows);
+            } catch (const std::invalid_argument& e) {
+                throw std::invalid_argument(store + ": " + what + " " + analytics::shortened_text(rows.text(0), 80) +
+                                            ": " + e.what() + "; nothing was written to it");
+            }
+        }
+    };
+    readable("campaign", DEMCAL_CAMPAIGN_QUERY, [](const Statement& st) { read_campaign(st); });
+    readable("run", kRunColumnsQuery, [](const Statement& st) { read_run(st, false, {}); });
+    readable("a run of campaign", "SELECT campaign_id, label FROM campaign_runs",
+             [](const Statement& st) { stored_json(st, 1, "campaign_runs.label"); });
+}
+
+// The store as a SQLite URI for a read-only open. A read-only connection to a WAL store leaves a -wal and a -shm
+// beside it; without a -wal (or a rollback journal) nobody has the store open, and `immutable` reads it creating
+// neither. A writer that opens it meanwhile appends to its own -wal and changes the file only when it checkpoints.
+std::string read_only_uri(const std::filesystem::path& db_path) {
+    const std::string path = std::filesystem::absolute(db_path).lexically_normal().string();
+    std::string uri = "file://";
+    for (const unsigned char c : path) {
+        if (std::isalnum(c) || std::string_view("/._-~").find(static_cast<char>(c)) != std::string_view::npos) {
+            uri += static_cast<char>(c);
+        } else {
+            char escaped[4];
+            std::snprintf(escaped, sizeof escaped, "%%%02X", c);
+            uri += escaped;
+        }
+    }
+    std::error_code ec;
+    const bool may_be_open =
+        std::filesystem::exists(path + "-wal", ec) || std::filesystem::exists(path + "-journal", ec);
+    return may_be_open ? uri : uri + "?immutable=1";
 }
 
 }  // namespace
 
-CampaignStore::CampaignStore(const std::filesystem::path& db_path)
+CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess access)
     : path_(db_path), base_dir_(std::filesystem::absolute(db_path).lexically_normal().parent_path()) {
     std::error_code ec;
     const auto status = std::filesystem::status(db_path, ec);
     const bool existed = std::filesystem::exists(status);
+    const bool read_only = access == StoreAccess::read_only;
+    if (read_only && !existed)
+        throw std::invalid_argument("campaign store '" + db_path.string() + "' does not exist");
     if (existed && !std::filesystem::is_regular_file(status))
         throw std::invalid_argument("campaign store '" + db_path.string() + "' is not a regular file");
     if (existed && std::filesystem::file_size(db_path, ec) == 0)
         throw std::invalid_argument("campaign store '" + db_path.string() +
                                     "' is empty (0 bytes), not a demcal campaign store; nothing was written to it");
-    const int flags = SQLITE_OPEN_READWRITE | (existed ? 0 : SQLITE_OPEN_CREATE);
-    if (sqlite3_open_v2(db_path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
+    const std::string name = read_only ? read_only_uri(db_path) : db_path.string();
+    const int flags = read_only ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI
+                                : SQLITE_OPEN_READWRITE | (existed ? 0 : SQLITE_OPEN_CREATE);
+    if (sqlite3_open_v2(name.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
         std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
         sqlite3_close(db_);
         throw std::runtime_error("store: cannot open " + db_path.string() + ": " + m);
@@ -224,13 +317,14 @@ CampaignStore::CampaignStore(const std::filesystem::path& db_path)
             throw;
         }
     }
+    if (read_only) return;
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=FULL");
     exec("PRAGMA foreign_keys=ON");
     exec("PRAGMA application_id=" + std::to_string(kDemcalApplicationId));
     exec(R"sql(
 CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);
-INSERT OR IGNORE INTO meta VALUES('schema_version', '1');
+INSERT OR IGNORE INTO meta VALUES('schema_version', ')sql" + std::to_string(kSchemaVersion) + R"sql(');
 CREATE TABLE IF NOT EXISTS campaigns(
   id INTEGER PRIMARY KEY, name TEXT UNIQUE NOT NULL, kind TEXT NOT NULL, spec TEXT NOT NULL,
   status TEXT NOT NULL DEFAULT 'open', created_at REAL NOT NULL);
@@ -264,38 +358,24 @@ void CampaignStore::exec(const std::string& sql) {
     }
 }
 
-CampaignRecord CampaignStore::ensure_campaign(const std::string& name, const std::string& kind,
-                                              const nlohmann::json& spec) {
+CampaignRecord CampaignStore::ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec) {
     if (auto c = find_campaign(name)) return *c;
     in_transaction(db_, [&] {
         Statement(db_, "INSERT INTO campaigns(name, kind, spec, created_at) VALUES(?,?,?,?)")
-            .bind(1, name).bind(2, kind).bind(3, spec.dump()).bind(4, now_seconds()).step();
+            .bind(1, name).bind(2, to_string(kind)).bind(3, spec.dump()).bind(4, now_seconds()).step();
     });
     return *find_campaign(name);
 }
 
-namespace {
-CampaignRecord read_campaign(const Statement& st) {
-    CampaignRecord c;
-    c.id = st.integer(0);
-    c.name = st.text(1);
-    c.kind = st.text(2);
-    c.spec = stored_json(st, 3, "campaigns.spec");
-    c.status = st.text(4);
-    c.created_at = st.real(5);
-    return c;
-}
-}  // namespace
-
 std::optional<CampaignRecord> CampaignStore::find_campaign(const std::string& name) {
-    Statement st(db_, "SELECT id, name, kind, spec, status, created_at FROM campaigns WHERE name = ?");
+    Statement st(db_, DEMCAL_CAMPAIGN_QUERY " WHERE name = ?");
     st.bind(1, name);
     if (st.step()) return read_campaign(st);
     return std::nullopt;
 }
 
 std::vector<CampaignRecord> CampaignStore::campaigns() {
-    Statement st(db_, "SELECT id, name, kind, spec, status, created_at FROM campaigns ORDER BY id");
+    Statement st(db_, DEMCAL_CAMPAIGN_QUERY " ORDER BY id");
     std::vector<CampaignRecord> out;
     while (st.step()) out.push_back(read_campaign(st));
     return out;

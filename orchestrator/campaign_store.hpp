@@ -19,6 +19,12 @@ enum class RunState { pending, running, done, failed };
 std::string to_string(RunState s);
 RunState run_state_from_string(const std::string& s);
 
+// What a campaign is; a store holding a kind this demcal does not know is refused (a newer demcal's store).
+enum class CampaignKind { shear, crosscheck_silo };
+std::string to_string(CampaignKind k);
+// Throws std::invalid_argument naming the value and the kinds known.
+CampaignKind campaign_kind_from_string(const std::string& s);
+
 struct RunRecord {
     std::string hash;
     nlohmann::json params;
@@ -35,23 +41,30 @@ struct RunRecord {
 
 struct CampaignRecord {
     std::int64_t id = 0;
-    std::string name, kind, status;
+    std::string name;
+    CampaignKind kind = CampaignKind::shear;
+    std::string status;
     nlohmann::json spec;
     double created_at = 0;
 };
 
+// read_only: the file must exist, and nothing is written to it or beside it (status; the check before a campaign
+// directory is locked). The write methods then fail.
+enum class StoreAccess { read_write, read_only };
+
 class CampaignStore {
 public:
-    // Opens the store, creating it when the file does not exist. An existing file must be an intact demcal store
-    // (application_id, or the tables of a store written before it was set; PRAGMA quick_check): anything else is
-    // refused with std::invalid_argument naming the file, before anything is written to it.
-    explicit CampaignStore(const std::filesystem::path& db_path);
+    // Opens the store, creating it when the file does not exist (read_write). An existing file must be an intact
+    // demcal store this demcal can read (application_id, or the tables of a store written before it was set; PRAGMA
+    // quick_check; a schema_version not newer than its own; every campaign and run row readable, its kind known):
+    // anything else is refused with std::invalid_argument naming the file, before anything is written to it.
+    explicit CampaignStore(const std::filesystem::path& db_path, StoreAccess access = StoreAccess::read_write);
     ~CampaignStore();
     CampaignStore(const CampaignStore&) = delete;
     CampaignStore& operator=(const CampaignStore&) = delete;
 
     // Returns the campaign of that name, creating it with `spec` if new.
-    CampaignRecord ensure_campaign(const std::string& name, const std::string& kind, const nlohmann::json& spec);
+    CampaignRecord ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec);
     std::optional<CampaignRecord> find_campaign(const std::string& name);
     std::vector<CampaignRecord> campaigns();
     void set_campaign_status(std::int64_t campaign_id, const std::string& status);

@@ -289,7 +289,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     const auto plan = plan_runs(spec, engine.identity_text, dir_);
 
     ShearCampaignOutcome out;
-    out.campaign = store_->ensure_campaign(campaign_name(spec), "shear", spec.to_json());
+    out.campaign = store_->ensure_campaign(campaign_name(spec), CampaignKind::shear, spec.to_json());
     std::deque<std::string> queue;
     std::map<std::string, const PlannedRun*> by_hash;
     std::set<std::string> seen;
@@ -434,7 +434,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
 std::vector<ShearCampaignOutcome> ShearCampaignRunner::resume(const ProgressCallback& progress) {
     std::vector<ShearCampaignOutcome> outs;
     for (const auto& c : store_->campaigns()) {
-        if (c.kind != "shear" || c.status == "complete") continue;
+        if (c.kind != CampaignKind::shear || c.status == "complete") continue;
         outs.push_back(run(ShearCampaignSpec::from_json(c.spec), progress));
         if (outs.back().interrupted) break;
     }
@@ -444,7 +444,7 @@ std::vector<ShearCampaignOutcome> ShearCampaignRunner::resume(const ProgressCall
 std::vector<ShearCampaignOutcome> inspect_campaigns(const fs::path& dir) {
     if (!fs::exists(dir / "campaign.sqlite"))
         throw std::invalid_argument("campaign = '" + dir.string() + "' holds no campaign.sqlite");
-    CampaignStore store(dir / "campaign.sqlite");
+    CampaignStore store(dir / "campaign.sqlite", StoreAccess::read_only);
     std::vector<ShearCampaignOutcome> outs;
     for (const auto& c : store.campaigns()) {
         ShearCampaignOutcome o;

@@ -130,7 +130,7 @@ private:
     CampaignStore* store_;
 };
 
-// Summary of a campaign directory without running anything (for `demcal status`): opens the store read-only-ish.
+// Summary of a campaign directory without running anything (for `demcal status`): opens the store read-only.
 std::vector<ShearCampaignOutcome> inspect_campaigns(const std::filesystem::path& dir);
 
 std::string campaign_name(const ShearCampaignSpec& spec);

@@ -28,8 +28,8 @@ TEST_CASE("the store keeps runs, states, results and attempts across reopening",
     std::int64_t cid;
     {
         CampaignStore s(d / "c.sqlite");
-        cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
-        CHECK(s.ensure_campaign("c1", "shear", {{"x", 2}}).id == cid);  // same name, same campaign
+        cid = s.ensure_campaign("c1", CampaignKind::shear, {{"x", 1}}).id;
+        CHECK(s.ensure_campaign("c1", CampaignKind::shear, {{"x", 2}}).id == cid);  // same name, same campaign
         s.ensure_run(cid, "h1", {{"normal_stress", 1e4}}, d / "runs/h1", {{"replicate", 0}});
         s.ensure_run(cid, "h2", {{"normal_stress", 2e4}}, d / "runs/h2", {{"replicate", 0}});
         s.ensure_run(cid, "h1", {{"normal_stress", 1e4}}, d / "runs/h1", {{"replicate", 0}});  // no duplicate
@@ -64,7 +64,7 @@ TEST_CASE("a run that wrote its result just before the orchestrator died is kept
     std::int64_t cid;
     {
         CampaignStore s(d / "campaign.sqlite");
-        cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
+        cid = s.ensure_campaign("c1", CampaignKind::shear, {{"x", 1}}).id;
         for (const std::string h : {"finished", "unfinished", "garbled", "flipped", "unsealed", "legacy"}) {
             fs::create_directories(d / "runs" / h);
             s.ensure_run(cid, h, {{"normal_stress", 1e4}}, d / "runs" / h, {{"replicate", 0}});
@@ -137,7 +137,7 @@ TEST_CASE("a damaged store is refused before a resume, a store without applicati
     const fs::path d = fresh_dir("damaged-store");
     {
         CampaignStore s(d / "c.sqlite");
-        const auto cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
+        const auto cid = s.ensure_campaign("c1", CampaignKind::shear, {{"x", 1}}).id;
         for (int i = 0; i < 200; ++i)  // several pages of runs
             s.ensure_run(cid, "h" + std::to_string(i), {{"normal_stress", 1e4 + i}, {"note", std::string(200, 'n')}},
                          d / "runs" / ("h" + std::to_string(i)), {{"replicate", i}});
@@ -163,7 +163,7 @@ TEST_CASE("run folders are stored relative to the campaign, so a copied campaign
     fs::create_directories(d / "a");
     {
         CampaignStore s(d / "a" / "campaign.sqlite");
-        const auto cid = s.ensure_campaign("c1", "shear", {{"x", 1}}).id;
+        const auto cid = s.ensure_campaign("c1", CampaignKind::shear, {{"x", 1}}).id;
         s.ensure_run(cid, "h1", {{"normal_stress", 1e4}}, d / "a" / "runs" / "h1", {{"replicate", 0}});
         s.ensure_run(cid, "h2", {{"normal_stress", 2e4}}, d / "a" / "runs" / "h2", {{"replicate", 0}});
     }

@@ -42,7 +42,8 @@ TEST_CASE("fuzz: a damaged campaign store is refused or read, never crashes", "[
     fs::create_directories(dir);
     {
         orchestrator::CampaignStore store(dir / "valid.sqlite");
-        const auto id = store.ensure_campaign("c", "shear", {{"material", {{"density", 2650}}}}).id;
+        const auto id =
+            store.ensure_campaign("c", orchestrator::CampaignKind::shear, {{"material", {{"density", 2650}}}}).id;
         for (int i = 0; i < 20; ++i) {
             const std::string hash = "h" + std::to_string(i);
             store.ensure_run(id, hash, {{"normal_stress", 1e3 * (i + 1)}}, dir / "runs" / hash, {{"replicate", i}});

@@ -29,7 +29,7 @@ std::map<std::string, std::string> run_all(CampaignDirectory& d, const std::vect
                                            StoredJobsOutcome& out) {
     std::map<std::string, std::string> events;
     LocalExecutor executor(2);
-    const auto id = d.store().ensure_campaign("test", "test_jobs", nlohmann::json::object()).id;
+    const auto id = d.store().ensure_campaign("test", CampaignKind::crosscheck_silo, nlohmann::json::object()).id;
     out = run_stored_jobs(d.store(), id, jobs, executor,
                           [&](const std::string& e, const StoredJob& j, const std::string&) { events[j.name] = e; });
     return events;

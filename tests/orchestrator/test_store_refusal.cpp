@@ -1,0 +1,164 @@
+// `demcal status` and `demcal resume` on real stores made by the real binary: status never writes to the store, and
+// a store either command refuses (a newer schema, an unknown campaign kind, a row that is not readable) is refused
+// with exit 2, the store file and the field named, and its folder left byte for byte as it was (no lock file, no
+// -wal or -shm). A folder without a store is still refused as holding none.
+#include "campaign_test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <utility>
+
+namespace fs = std::filesystem;
+using namespace demcal;
+using Catch::Matchers::Contains;
+
+namespace {
+
+using FolderState = std::map<std::string, std::pair<std::string, fs::file_time_type>>;
+
+// Every file under `dir` with its bytes and modification time; folders by name.
+FolderState folder_state(const fs::path& dir) {
+    FolderState state;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        const std::string name = fs::relative(e.path(), dir).string();
+        state[name] = e.is_regular_file() ? std::make_pair(test::read_file(e.path()), e.last_write_time())
+                                          : std::make_pair(std::string("folder"), fs::file_time_type());
+    }
+    return state;
+}
+
+// What differs from `before` in `dir`, e.g. "campaign.sqlite changed, .lock added"; empty when nothing does.
+std::string changes(const FolderState& before, const fs::path& dir) {
+    const FolderState after = folder_state(dir);
+    std::string out;
+    for (const auto& [name, state] : after)
+        if (!before.count(name))
+            out += name + " added, ";
+        else if (before.at(name) != state)
+            out += name + " changed, ";
+    for (const auto& [name, state] : before)
+        if (!after.count(name)) out += name + " removed, ";
+    return out;
+}
+
+void sql(const fs::path& db_file, const std::string& statements) {
+    sqlite3* db = nullptr;
+    REQUIRE(sqlite3_open(db_file.c_str(), &db) == SQLITE_OK);
+    CHECK(sqlite3_exec(db, statements.c_str(), nullptr, nullptr, nullptr) == SQLITE_OK);
+    sqlite3_close(db);
+}
+
+// A complete shear campaign of two runs in `campaign`, made by `demcal shear` with a stand-in simulator (written to
+// `dir`, returned) that writes the result file named by its last argument. The lock file is removed, as in a
+// campaign copied from elsewhere, so a lock a refused command leaves behind is seen; the store's time is set an hour
+// back, so a rewrite shows in it even on a file system with coarse times.
+fs::path complete_campaign(const fs::path& dir, const fs::path& campaign) {
+    const fs::path yade = dir / "stand-in-yade";
+    std::ofstream(yade) << "#!/bin/sh\nfor last; do :; done\n"
+                           "echo '{\"schema\": \"demcal.shear_result/1\", \"peak_shear_stress\": 1000, "
+                           "\"residual_shear_stress\": 800}' > \"$last\"\n";
+    fs::permissions(yade, fs::perms::owner_all);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4", "--yade", yade.string(), "--campaign",
+                                     campaign.string(), "--plot", "svg"},
+                                    dir / "shear.log");
+    INFO(test::read_file(dir / "shear.log"));
+    REQUIRE(rc == 0);
+    fs::remove(campaign / ".lock");
+    REQUIRE_FALSE(fs::exists(campaign / "campaign.sqlite-wal"));  // closed: the store is all in its file
+    fs::last_write_time(campaign / "campaign.sqlite", fs::file_time_type::clock::now() - std::chrono::hours(1));
+    return yade;
+}
+
+}  // namespace
+
+TEST_CASE("status reads a store without writing to it, also while another connection has it open", "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("status-read-only");
+    const fs::path campaign = dir / "campaign";
+    complete_campaign(dir, campaign);
+    const auto before = folder_state(campaign);
+    CHECK(test::run_demcal({"status", campaign.string()}, dir / "status.log") == 0);
+    INFO(test::read_file(dir / "status.log"));
+    CHECK_THAT(test::read_file(dir / "status.log"), Contains("[complete] shear: 2 runs, 2 done"));
+    CHECK(changes(before, campaign) == "");  // status rewrote the file (SQLite's change counter) and its time
+
+    // a campaign running: its committed changes are in the -wal, which status reads and leaves as it was
+    sqlite3* db = nullptr;
+    REQUIRE(sqlite3_open((campaign / "campaign.sqlite").c_str(), &db) == SQLITE_OK);
+    REQUIRE(sqlite3_exec(db, "UPDATE campaigns SET status = 'interrupted'", nullptr, nullptr, nullptr) == SQLITE_OK);
+    REQUIRE(fs::exists(campaign / "campaign.sqlite-wal"));
+    const std::string store = test::read_file(campaign / "campaign.sqlite");
+    const std::string wal = test::read_file(campaign / "campaign.sqlite-wal");
+    CHECK(test::run_demcal({"status", campaign.string()}, dir / "status.log") == 0);
+    CHECK_THAT(test::read_file(dir / "status.log"), Contains("[interrupted] shear: 2 runs, 2 done"));
+    const bool store_unchanged = test::read_file(campaign / "campaign.sqlite") == store;
+    const bool wal_unchanged = test::read_file(campaign / "campaign.sqlite-wal") == wal;
+    CHECK(store_unchanged);
+    CHECK(wal_unchanged);
+    sqlite3_close(db);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("status and resume refuse a newer schema, an unknown kind or an unreadable row, writing nothing",
+          "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("store-refusal");
+    const fs::path pristine = dir / "pristine";
+    const fs::path yade = complete_campaign(dir, pristine);
+    struct Case {
+        std::string damage, expect;
+    };
+    const std::vector<Case> cases{
+        {"UPDATE meta SET value = '999' WHERE key = 'schema_version'", "schema_version 999 is newer than this demcal's"},
+        {"UPDATE meta SET value = 'two' WHERE key = 'schema_version'", "schema_version 'two' is not a version demcal"},
+        {"UPDATE campaigns SET kind = 'martian'", "campaign 1: kind 'martian' is not one demcal knows (shear"},
+        {"UPDATE campaigns SET spec = '{not json'", "campaigns.spec is not valid JSON"},
+        {"UPDATE runs SET result = '{\"peak' WHERE rowid = 1", "runs.result is not valid JSON"},
+    };
+    for (const auto& c : cases) {
+        INFO(c.damage);
+        const fs::path campaign = dir / "campaign";
+        fs::remove_all(campaign);
+        fs::copy(pristine, campaign, fs::copy_options::recursive);
+        const fs::path store = campaign / "campaign.sqlite";
+        sql(store, c.damage);
+        REQUIRE_FALSE(fs::exists(campaign / "campaign.sqlite-wal"));
+        fs::last_write_time(store, fs::file_time_type::clock::now() - std::chrono::hours(1));
+        const auto before = folder_state(campaign);
+        for (const std::vector<std::string>& args :
+             {std::vector<std::string>{"status", campaign.string()},
+              std::vector<std::string>{"resume", campaign.string(), "--yade", yade.string()}}) {
+            INFO(args[0]);
+            CHECK(test::run_demcal(args, dir / "out.log") == 2);
+            const std::string log = test::read_file(dir / "out.log");
+            INFO(log);
+            CHECK_THAT(log, Contains(store.string()) && Contains(c.expect));
+            CHECK(std::count(log.begin(), log.end(), '\n') == 1);  // one line
+            CHECK(changes(before, campaign) == "");  // no .lock, no -wal, the store's bytes and time
+        }
+    }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("status and resume on a folder without a store refuse it as holding none and create nothing",
+          "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("store-none");
+    fs::create_directories(dir / "empty");
+    for (const std::string command : {"status", "resume"}) {
+        INFO(command);
+        for (const fs::path& campaign : {dir / "empty", dir / "missing"}) {
+            CHECK(test::run_demcal({command, campaign.string()}, dir / "out.log") == 2);
+            CHECK_THAT(test::read_file(dir / "out.log"), Contains("holds no campaign.sqlite"));
+        }
+        CHECK(fs::is_empty(dir / "empty"));
+        CHECK_FALSE(fs::exists(dir / "missing"));
+    }
+    fs::remove_all(dir);
+}
