@@ -41,7 +41,7 @@ nlohmann::json checked_run_params(const nlohmann::json& raw, const std::string& 
     if (!raw["seed"].is_number_integer()) throw std::invalid_argument(where + ": field 'seed' must be an integer");
     if (!raw["normal_stress"].is_number()) throw std::invalid_argument(where + ": field 'normal_stress' must be a number");
     return orchestrator::make_run_params(orchestrator::validate_material(material, where),
-                                         raw["normal_stress"].get<double>(), raw["seed"].get<long>());
+                                         raw["normal_stress"].get<double>(), raw["seed"].get<long>(), where);
 }
 
 ShearBoxParams to_kernel_params(const nlohmann::json& j) {

@@ -3,10 +3,12 @@
 #include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace demcal::orchestrator {
 
@@ -25,7 +27,10 @@ std::string range_text(const ParamSpec& s) {
 const std::vector<ParamSpec>& shear_param_specs() {
     // Defaults of the test set-up follow the seed (box 0.1 x 0.1 x 0.05 m); the micromechanical ones have none.
     static const std::vector<ParamSpec> specs = {
-        {"density", "kg/m^3", "particle material density", std::nullopt, 0, 1e5, true},
+        // >= 10: below the lightest granular solid (expanded polystyrene beads, 15-30 kg/m^3; the silo's materials
+        // have the same bound). Lighter grains change nothing but the time step, sqrt(density / young_modulus), at the
+        // procedure's fixed growth and shear speeds: 1e-3 kg/m^3 made sand-tiny a 2e7-step run.
+        {"density", "kg/m^3", "particle material density", std::nullopt, 10, 1e5},
         {"young_modulus", "Pa", "Young modulus of the particle material (YADE CohFrictMat.young)", std::nullopt, 0, 1e13,
          true},
         {"poisson_ratio", "-",
@@ -108,8 +113,133 @@ void check_geometry(const nlohmann::json& m, const std::string& where) {
     if (m.at("shear_displacement").get<double>() > 0.5 * m.at("box_length").get<double>())
         throw std::invalid_argument(where + ": field 'shear_displacement' = " + format_value(m.at("shear_displacement")) +
                                     " m is more than half the box length " + format_value(m.at("box_length")) + " m");
+    // A failure line needs every sample sheared through its peak, and the peak comes once the grains of the shear band
+    // have moved over their neighbours: after 0.5-1 particle length (sand-tiny: 0.71; sand.json: 0.9-1.3). A shorter
+    // travel than a quarter of a particle length ends before any failure, its "peak" only the last sample (1e-12 m
+    // gave a peak at 3 um). The repository's shortest travel is 0.33 of one (sand-scale-tiny at r = 4.5 mm).
+    constexpr double min_travel_particle_lengths = 0.25;
+    const double r = m.at("particle_radius").get<double>(), form = m.at("particle_form").get<double>();
+    if (m.at("shear_displacement").get<double>() < min_travel_particle_lengths * 2 * r * form) {
+        std::ostringstream o;
+        o << where << ": field 'shear_displacement' = " << format_value(m.at("shear_displacement"))
+          << " m is shorter than a quarter of a particle length (" << min_travel_particle_lengths * 2 * r * form
+          << " m for particle_radius = " << r << " m, particle_form = " << form
+          << "): the sample would not be sheared through its peak";
+        throw std::invalid_argument(o.str());
+    }
+}
+
+// ---- the work a run implies
+
+// The procedure's numbers the estimate needs: yade_scripts/shear_box.py's constants of the same names (the kernel's
+// ShearBoxProcedure copies them and tests/kernel/test_shear_box.cpp compares the two; a real run is compared with
+// this estimate in tests/orchestrator/test_shear_run_work.cpp).
+constexpr double kCloudSolidFraction = 0.25, kGrownSolidFraction = 0.50, kExpectedSolidFraction = 0.555;
+constexpr double kGrowthSurfaceSpeed = 0.05;  // [m/s]
+constexpr double kConsolidationInertialNumber = 0.01;
+constexpr double kConsolidationChunk = 200;
+
+// The script's clump_layout and union_volume for spheres of radius 1: n in a row, their centres `spacing` apart.
+std::pair<int, double> clump_layout(double form) {
+    if (form <= 1.0 + 1e-12) return {1, 0.0};
+    const int n = 1 + static_cast<int>(std::ceil(2 * (form - 1) - 1e-9));
+    return {n, 2 * (form - 1) / (n - 1)};
+}
+double unit_union_volume(int n, double spacing) {
+    const double sphere = 4.0 / 3.0 * M_PI;
+    if (n == 1) return sphere;
+    return n * sphere - (n - 1) * M_PI * (4 + spacing) * std::pow(2 - spacing, 2.0) / 12.0;
+}
+
+// What one run may cost. Values each in their range can still make a run that ends on no machine: 1 um grains in a
+// 4 cm box (4e12 particles), a time step fraction of 1e-12 or a shear velocity of 1 nm/s (1e12 steps); they were
+// planned and started, and ran until killed. The limits lie far above every run of the repository (sand-tiny: 525
+// particles and 1.2e5 steps, the consolidation's step limit counted in full; the seed's 0.1 x 0.1 x 0.05 m box of
+// r = 1 mm particles, the smallest it studies: 66 000 particles) and above any run a user would wait for. A million
+// particles: placing the cloud alone (makeCloud, YADE's and the kernel's copy, is O(n^2)) takes hours, and each
+// step 2000 times sand-tiny's. 1e8 steps: hours for sand-tiny's 525 particles (the kernel makes about 1e4 of its steps
+// a second) and weeks for the seed's box at r = 1 mm, while shearing sand.json at a laboratory speed (1 mm/min)
+// takes 5e7.
+void check_work(const nlohmann::json& m, std::optional<double> normal_stress, const std::string& where) {
+    const ShearRunWork w = estimate_shear_work(m, normal_stress);
+    auto v = [&](const char* k) { return analytics::number_text(m.at(k).get<double>()); };
+    if (!(w.particles <= kMaxShearParticles))
+        throw std::invalid_argument(
+            where + ": particle_radius = " + v("particle_radius") + " m (particle_form = " + v("particle_form") +
+            ") gives about " + analytics::number_text(w.particles, 2) + " particles in the " + v("box_length") + " x " +
+            v("box_width") + " x " + v("box_height") + " m box (box_length x box_width x box_height; limit " +
+            analytics::number_text(kMaxShearParticles) + " particles per run)");
+    if (w.steps() <= kMaxShearSteps) return;
+    std::string phase;  // the phase that takes the most steps, with the fields that set it
+    if (w.shear_steps >= w.growth_steps && w.shear_steps >= w.consolidation_steps)
+        phase = "shearing shear_displacement = " + v("shear_displacement") + " m at shear_velocity = " +
+                v("shear_velocity") + " m/s takes about " + analytics::number_text(w.shear_steps, 2) + " steps";
+    else if (w.consolidation_steps >= w.growth_steps)
+        phase = "consolidating under normal_stress = " + analytics::number_text(*normal_stress) +
+                " Pa may take about " + analytics::number_text(w.consolidation_steps, 2) +
+                " steps (its step limit: the lid comes down at most at the quasi-static speed " +
+                analytics::number_text(kConsolidationInertialNumber) +
+                " box_height / (particle length x sqrt(density / normal_stress)), density = " + v("density") +
+                " kg/m^3)";
+    else
+        phase = "growing the particles to full size at " + analytics::number_text(kGrowthSurfaceSpeed) +
+                " m/s takes about " + analytics::number_text(w.growth_steps, 2) + " steps";
+    throw std::invalid_argument(
+        where + ": " + phase + " at a time step of " + analytics::number_text(w.timestep, 3) +
+        " s (timestep_fraction = " + v("timestep_fraction") + " of the critical step of particle_radius = " +
+        v("particle_radius") + " m, radius_spread = " + v("radius_spread") + ", density = " + v("density") +
+        " kg/m^3, young_modulus = " + v("young_modulus") + " Pa): about " + analytics::number_text(w.steps(), 2) +
+        " steps in all (limit " + analytics::number_text(kMaxShearSteps) + " steps per run)");
+}
+
+// Contact overlap under the lid's stress, relative to the particle diameter d. A packing at solid fraction phi with Z
+// contacts per particle carries a stress sigma with a mean contact force F = pi d^2 sigma / (phi Z) (Rothenburg and
+// Bathurst), and the linear law's kn is E r = E d / 2, so delta / d = 2 pi sigma / (phi Z E): about 2.3 sigma / E at
+// phi = 0.55, Z = 5. Above 5 % of a diameter the sample is squeezed rather than sheared: sand-tiny at 5 kPa (kernel,
+// seed 1) was compressed by 6 % with E = 100 sigma (estimate 2.3 %), by 19 % with E = 25 sigma (9 %; porosity 0.35,
+// below random close packing) and failed with E = 10 sigma (no upper half left above the shear plane); with 1e-3 Pa
+// its spheres escaped. Every material of the repository stays below 0.4 % (E >= 1.4e7 Pa at <= 20 kPa).
+constexpr double kOverlapPerStressRatio = 2.3;
+constexpr double kMaxRelativeOverlap = 0.05;
+
+void check_overlap(const nlohmann::json& p, double normal_stress, const std::string& where) {
+    const double young = p.at("young_modulus").get<double>();
+    const double overlap = kOverlapPerStressRatio * normal_stress / young;
+    if (!(overlap <= kMaxRelativeOverlap))
+        throw std::invalid_argument(
+            where + ": young_modulus = " + analytics::number_text(young) + " Pa under normal_stress = " +
+            analytics::number_text(normal_stress) + " Pa: the contacts would overlap by about " +
+            analytics::number_text(overlap, 2) + " particle diameters (" +
+            analytics::number_text(kOverlapPerStressRatio) + " normal_stress / young_modulus; at most " +
+            analytics::number_text(kMaxRelativeOverlap) + ", so young_modulus >= " +
+            analytics::number_text(kOverlapPerStressRatio / kMaxRelativeOverlap * normal_stress, 3) +
+            " Pa at this stress)");
 }
 }  // namespace
+
+ShearRunWork estimate_shear_work(const nlohmann::json& m, std::optional<double> normal_stress) {
+    auto d = [&](const char* k) { return m.at(k).get<double>(); };
+    const double r = d("particle_radius"), spread = d("radius_spread"), form = d("particle_form");
+    const double L = d("box_length"), W = d("box_width"), H = d("box_height");
+    const auto [n, spacing] = clump_layout(form);
+    const double particle_volume = unit_union_volume(n, spacing) * r * r * r * (1 + spread * spread);  // mean
+    ShearRunWork w;
+    w.particles = std::max(1.0, std::nearbyint(kExpectedSolidFraction * L * W * H / particle_volume));
+    // the cloud starts shrunk by size_factor; the time step is the smallest sphere's, r (1 - spread) at full size
+    const double size_factor = std::cbrt(kCloudSolidFraction * unit_union_volume(n, spacing) /
+                                         (kGrownSolidFraction * 4.0 / 3.0 * M_PI * std::pow(form, 3.0)));
+    w.timestep = d("timestep_fraction") * r * (1 - spread) * std::sqrt(d("density") / d("young_modulus"));
+    w.growth_steps = std::ceil(r * std::log(1 / size_factor) / (kGrowthSurfaceSpeed * size_factor * w.timestep));
+    w.shear_steps = std::max(d("samples"), std::ceil(d("shear_displacement") / (d("shear_velocity") * w.timestep)));
+    if (normal_stress) {
+        // the consolidation's step limit: twice the cloud's height at the lid's quasi-static speed, 20 checks more
+        const double cloud_height = w.particles * particle_volume / (L * W * kGrownSolidFraction);
+        const double lid_speed =
+            kConsolidationInertialNumber * H / (2 * r * form * std::sqrt(d("density") / *normal_stress));
+        w.consolidation_steps = std::ceil(2 * cloud_height / lid_speed / w.timestep) + 20 * kConsolidationChunk;
+    }
+    return w;
+}
 
 nlohmann::json validate_material(const nlohmann::json& material, const std::string& where) {
     if (!material.is_object()) throw std::invalid_argument(where + ": a material must be a JSON object");
@@ -135,15 +265,19 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
         out[s.name] = s.integer ? nlohmann::json(static_cast<long>(*s.default_value)) : nlohmann::json(*s.default_value);
     }
     check_geometry(out, where);
+    check_work(out, std::nullopt, where);
     return out;
 }
 
-nlohmann::json make_run_params(const nlohmann::json& validated_material, double normal_stress, long seed) {
+nlohmann::json make_run_params(const nlohmann::json& validated_material, double normal_stress, long seed,
+                               const std::string& where) {
     nlohmann::json p = validated_material;
     p["normal_stress"] = normal_stress;
     p["seed"] = seed;
-    check_value(*find_shear_param("normal_stress"), p["normal_stress"], "run");
-    check_value(*find_shear_param("seed"), p["seed"], "run");
+    check_value(*find_shear_param("normal_stress"), p["normal_stress"], where);
+    check_value(*find_shear_param("seed"), p["seed"], where);
+    check_overlap(p, normal_stress, where);
+    check_work(p, normal_stress, where);
     return p;
 }
 

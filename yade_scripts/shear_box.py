@@ -30,7 +30,7 @@ SCHEMA = "demcal.shear_result/2"
 
 # name: (unit, kind, lower bound, lower bound inclusive, upper bound, upper bound inclusive, meaning)
 PARAM_SPECS = {
-    "density": ("kg/m^3", float, 0.0, False, 1e5, True, "particle material density"),
+    "density": ("kg/m^3", float, 10.0, True, 1e5, True, "particle material density"),
     "young_modulus": ("Pa", float, 0.0, False, 1e13, True,
                       "Young modulus of particles and walls; linear contact kn = 2 Ea Ra Eb Rb / (Ea Ra + Eb Rb)"),
     "poisson_ratio": ("-", float, 0.0, False, 0.5, True,
