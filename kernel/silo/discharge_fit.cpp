@@ -1,5 +1,6 @@
 #include "kernel/silo/discharge_fit.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace demcal::kernel::silo {
@@ -16,11 +17,14 @@ DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, dou
     }
     const double lo = lower_fraction * reference_mass, hi = upper_fraction * reference_mass;
     double st = 0, sm = 0;
+    double m_min = hi, m_max = lo;
     int n = 0;
     for (const auto& s : samples)
         if (s.mass >= lo && s.mass <= hi) {
             st += s.time;
             sm += s.mass;
+            m_min = std::min(m_min, s.mass);
+            m_max = std::max(m_max, s.mass);
             if (n == 0) f.t_begin = s.time;
             f.t_end = s.time;
             ++n;
@@ -43,7 +47,7 @@ DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, dou
         f.message = "the samples of the steady part all have the same time";
         return f;
     }
-    if (!(smm > 0)) {
+    if (!(m_max > m_min && smm > 0)) {  // (the mean's rounding leaves smm > 0 on a plateau)
         f.message = "the discharged mass does not change between " + std::to_string(lower_fraction * 100) + " % and " +
                     std::to_string(upper_fraction * 100) + " % of the reference mass";
         return f;
