@@ -41,6 +41,8 @@ double BinVibration::peak_acceleration() const {
     return amplitude * w * w;
 }
 
+double BinVibration::peak_velocity() const { return amplitude * 2 * pi * frequency; }
+
 void validate(const BinVibration& v) {
     check_range("vibration_frequency", v.frequency, 1000, "Hz");
     check_range("vibration_amplitude", v.amplitude, 0.01, "m");

@@ -37,6 +37,7 @@ struct BinVibration {
 
     bool vibrates() const { return frequency > 0 && amplitude > 0; }
     double peak_acceleration() const;  // A (2 pi f)^2 [m/s^2]
+    double peak_velocity() const;      // A 2 pi f [m/s]
 };
 
 // Throws std::invalid_argument naming the field and the value: f in [0, 1000] Hz, A in [0, 0.01] m, the start

@@ -47,7 +47,7 @@ DischargeFit fit_discharge_rate(const std::vector<DischargeSample>& samples, dou
         f.message = "the samples of the steady part all have the same time";
         return f;
     }
-    if (!(m_max > m_min && smm > 0)) {  // (the mean's rounding leaves smm > 0 on a plateau)
+    if (!(m_max > m_min)) {  // (not smm: the mean's rounding leaves it above 0 on a plateau)
         f.message = "the discharged mass does not change between " + std::to_string(lower_fraction * 100) + " % and " +
                     std::to_string(upper_fraction * 100) + " % of the reference mass";
         return f;

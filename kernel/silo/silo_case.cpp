@@ -233,11 +233,18 @@ double grain_length(const WheatMaterials& m) {
                                                       : clump_length(elongated_wheat_clump(m.grain_aspect_ratio));
 }
 
-double smallest_sphere_rayleigh_step(const WheatMaterials& m) {
+namespace {
+// The radius of the grain's smallest sphere: it sets the stiffest contact's time step and the overlap a grain bears.
+double smallest_sphere_radius(const WheatMaterials& m) {
     double smallest_radius = 1;
     for (const auto& sphere : elongated_wheat_clump(m.grain_aspect_ratio))
         smallest_radius = std::min(smallest_radius, sphere.radius);
-    return rayleigh_time_step(m.wheat_scaled(), smallest_radius);
+    return smallest_radius;
+}
+}  // namespace
+
+double smallest_sphere_rayleigh_step(const WheatMaterials& m) {
+    return rayleigh_time_step(m.wheat_scaled(), smallest_sphere_radius(m));
 }
 
 double planned_time_step(const SiloCaseSettings& s) {
@@ -365,14 +372,12 @@ void validate(const SiloCaseSettings& s) {
     // (a stiffness_scale of 1e-12 gave a 2 s time step and every grain fell through the walls). Hertz's impact
     // overlap, two grains head on: delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5), m* = m/2, R* = r/2, E* = E/(2(1-nu^2)).
     // The reduced cases' 1e-3 gives 0.6 r; 1e-4 would give 1.6 r.
-    double smallest_radius = 1;
-    for (const auto& sphere : elongated_wheat_clump(s.materials.grain_aspect_ratio))
-        smallest_radius = std::min(smallest_radius, sphere.radius);
+    const double smallest_radius = smallest_sphere_radius(s.materials);
     const Material grain = s.materials.wheat_scaled();
     const double young = 2 * grain.shear_modulus * (1 + grain.poisson);
     const double e_star = young / (2 * (1 - grain.poisson * grain.poisson));
-    const double speed = std::sqrt(2 * 9.81 * s.geometry.top()) +
-                         (s.vibration.vibrates() ? 2 * M_PI * s.vibration.frequency * s.vibration.amplitude : 0.0);
+    const double speed = std::sqrt(2 * std::abs(s.gravity) * s.geometry.top()) +
+                         (s.vibration.vibrates() ? s.vibration.peak_velocity() : 0.0);
     const double impact_overlap =
         std::pow(15 * 0.5 * grain_mass * speed * speed / (16 * e_star * std::sqrt(0.5 * smallest_radius)), 0.4);
     if (!(impact_overlap <= smallest_radius))
