@@ -137,6 +137,11 @@ void validate(const SiloGeometry& g, double particle_size, double min_outlet_par
     if (g.hopper_height() > 20 * size)
         reject_setting("theta", g.half_angle_deg,
             "the hopper would be " + setting_text(g.hopper_height()) + " m tall (more than 20 silo sizes)");
+    // Beyond a few sizes the body adds only head that Janssen's arching screens from the outlet (industrial silos
+    // stop near H/D = 10); a body of kilometres would make the filling's free fall the run's whole time.
+    if (g.body_height > 20 * size)
+        reject_setting("body_height", g.body_height,
+            "the body would be more than 20 silo sizes tall (" + setting_text(20 * size) + " m)");
 }
 
 }  // namespace demcal::kernel::silo

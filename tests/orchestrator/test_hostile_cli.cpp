@@ -332,7 +332,8 @@ TEST_CASE("an output on an input's path or on another output's is refused before
 
 TEST_CASE("repeats that share a run folder, a search without vibration and nonsense settings are refused", "[cli]") {
     // vibration --theta 30,30.0000001 ran both cells into one folder; cutoff --seeds 1,1 counted one bed twice in its
-    // vote; --amplitude 0 bisected a still bed; a stiffness scale of 1e-12 let every grain fall through the walls
+    // vote; --amplitude 0 bisected a still bed; a stiffness scale of 1e-12 let every grain fall through the walls; a
+    // 100 km body made the filling a free fall of hours
     const fs::path root = test::fresh_test_dir("hostile-repeats"), dir = root / "work";
     fs::create_directories(dir);
     const std::string camp = (dir / "camp").string(), out = (dir / "o").string();
@@ -353,6 +354,8 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--no-checkpoint", "--checkpoint-every", "5"},
               {"--checkpoint-every 5", "--no-checkpoint"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--threads", "2147483647"}, {"--threads"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--body-height", "1e5"},
+              {"body_height = 100000", "20 silo sizes"}},
              {{"predict", (dir / "wide_k.json").string()}, {"beverloo_k=100", "effective outlet would be empty"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
