@@ -739,7 +739,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"contact_law", r.contact_law}};
     if (!s.vtk_dir.empty()) j["vtk"] = {{"dir", s.vtk_dir}, {"files", r.vtk_files}};
     try {
-        ks::write_discharge_csv(dir / "discharge.csv", r.discharge);
+        orchestrator::write_text_file_atomically(dir / "discharge.csv", ks::discharge_csv_text(r.discharge));
         orchestrator::write_text_file_atomically(dir / "summary.json", j.dump(2) + "\n");
     } catch (const std::exception& e) {
         // the checkpoint stays: resuming from it computes the end again and writes the results

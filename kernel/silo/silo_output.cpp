@@ -2,21 +2,23 @@
 
 #include <fstream>
 #include <iomanip>
+#include <sstream>
 #include <stdexcept>
 
 namespace demcal::kernel::silo {
 
-void write_discharge_csv(const std::filesystem::path& file, const std::vector<DischargeRow>& rows) {
-    std::ofstream f(file);
-    if (!f) throw std::runtime_error("cannot write " + file.string());
+std::string discharge_csv_text(const std::vector<DischargeRow>& rows) {
+    std::ostringstream f;
     f << "time_s,discharged_mass_kg,discharged_grains\n" << std::setprecision(9);
     for (const auto& r : rows) f << r.time << "," << r.mass << "," << r.grains << "\n";
-    f.close();  // the last buffer reaches the disk here: a full disk shows now
-    if (!f) throw std::runtime_error("failed writing " + file.string());
+    return f.str();
 }
 
 void write_vtk(const std::filesystem::path& file, const SphereSnapshot& s, double time) {
-    std::ofstream f(file);
+    // written beside, then renamed: a run killed while writing leaves no half snapshot (a resume writes it again)
+    std::filesystem::path tmp = file;
+    tmp += ".tmp";
+    std::ofstream f(tmp);
     if (!f) throw std::runtime_error("cannot write " + file.string());
     const size_t n = s.positions.size();
     f << "# vtk DataFile Version 3.0\ndemcal silo t = " << time << " s\nASCII\nDATASET POLYDATA\n"
@@ -31,7 +33,12 @@ void write_vtk(const std::filesystem::path& file, const SphereSnapshot& s, doubl
     f << "SCALARS clump int 1\nLOOKUP_TABLE default\n";
     for (long c : s.clump) f << c << "\n";
     f.close();
-    if (!f) throw std::runtime_error("failed writing " + file.string());
+    std::error_code ec;
+    if (f) std::filesystem::rename(tmp, file, ec);
+    if (!f || ec) {
+        std::filesystem::remove(tmp, ec);
+        throw std::runtime_error("failed writing " + file.string());
+    }
 }
 
 }  // namespace demcal::kernel::silo

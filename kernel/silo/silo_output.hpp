@@ -5,17 +5,19 @@
 #include <Eigen/Core>
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace demcal::kernel::silo {
 
-// CSV with header "time_s,discharged_mass_kg,discharged_grains": time since the outlet opened.
+// The discharge table as CSV text with header "time_s,discharged_mass_kg,discharged_grains": time since the outlet
+// opened (the caller writes it atomically, beside summary.json).
 struct DischargeRow {
     double time;
     double mass;
     long grains;
 };
-void write_discharge_csv(const std::filesystem::path& file, const std::vector<DischargeRow>& rows);
+std::string discharge_csv_text(const std::vector<DischargeRow>& rows);
 
 // One snapshot of the spheres (clump members) as VTK legacy ASCII POLYDATA: points, and point data "radius",
 // "velocity" (vectors) and "clump" (the grain index).

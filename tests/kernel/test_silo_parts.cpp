@@ -172,11 +172,8 @@ TEST_CASE("section field and output files", "[silo]") {
     std::filesystem::create_directories(dir);
     sec.write_grid(dir / "grid.dat");
     sec.write_outline(dir / "outline.dat");
-    write_discharge_csv(dir / "d.csv", {{0, 0, 0}, {0.1, 0.02, 560}});
-    std::ifstream csv(dir / "d.csv");
-    std::string header;
-    std::getline(csv, header);
-    CHECK(header == "time_s,discharged_mass_kg,discharged_grains");
+    CHECK(discharge_csv_text({{0, 0, 0}, {0.1, 0.02, 560}}) ==
+          "time_s,discharged_mass_kg,discharged_grains\n0,0,0\n0.1,0.02,560\n");
     SphereSnapshot s;
     s.positions = {{0, 0, 0.1}};
     s.velocities = {{0, 0, -1}};
@@ -186,5 +183,6 @@ TEST_CASE("section field and output files", "[silo]") {
     const std::string vtk = demcal::test::read_file(dir / "s.vtk");
     CHECK_THAT(vtk, Contains("POINTS 1 double"));
     CHECK_THAT(vtk, Contains("VECTORS velocity double"));
+    CHECK_FALSE(std::filesystem::exists(dir / "s.vtk.tmp"));  // written beside, then renamed
     std::filesystem::remove_all(dir);
 }
