@@ -1,5 +1,6 @@
 #include "orchestrator/stored_jobs.hpp"
 
+#include "analytics/user_input.hpp"
 #include "orchestrator/run_identity.hpp"
 
 #include <unistd.h>
@@ -16,12 +17,15 @@ using nlohmann::json;
 
 namespace {
 
-// The result file as JSON, or nothing when it is absent or not JSON (a run that did not finish).
+// The result file as JSON, or nothing when it is absent or not JSON (a run that did not finish) or breaks the
+// input rules (too large, nested too deep, a repeated key): read through the one JSON reader, as shear results are,
+// so that a file damaged or planted in a run folder costs a rerun, not the orchestrator.
 std::optional<json> read_result(const fs::path& file) {
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) return std::nullopt;
     try {
-        return json::parse(read_text_file(file));
+        const std::string what = "result '" + file.string() + "'";
+        return analytics::parse_json_text(analytics::read_input_file(file, what, analytics::kMaxJsonInputBytes), what);
     } catch (const std::exception&) {
         return std::nullopt;
     }

@@ -94,3 +94,27 @@ TEST_CASE("stored jobs: reuse, failure for good on exit 2, retry of other failur
     CHECK_THROWS_AS(CampaignDirectory(root, stored_job_result), std::runtime_error);  // the lock is held
     fs::remove_all(root);
 }
+
+TEST_CASE("stored jobs: a result file nested 100000 deep or with a repeated key is a damaged result, not a crash",
+          "[store]") {
+    // the result is read back on every reuse and recovery: a file damaged (or planted) in a run folder must cost a
+    // rerun, never the orchestrator; the JSON reader's depth limit is what keeps the parse and the store's dump bounded
+    const fs::path root = fs::temp_directory_path() / ("demcal-test-stored-deep-" + std::to_string(::getpid()));
+    fs::remove_all(root);
+    const std::string deep = "python3 -c \"print('[' * 100000 + ']' * 100000)\" > result.json";
+    std::vector<StoredJob> jobs = {shell_job(root, "deep", deep),
+                                   shell_job(root, "twice", "echo '{\"x\": 1, \"x\": 2}' > result.json")};
+    CampaignDirectory d(root, stored_job_result);
+    StoredJobsOutcome out;
+    auto events = run_all(d, jobs, out);
+    for (const auto& job : jobs) {
+        INFO(job.name);
+        CHECK(events[job.name] == "retry later");
+        const auto run = d.store().run(job.hash);
+        REQUIRE(run);
+        CHECK(run->state == RunState::pending);
+        CHECK(run->cause == "no_result");
+    }
+    CHECK(out.executed == 0);
+    fs::remove_all(root);
+}
