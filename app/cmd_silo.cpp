@@ -660,6 +660,7 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
         throw CLI::RuntimeError(kExitSuspended);
     }
     nlohmann::json j;
+    j["schema"] = orchestrator::kSiloSummarySchema;
     j["geometry"] = silo_geometry_json(s.geometry);
     j["grains"] = r.grains;
     j["grain_mass_kg"] = r.grain_mass;
@@ -740,7 +741,9 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     if (!s.vtk_dir.empty()) j["vtk"] = {{"dir", s.vtk_dir}, {"files", r.vtk_files}};
     try {
         orchestrator::write_text_file_atomically(dir / "discharge.csv", ks::discharge_csv_text(r.discharge));
-        orchestrator::write_text_file_atomically(dir / "summary.json", j.dump(2) + "\n");
+        // sealed: the campaigns that read it back (vibration, cutoff, crosscheck, diagnose silo-dem) find a damaged one
+        orchestrator::write_text_file_atomically(dir / "summary.json",
+                                                 orchestrator::sealed_result_text(j.dump(2) + "\n"));
     } catch (const std::exception& e) {
         // the checkpoint stays: resuming from it computes the end again and writes the results
         throw std::runtime_error(std::string(e.what()) + "; the results are not written" +

@@ -198,7 +198,8 @@ struct KernelSide {
 
 KernelSide read_kernel_side(const fs::path& kernel_dir) {
     KernelSide k;
-    k.summary = analytics::read_json_input(kernel_dir / "summary.json", "kernel summary");
+    k.summary = orchestrator::read_result_json(kernel_dir / "summary.json",
+                                               "kernel summary '" + (kernel_dir / "summary.json").string() + "'");
     // (no rate where the run could not determine one: nothing discharged, no steady window)
     k.rate = k.summary.at("rate").value("rate_kg_s", std::numeric_limits<double>::quiet_NaN());
     k.filled = k.summary.at("filled_mass_kg").get<double>();

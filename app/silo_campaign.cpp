@@ -3,7 +3,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "orchestrator/executor.hpp"
-#include "orchestrator/run_identity.hpp"  // write_text_file_atomically
+#include "orchestrator/run_identity.hpp"  // write_text_file_atomically, read_result_json
 #include "orchestrator/shear_campaign.hpp"  // pinned_program
 #include "orchestrator/slurm_executor.hpp"
 
@@ -197,7 +197,13 @@ std::string SiloRunSummary::text(const std::string& field) const {
 std::optional<SiloRunSummary> silo_run_summary(const fs::path& dir, const std::string& name) {
     const fs::path summary = dir / "runs" / name / "summary.json";
     if (!fs::exists(summary)) return std::nullopt;
-    return SiloRunSummary(read_json_file(summary.string(), "run summary"), summary);
+    try {
+        return SiloRunSummary(orchestrator::read_result_json(summary, "run summary '" + summary.string() + "'"),
+                              summary);
+    } catch (const std::exception& e) {  // damaged (its seal), or not JSON within the reader's rules
+        throw UserError(std::string(e.what()) + " (written by demcal silo: remove " + (dir / "runs" / name).string() +
+                        " to run it again)");
+    }
 }
 
 bool silo_run_failed(const fs::path& dir, const std::string& name) { return fs::exists(dir / "runs" / name / "failed"); }

@@ -1,5 +1,7 @@
 #include "orchestrator/run_identity.hpp"
 
+#include "analytics/user_input.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -54,6 +56,29 @@ std::string unsealed_result_text(const std::string& text) {
         throw DamagedResult("its text does not match its SHA-256 (sealed " + recorded.substr(0, 12) + "..., the text " +
                             actual.substr(0, 12) + "...): damaged or truncated after it was written");
     return body;
+}
+
+ResultFile read_result_file(const std::filesystem::path& file, const std::string& what) {
+    const std::string text = analytics::read_input_file(file, what, analytics::kMaxJsonInputBytes);
+    ResultFile r;
+    r.sealed = has_result_seal(text);
+    try {
+        r.json = analytics::parse_json_text(unsealed_result_text(text), what);
+    } catch (const DamagedResult& e) {
+        throw DamagedResult(what + ": " + e.what());
+    }
+    return r;
+}
+
+nlohmann::json read_result_json(const std::filesystem::path& file, const std::string& what) {
+    ResultFile r = read_result_file(file, what);
+    if (!r.sealed && r.json.is_object() && r.json.contains("schema")) {
+        const nlohmann::json& schema = r.json["schema"];
+        if (schema == kShearResultSchema || schema == kSiloSummarySchema)
+            throw DamagedResult(what + ": schema " + schema.get<std::string>() +
+                                " without its SHA-256 seal: damaged or not a demcal result");
+    }
+    return std::move(r.json);
 }
 
 namespace {

@@ -37,6 +37,23 @@ std::string sealed_result_text(const std::string& body);
 std::string unsealed_result_text(const std::string& text);
 bool has_result_seal(const std::string& text);
 
+// demcal silo's summary.json, sealed by the same rule since this schema (earlier summaries had no schema and no seal).
+inline constexpr const char* kSiloSummarySchema = "demcal.silo_summary/1";
+
+// A result file read through the one JSON reader (size, depth, repeated keys: analytics::parse_json_text) with its
+// seal checked where it has one. `sealed` says whether it had one; the caller decides what an unsealed file may be.
+struct ResultFile {
+    nlohmann::json json;
+    bool sealed = false;
+};
+ResultFile read_result_file(const std::filesystem::path& file, const std::string& what);
+
+// read_result_file for any result: an object whose schema is one that is always sealed (kShearResultSchema,
+// kSiloSummarySchema) but carries no seal is damaged (a flipped byte in the seal itself); an unsealed file of
+// another schema, or of none (older writers, YADE's silo script), is taken as it is.
+// Throws DamagedResult, or analytics::InputError when the text breaks the reader's rules.
+nlohmann::json read_result_json(const std::filesystem::path& file, const std::string& what);
+
 std::string read_text_file(const std::filesystem::path& p);
 // Writes via a temporary file and rename, so a reader (or a crash) never sees half a file.
 void write_text_file_atomically(const std::filesystem::path& p, const std::string& text);

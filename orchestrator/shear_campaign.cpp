@@ -246,9 +246,7 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
 
 nlohmann::json read_shear_result(const fs::path& file) {
     const std::string what = "result = '" + file.string() + "'";
-    const std::string text = analytics::read_input_file(file, what, analytics::kMaxJsonInputBytes);
-    const bool sealed = has_result_seal(text);
-    nlohmann::json result = analytics::parse_json_text(unsealed_result_text(text), what);
+    auto [result, sealed] = read_result_file(file, what);
     if (!result.is_object()) throw std::invalid_argument(what + ": not a JSON object");
     const std::string schema = result.value("schema", std::string());
     // a schema that needs the seal, without it: the seal itself was hit (or the file is not a demcal result)

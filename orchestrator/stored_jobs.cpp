@@ -1,6 +1,5 @@
 #include "orchestrator/stored_jobs.hpp"
 
-#include "analytics/user_input.hpp"
 #include "orchestrator/run_identity.hpp"
 
 #include <unistd.h>
@@ -17,15 +16,14 @@ using nlohmann::json;
 
 namespace {
 
-// The result file as JSON, or nothing when it is absent or not JSON (a run that did not finish) or breaks the
-// input rules (too large, nested too deep, a repeated key): read through the one JSON reader, as shear results are,
-// so that a file damaged or planted in a run folder costs a rerun, not the orchestrator.
+// The result file as JSON, or nothing when it is absent or not JSON (a run that did not finish), breaks the input
+// rules (too large, nested too deep, a repeated key) or fails its seal: read as shear results are, so that a file
+// damaged or planted in a run folder costs a rerun, not the orchestrator.
 std::optional<json> read_result(const fs::path& file) {
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) return std::nullopt;
     try {
-        const std::string what = "result '" + file.string() + "'";
-        return analytics::parse_json_text(analytics::read_input_file(file, what, analytics::kMaxJsonInputBytes), what);
+        return read_result_json(file, "result '" + file.string() + "'");
     } catch (const std::exception&) {
         return std::nullopt;
     }

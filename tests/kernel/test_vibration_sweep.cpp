@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "orchestrator/run_identity.hpp"
 #include "slurm_for_test.hpp"
 #include "demcal_cli.hpp"
 #include "test_files.hpp"
@@ -83,17 +84,27 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
   CHECK(paired["se_pct"].get<double>() == Approx(std::abs(change1 - change2) / 2));
   CHECK(report["cells"][0]["rate_change_paired"]["pairs"] == 0);  // the still cell is the reference
   CHECK(report["cells"][1]["outlet_speed_change_paired"]["pairs"] == 2);
-  // a run's summary damaged by hand stops the report naming the file and the field, and the report is left as it was
+  // a run's summary damaged by hand stops the report naming the file, and the report is left as it was: an edit
+  // breaks the summary's seal; an edit sealed again (a writer's bug, not a flipped byte) is caught by the field check
   const fs::path summary = campaign / "runs" / "theta45_f100_seed2" / "summary.json";
-  auto damaged = nlohmann::json::parse(demcal::test::read_file(summary));
+  const std::string sealed = demcal::test::read_file(summary);
+  auto damaged = nlohmann::json::parse(demcal::orchestrator::unsealed_result_text(sealed));
   damaged["outlet_flow"]["solid_density_kg_m3"] = "dense";
-  std::ofstream(summary) << damaged.dump();
   const std::string before = demcal::test::read_file(campaign / "vibration.json");
-  CHECK(demcal_run(sweep, dir / "damaged.log") == 2);
-  CHECK_THAT(demcal::test::read_file(dir / "damaged.log"),
-             Catch::Matchers::Contains(summary.string()) &&
-                 Catch::Matchers::Contains("outlet_flow/solid_density_kg_m3 = \"dense\": not a number"));
-  CHECK(demcal::test::read_file(campaign / "vibration.json") == before);
+  std::string flipped = sealed;
+  flipped[flipped.find("\"grains\": ") + 10] ^= 1;  // one bit of the grain count
+  for (const auto& [text, expect] :
+       {std::pair{flipped, std::string("does not match its SHA-256")},
+        std::pair{damaged.dump(), std::string("schema demcal.silo_summary/1 without its SHA-256 seal")},
+        std::pair{demcal::orchestrator::sealed_result_text(damaged.dump()),
+                  std::string("outlet_flow/solid_density_kg_m3 = \"dense\": not a number")}}) {
+    INFO(expect);
+    std::ofstream(summary) << text;
+    CHECK(demcal_run(sweep, dir / "damaged.log") == 2);
+    CHECK_THAT(demcal::test::read_file(dir / "damaged.log"),
+               Catch::Matchers::Contains(summary.string()) && Catch::Matchers::Contains(expect));
+    CHECK(demcal::test::read_file(campaign / "vibration.json") == before);
+  }
   fs::remove_all(dir);
 }
 
