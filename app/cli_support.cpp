@@ -139,6 +139,12 @@ void check_output_file(const std::string& path, const std::string& option) {
     if (path.empty()) throw UserError(option + ": an empty path");
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
+    const fs::file_status st = fs::status(path, ec);  // (through a link: what the output would be written into)
+    if (fs::exists(st) && !fs::is_regular_file(st))
+        throw UserError(named + " is not a regular file (a device, FIFO or socket); give a file name");
+    if (fs::is_symlink(fs::symlink_status(path, ec)) && !fs::exists(st))
+        throw UserError(named + " is a link to nothing (" +
+                        analytics::shortened_text(fs::read_symlink(path, ec).string(), 200) + "); give a file name");
     const fs::path folder = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
     if (!fs::is_directory(folder, ec)) throw UserError(named + ": the folder " + folder.string() + " does not exist");
     if (!can_create_files_in(folder))

@@ -372,7 +372,11 @@ void add_enlarge(CLI::App& app) {
         check_output_file(o->output, "output");
         std::vector<NamedPath> inputs;
         for (const auto& file : o->materials) inputs.push_back({file, "material"});
-        check_paths_apart(inputs, {{o->output, "output"}});
+        std::vector<NamedPath> outputs = {{o->output, "output"}};
+        if (!o->no_plot)  // the plot's files are written beside the output, by its name
+            for (const fs::path& f : enlargement_plot_files(o->output, o->plot_format))
+                outputs.push_back({f.string(), "output's plot file"});
+        check_paths_apart(inputs, outputs);
         std::vector<double> r, e, nu;
         std::map<double, std::string> file_of_radius;
         for (const auto& file : o->materials) {

@@ -158,6 +158,26 @@ std::vector<std::string> regime_labels(const analytics::DiagnoseResult& r, const
     return {};
 }
 
+// The residual plots beside a report REPORT.md: their data and the two pictures.
+struct ReportPlots {
+    std::filesystem::path data, before, after;
+};
+ReportPlots report_plots(const std::filesystem::path& report) {
+    const std::string stem = report.stem().string();
+    const auto dir = report.parent_path();
+    return {dir / (stem + "_residuals.dat"), dir / (stem + "_residuals_before.png"),
+            dir / (stem + "_residuals_after.png")};
+}
+
+// Every file report_plots' plots write (the data, each picture with its gnuplot files).
+std::vector<std::filesystem::path> report_plot_files(const std::filesystem::path& report) {
+    const ReportPlots p = report_plots(report);
+    std::vector<std::filesystem::path> files = {p.data};
+    for (const auto& picture : {p.before, p.after})
+        for (auto& f : gnuplot_files(picture)) files.push_back(std::move(f));
+    return files;
+}
+
 // Residuals against the fitted value and against the first added effect's column (or the file order): before/after.
 // Rows are coloured by the regime of a regime effect, so that its slopes show; outliers are drawn apart.
 void plot_residuals(const analytics::DiagnoseResult& r, const analytics::MeasuredData& data,
@@ -325,7 +345,10 @@ int run_diagnose(const DiagnoseArgs& a) {
     // outputs first (issue 23): a path that cannot be written is refused before any work
     check_output_file_in_new_folders(a.json_out, "--json");
     check_output_file_in_new_folders(a.report_out, "--report");
-    check_paths_apart({{a.data, "--data"}}, {{a.json_out, "--json"}, {a.report_out, "--report"}});
+    std::vector<NamedPath> outputs = {{a.json_out, "--json"}, {a.report_out, "--report"}};
+    if (!a.report_out.empty() && !a.no_plots)  // the report's plots and their data, beside it by its name
+        for (const auto& f : report_plot_files(a.report_out)) outputs.push_back({f.string(), "--report's plot file"});
+    check_paths_apart({{a.data, "--data"}}, outputs);
     analytics::MeasuredData data;
     analytics::DiagnoseResult r;
     try {
@@ -370,11 +393,10 @@ int run_diagnose(const DiagnoseArgs& a) {
         if (report.has_parent_path()) std::filesystem::create_directories(report.parent_path());
         std::string before_name, after_name;
         if (!a.no_plots) {
-            const std::string stem = report.stem().string();
-            before_name = stem + "_residuals_before.png";
-            after_name = stem + "_residuals_after.png";
-            const auto dir = report.parent_path();
-            plot_residuals(r, data, dir / (stem + "_residuals.dat"), dir / before_name, dir / after_name);
+            const ReportPlots plots = report_plots(report);
+            before_name = plots.before.filename().string();
+            after_name = plots.after.filename().string();
+            plot_residuals(r, data, plots.data, plots.before, plots.after);
         }
         write_text(a.report_out, markdown_report(r, a.data, before_name, after_name));
     }

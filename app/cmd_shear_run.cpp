@@ -115,6 +115,7 @@ void run(const std::string& params_path, const std::string& result_path, int thr
     }
     try {  // before the run, not after it: a result that cannot be written is a run wasted
         check_output_file(result_path, "result");
+        check_paths_apart({{params_path, "params (the input file)"}}, {{result_path, "result"}});
     } catch (const UserError& e) {
         fail(2, "output", e.what());
     }

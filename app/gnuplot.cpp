@@ -12,6 +12,13 @@ std::string gnuplot_quote(const std::filesystem::path& p) {
     return s + "'";
 }
 
+std::vector<std::filesystem::path> gnuplot_files(const std::filesystem::path& output) {
+    std::filesystem::path script = output, log = output;
+    script += ".gp";
+    log += ".gp.log";
+    return {output, script, log};
+}
+
 void render_gnuplot(const std::filesystem::path& output, const std::string& body, int width, int height) {
     const std::string ext = output.extension().string();
     std::string terminal;

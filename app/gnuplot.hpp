@@ -4,12 +4,17 @@
 #pragma once
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace demcal {
 
 // Writes `body` (gnuplot commands, without `set terminal`/`set output`) to OUTPUT.gp and renders OUTPUT.
 void render_gnuplot(const std::filesystem::path& output, const std::string& body, int width = 900,
                     int height = 650);
+
+// Every file render_gnuplot(output, ...) writes: OUTPUT, OUTPUT.gp and gnuplot's log OUTPUT.gp.log (for the check
+// that no output lands on an input or another output).
+std::vector<std::filesystem::path> gnuplot_files(const std::filesystem::path& output);
 
 // Quotes a path for use inside a gnuplot script.
 std::string gnuplot_quote(const std::filesystem::path& p);

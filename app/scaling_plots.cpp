@@ -10,12 +10,21 @@ namespace demcal {
 
 namespace fs = std::filesystem;
 
-void plot_enlargement(const fs::path& output, const std::vector<double>& r, const std::vector<double>& e,
-                      const std::vector<double>& nu, const analytics::ScalingLawFit& e_law,
-                      const analytics::ScalingLawFit& nu_law, const std::string& format) {
+std::vector<fs::path> enlargement_plot_files(const fs::path& output, const std::string& format) {
     fs::path data = output, picture = output;
     data.replace_extension(".dat");
     picture.replace_extension("." + format);
+    std::vector<fs::path> files = gnuplot_files(picture);
+    files.insert(files.begin(), data);
+    return files;
+}
+
+void plot_enlargement(const fs::path& output, const std::vector<double>& r, const std::vector<double>& e,
+                      const std::vector<double>& nu, const analytics::ScalingLawFit& e_law,
+                      const analytics::ScalingLawFit& nu_law, const std::string& format) {
+    const std::vector<fs::path> files = enlargement_plot_files(output, format);
+    const fs::path& data = files[0];
+    const fs::path& picture = files[1];
     std::ostringstream d;
     d << "# particle_radius_m young_modulus_Pa poisson_ratio\n" << std::setprecision(10);
     for (std::size_t i = 0; i < r.size(); ++i) d << r[i] << " " << e[i] << " " << nu[i] << "\n";

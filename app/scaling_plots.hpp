@@ -16,6 +16,9 @@ void plot_enlargement(const std::filesystem::path& output, const std::vector<dou
                       const std::vector<double>& nu, const analytics::ScalingLawFit& e_law,
                       const analytics::ScalingLawFit& nu_law, const std::string& format);
 
+// Every file plot_enlargement(output, ..., format) writes (the data, the picture and its gnuplot files).
+std::vector<std::filesystem::path> enlargement_plot_files(const std::filesystem::path& output, const std::string& format);
+
 // Fig. 3.4: mu_b and tau_c of the base parameters against r (1 SE bars), their linear-or-constant trends, the
 // reference line's values and the verification points of the laws' materials.
 void plot_macro_trends(const std::filesystem::path& picture, const calibration::EnlargementStudy& study);

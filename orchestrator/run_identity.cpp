@@ -112,7 +112,26 @@ std::string read_text_file(const std::filesystem::path& p) {
     return s.str();
 }
 
-void write_text_file_atomically(const std::filesystem::path& p, const std::string& text) {
+std::filesystem::path atomic_write_target(const std::filesystem::path& p) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path target = p;
+    // a link stays a link: its target gets the new text (a rename over the link would replace the link itself)
+    if (fs::is_symlink(fs::symlink_status(p, ec))) {
+        target = fs::weakly_canonical(fs::absolute(p, ec), ec);
+        if (ec) throw std::runtime_error("cannot write " + p.string() + " (a link that cannot be followed: " + ec.message() + ")");
+    }
+    // a rename over a device, a FIFO or a socket would replace the node itself (as root: /dev/null)
+    const fs::file_status st = fs::status(target, ec);
+    if (fs::exists(st) && !fs::is_regular_file(st))
+        throw std::runtime_error("cannot write " + p.string() + ": it is " +
+                                 (fs::is_directory(st) ? "a folder" : "not a regular file (a device, FIFO or socket)") +
+                                 "; nothing written");
+    return target;
+}
+
+void write_text_file_atomically(const std::filesystem::path& path, const std::string& text) {
+    const std::filesystem::path p = atomic_write_target(path);
     std::filesystem::path tmp = p;
     tmp += ".tmp" + std::to_string(::getpid());
     {

@@ -55,7 +55,11 @@ ResultFile read_result_file(const std::filesystem::path& file, const std::string
 nlohmann::json read_result_json(const std::filesystem::path& file, const std::string& what);
 
 std::string read_text_file(const std::filesystem::path& p);
-// Writes via a temporary file and rename, so a reader (or a crash) never sees half a file.
+// Writes via a temporary file and rename, so a reader (or a crash) never sees half a file. A symbolic link is
+// followed (its target is written, the link kept); a path that is a folder, a device, a FIFO or a socket is refused
+// (throws, nothing written): a rename would replace the node.
 void write_text_file_atomically(const std::filesystem::path& p, const std::string& text);
+// Where write_text_file_atomically writes `p` (the link's target for a link); throws as it does.
+std::filesystem::path atomic_write_target(const std::filesystem::path& p);
 
 }  // namespace demcal::orchestrator

@@ -9,6 +9,8 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -311,6 +313,13 @@ TEST_CASE("an output on an input's path or on another output's is refused before
     const std::string m1 = copy("examples/materials/sand-tiny.json", "m1.json");
     const std::string m2 = copy("examples/materials/sand.json", "m2.json");
     const std::string out = (dir / "o").string(), same = (dir / "same.json").string();
+    const std::string residuals = copy("examples/diagnose/oldal_clean.csv", "r_residuals.dat");
+    const std::string m1_dat = copy("examples/materials/sand-tiny.json", "e.dat");
+    nlohmann::json run_params = nlohmann::json::parse(test::read_file(m1));
+    for (const char* k : {"name", "description"}) run_params.erase(k);
+    run_params["normal_stress"] = 5e3;
+    run_params["seed"] = 1;
+    std::ofstream(dir / "p.json") << run_params.dump();
     const std::vector<std::string> silo{"silo", "--theta", "30", "--particles", "50", "--out", out, "--check"};
     const auto with = [&](std::vector<std::string> extra) {
         std::vector<std::string> a = silo;
@@ -324,9 +333,49 @@ TEST_CASE("an output on an input's path or on another output's is refused before
              {{"enlarge", "--no-plot", "-o", m1, m1, m2}, {"output", "is the input material"}},
              {with({"--export-final-bed", out}), {"--export-final-bed", "is also --out"}},
              {with({"--export-bed", same, "--export-final-bed", same}), {"--export-final-bed", "is also --export-bed"}},
-             {with({"--export-final-bed", out + "/summary.json"}), {"--export-final-bed", "--out's summary.json"}}},
+             {with({"--export-final-bed", out + "/summary.json"}), {"--export-final-bed", "--out's summary.json"}},
+             // the side files written beside an output by its name: a report's residual table, enlarge's plot data
+             {{"diagnose", "--model", "oldal", "--data", residuals, "--report", (dir / "r.md").string()},
+              {"--report's plot file", "r_residuals.dat", "is the input --data"}},
+             {{"diagnose", "--model", "oldal", "--data", data, "--report", (dir / "r.md").string(), "--json",
+               (dir / "r_residuals_after.png.gp").string()},
+              {"--report's plot file", "is also --json"}},
+             {{"enlarge", "-o", (dir / "e.json").string(), m1_dat, m2, m1},
+              {"output's plot file", "e.dat", "is the input material"}},
+             // shear-run's result on its own params, spelled another way
+             {{"shear-run", (dir / "p.json").string(), (dir / "." / "p.json").string()},
+              {"result", "is the input params"}}},
             dir);
     CHECK(test::read_file(geometry) == test::read_file(test::source_path("examples/diagnose/silo_105mm_wheat.json")));
+    fs::remove_all(root);
+}
+
+TEST_CASE("an output that is a device, a FIFO or a dangling link is refused; a link is written through", "[cli]") {
+    // a temporary file renamed over the path replaced the node itself: as root, `shear-run p.json /dev/null` turned
+    // /dev/null into a regular file
+    const fs::path root = test::fresh_test_dir("hostile-nodes"), dir = root / "work";
+    fs::create_directories(dir);
+    fs::copy_file(test::source_path("examples/diagnose/silo_105mm_wheat.json"), dir / "geometry.json");
+    const std::string geometry = (dir / "geometry.json").string(), fifo = (dir / "fifo").string();
+    REQUIRE(::mkfifo(fifo.c_str(), 0644) == 0);
+    fs::create_symlink(dir / "nowhere" / "x.json", dir / "dangling.json");
+    nlohmann::json run_params = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
+    for (const char* k : {"name", "description"}) run_params.erase(k);
+    run_params["normal_stress"] = 5e3;
+    run_params["seed"] = 1;
+    std::ofstream(dir / "p.json") << run_params.dump();
+    refused({{{"predict", geometry, "--json", fifo}, {"--json", "not a regular file"}},
+             {{"predict", geometry, "--json", "/dev/null"}, {"--json", "not a regular file"}},
+             {{"shear-run", (dir / "p.json").string(), "/dev/null"}, {"result", "not a regular file"}},
+             {{"predict", geometry, "--json", (dir / "dangling.json").string()}, {"--json", "a link to nothing"}}},
+            dir);
+    CHECK(fs::is_fifo(fifo));
+    // a link to a regular file stays a link, and its target gets the output
+    std::ofstream(dir / "target.json") << "{}";
+    fs::create_symlink(dir / "target.json", dir / "link.json");
+    CHECK(test::run_demcal({"predict", geometry, "--json", (dir / "link.json").string()}, root / "link.log") == 0);
+    CHECK(fs::is_symlink(dir / "link.json"));
+    CHECK_THAT(test::read_file(dir / "target.json"), Contains("beverloo"));
     fs::remove_all(root);
 }
 
