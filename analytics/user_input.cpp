@@ -99,6 +99,9 @@ private:
 }  // namespace
 
 nlohmann::json parse_json_text(std::string_view text, const std::string& what) {
+    // the parser stops at a NUL as at the end of the text: what follows would be ignored, not refused
+    if (const auto nul = text.find('\0'); nul != std::string_view::npos)
+        throw InputError(what + ": byte " + std::to_string(nul + 1) + " is a NUL byte: not JSON text");
     JsonRules rules(what);
     try {
         return nlohmann::json::parse(text.begin(), text.end(), std::ref(rules));

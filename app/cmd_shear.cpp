@@ -4,6 +4,7 @@
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
 #include "app/shear_report.hpp"
+#include "analytics/failure_line.hpp"
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
@@ -145,7 +146,8 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
                   << "); the runs it hit stay pending: fix it (--yade; the kernel engine: the demcal program), then `demcal resume " << dir.string() << "`\n";
         return kExitResumeLater;
     }
-    return outcome.failed > 0 ? 1 : 0;
+    // a campaign is run for its failure line: finished without one, it has not done its job
+    return outcome.failed > 0 || !(ev.peak && ev.residual) ? 1 : 0;
 }
 
 }  // namespace
@@ -192,6 +194,7 @@ void add_shear_commands(CLI::App& app) {
         try {
             validate_shear_spec(spec);  // everything is checked before anything is written
             if (spec.engine == ShearEngine::yade) find_yade(opt->exec.yade);
+            analytics::check_failure_line_design(spec.normal_stresses, spec.replicates);
         } catch (const std::invalid_argument& e) {
             throw UserError(e.what());
         }

@@ -214,7 +214,7 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
     fs::permissions(dir / "broken-yade", fs::perms::owner_all);
     fs::permissions(dir / "stand-in-yade", fs::perms::owner_all);
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
-    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4", "--yade", (dir / "broken-yade").string(),
+    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4,2e4", "--yade", (dir / "broken-yade").string(),
                                      "--campaign", campaign.string(), "--retries", "0"},
                                     dir / "out.log");
     INFO(test::read_file(dir / "out.log"));

@@ -120,7 +120,7 @@ TEST_CASE("output paths are tried for real before any work: a folder nobody can 
              {{"silo", "--theta", "30", "--particles", "200", "--out", params}, {"--out", "is a file, not a folder"}},
              {{"silo", "--resume", "/proc"}, {"resume"}},
              // a campaign folder that cannot be made was a filesystem error with exit 1
-             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4",
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4,2e4",
                "--engine", "kernel", "--campaign", "/proc/campaign"},
               {"campaign = '/proc/campaign': cannot create the campaign folder"}},
              {{"crosscheck", "silo", "--theta", "30", "--campaign", "/proc/xsilo"},
@@ -405,7 +405,14 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--threads", "2147483647"}, {"--threads"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--body-height", "1e5"},
               {"body_height = 100000", "20 silo sizes"}},
-             {{"predict", (dir / "wide_k.json").string()}, {"beverloo_k=100", "effective outlet would be empty"}}},
+             {{"predict", (dir / "wide_k.json").string()}, {"beverloo_k=100", "effective outlet would be empty"}},
+             // a shear campaign that cannot give a failure line ran and ended "no failure line" with exit 0
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,5e3,5e3",
+               "--engine", "kernel", "--campaign", camp},
+              {"at least 2 distinct normal stresses, got 1"}},
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4",
+               "--engine", "kernel", "--campaign", camp},
+              {"replicates = 1 at 2 normal stresses", "at least 3 points"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);

@@ -67,7 +67,7 @@ fs::path complete_campaign(const fs::path& dir, const fs::path& campaign) {
                            "\"residual_shear_stress\": 800}' > \"$last\"\n";
     fs::permissions(yade, fs::perms::owner_all);
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
-    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4", "--yade", yade.string(), "--campaign",
+    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4,2e4", "--yade", yade.string(), "--campaign",
                                      campaign.string(), "--plot", "svg"},
                                     dir / "shear.log");
     INFO(test::read_file(dir / "shear.log"));
@@ -87,7 +87,7 @@ TEST_CASE("status reads a store without writing to it, also while another connec
     const auto before = folder_state(campaign);
     CHECK(test::run_demcal({"status", campaign.string()}, dir / "status.log") == 0);
     INFO(test::read_file(dir / "status.log"));
-    CHECK_THAT(test::read_file(dir / "status.log"), Contains("[complete] shear: 2 runs, 2 done"));
+    CHECK_THAT(test::read_file(dir / "status.log"), Contains("[complete] shear: 3 runs, 3 done"));
     CHECK(changes(before, campaign) == "");  // status rewrote the file (SQLite's change counter) and its time
 
     // a campaign running: its committed changes are in the -wal, which status reads and leaves as it was
@@ -98,7 +98,7 @@ TEST_CASE("status reads a store without writing to it, also while another connec
     const std::string store = test::read_file(campaign / "campaign.sqlite");
     const std::string wal = test::read_file(campaign / "campaign.sqlite-wal");
     CHECK(test::run_demcal({"status", campaign.string()}, dir / "status.log") == 0);
-    CHECK_THAT(test::read_file(dir / "status.log"), Contains("[interrupted] shear: 2 runs, 2 done"));
+    CHECK_THAT(test::read_file(dir / "status.log"), Contains("[interrupted] shear: 3 runs, 3 done"));
     const bool store_unchanged = test::read_file(campaign / "campaign.sqlite") == store;
     const bool wal_unchanged = test::read_file(campaign / "campaign.sqlite-wal") == wal;
     CHECK(store_unchanged);
