@@ -303,6 +303,13 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
             store_->reset_to_pending(r.hash, "forced recomputation");
             rec.state = RunState::pending;
         }
+        // a failure that is not the physics' verdict (a timeout, a crash, a lost SLURM task) is tried again by a new
+        // invocation (resume, or the same command; perhaps with a longer --timeout): one more attempt, then its
+        // retries as counted so far
+        if (rec.state == RunState::failed && !retry_is_pointless(rec.cause)) {
+            store_->reset_to_pending(r.hash, "tried again: its last attempt ended by " + rec.cause);
+            rec.state = RunState::pending;
+        }
         if (rec.state == RunState::done) ++out.reused;
         if (rec.state == RunState::pending) queue.push_back(r.hash);
     }

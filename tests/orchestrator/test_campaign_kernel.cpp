@@ -74,3 +74,23 @@ TEST_CASE("the kernel engine refuses a YADE template and bad run parameters, nam
     CHECK(log.find("box_width") != std::string::npos);
     CHECK_FALSE(fs::exists(dir / "result.json"));
 }
+
+TEST_CASE("runs that timed out are tried again by resume (a longer --timeout), runs the physics failed are not",
+          "[kernel_engine]") {
+    // a timeout was stored as a final failure: `resume --timeout 100` ran nothing and ended "3 failed", exit 1
+    const fs::path dir = test::fresh_test_dir("kernel-campaign-timeout");
+    const std::string camp = (dir / "c").string();
+    CHECK(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "--jobs", "2", "--timeout",
+                            "0.001", "--retries", "0", "--campaign", camp},
+                           dir / "first.log") == 1);
+    for (const auto& r : test::stored_runs(camp)) {
+        CHECK(r.state == RunState::failed);
+        CHECK(r.cause == "timeout");
+    }
+    const int rc = test::run_demcal({"resume", camp, "--timeout", "600", "--jobs", "2"}, dir / "resume.log");
+    INFO(test::read_file(dir / "resume.log"));
+    CHECK(rc == 0);
+    for (const auto& r : test::stored_runs(camp)) CHECK(r.state == RunState::done);
+    CHECK_THAT(test::read_file(dir / "resume.log"), Catch::Matchers::Contains("Peak failure line"));
+    fs::remove_all(dir);
+}
