@@ -257,9 +257,21 @@ void validate_measured(const MeasuredData& data, MeasuredKind kind) {
     }
 }
 
-MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind) {
-    std::istringstream in(read_input_file(path, "data file " + shortened_text(path, 200), kMaxMeasuredDataBytes));
+MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind, std::size_t max_rows) {
+    const std::string named = "data file " + shortened_text(path, 200);
+    const std::string text = read_input_file(path, named, kMaxMeasuredDataBytes);
+    if (text.find('\r') != std::string::npos && text.find('\n') == std::string::npos)
+        throw std::invalid_argument(named + ": its lines end in CR alone (an old Mac text file); save it with LF or "
+                                            "CRLF line ends");
+    std::istringstream in(text);
     auto data = parse_csv(in, path);
+    if (data.columns.size() > kMaxMeasuredColumns)
+        throw std::invalid_argument(named + ": " + std::to_string(data.columns.size()) + " columns, more than " +
+                                    std::to_string(kMaxMeasuredColumns) + " (each is a candidate effect)");
+    if (data.rows() > max_rows)
+        throw std::invalid_argument(named + ": " + std::to_string(data.rows()) + " rows, more than the limit of " +
+                                    std::to_string(max_rows) + " (about 2 ms of diagnosis per row; raise it with "
+                                    "--max-rows)");
     validate_measured(data, kind);
     return data;
 }

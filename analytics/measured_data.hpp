@@ -48,9 +48,15 @@ void validate_measured(const MeasuredData& data, MeasuredKind kind);
 // Measured data sets are a few hundred rows; a larger file is a wrong file.
 inline constexpr std::size_t kMaxMeasuredDataBytes = std::size_t{64} << 20;
 
+// A diagnosis costs about 2 ms per row and grows with every column (each is a candidate effect): the limits keep a
+// wrong file from running for hours. Rows can be raised (diagnose --max-rows); columns cannot (no data set has 200).
+inline constexpr std::size_t kMaxMeasuredRows = 10000;
+inline constexpr std::size_t kMaxMeasuredColumns = 200;
+
 // parse_csv + validate_measured on a file (read by analytics::read_input_file: a folder, a device or a file over
-// kMaxMeasuredDataBytes is refused).
-MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind);
+// kMaxMeasuredDataBytes is refused; so are more than max_rows rows, more than kMaxMeasuredColumns columns and lines
+// ended by CR alone).
+MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind, std::size_t max_rows = kMaxMeasuredRows);
 
 // The data back as CSV (numbers with 10 significant digits), e.g. to write generated sets.
 std::string to_csv(const MeasuredData& data);

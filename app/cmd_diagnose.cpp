@@ -328,6 +328,7 @@ struct DiagnoseArgs {
     double effective_friction_deg = std::nan(""), wall_friction_deg = std::nan("");  // NaN: not given
     bool no_plots = false;
     bool allow_undetermined = false;  // exit 0 even when the diagnosis is not determined by the data
+    int max_rows = int(analytics::kMaxMeasuredRows);
     SiloDemArgs silo_dem;  // --model silo-dem: the kernel's silo as the model
 };
 
@@ -353,7 +354,7 @@ int run_diagnose(const DiagnoseArgs& a) {
     analytics::DiagnoseResult r;
     try {
         const auto kind = analytics::data_kind_of(a.model);
-        data = analytics::read_measured_csv(a.data, kind);
+        data = analytics::read_measured_csv(a.data, kind, std::size_t(a.max_rows));
         auto options = a.options;
         if (!std::isnan(a.effective_friction_deg)) options.effective_friction_deg = a.effective_friction_deg;
         if (!std::isnan(a.wall_friction_deg)) options.wall_friction_deg = a.wall_friction_deg;
@@ -438,6 +439,10 @@ void add_discharge_commands(CLI::App& app) {
                          "least relative drop of the cross-validated RMSE for an effect to be added")
         ->capture_default_str()
         ->check(number_in(0.0, 0.9));
+    diagnose->add_option("--max-rows", args->max_rows,
+                         "most data rows (about 2 ms of diagnosis per row: a limit against a wrong file)")
+        ->capture_default_str()
+        ->check(integer_in(1, 10000000));
     diagnose->add_option("--max-effects", args->options.max_effects, "most effects to add")
         ->capture_default_str()
         ->check(number_in(0, 10));

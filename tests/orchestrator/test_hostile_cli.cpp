@@ -440,3 +440,49 @@ TEST_CASE("diagnose: a fit the data cannot determine is reported as such and end
     CHECK(test::run_demcal(allowed, root / "log") == 0);
     fs::remove_all(root);
 }
+
+TEST_CASE("diagnose: a data file of more rows than the limit, too many columns or CR-only lines is refused at once",
+          "[cli]") {
+    // 100,000 rows ran for minutes (about 2 ms a row) and 300,000 columns likewise; a CR-only file was "duplicate
+    // column 1"
+    const fs::path root = test::fresh_test_dir("hostile-diagnose-size"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string clean = test::read_file(test::source_path("examples/diagnose/oldal_clean.csv"));
+    std::vector<std::string> lines;
+    for (std::size_t at = 0, next; at < clean.size(); at = next + 1) {
+        next = clean.find('\n', at);
+        if (next == std::string::npos) next = clean.size();
+        if (next > at && clean[at] != '#') lines.push_back(clean.substr(at, next - at));
+    }
+    REQUIRE(lines.size() > 2);
+    {
+        std::ofstream rows(dir / "rows.csv");
+        rows << lines[0] << "\n";
+        for (int i = 0; i < 10001; ++i) rows << lines[1 + i % (lines.size() - 1)] << "\n";
+    }
+    {
+        std::ofstream wide(dir / "wide.csv");
+        wide << lines[0];
+        for (int c = 0; c < 250; ++c) wide << ",x" << c;
+        wide << "\n";
+        for (std::size_t i = 1; i < lines.size(); ++i) {
+            wide << lines[i];
+            for (int c = 0; c < 250; ++c) wide << "," << c;
+            wide << "\n";
+        }
+    }
+    std::string cr = lines[0];
+    for (std::size_t i = 1; i < lines.size(); ++i) cr += "\r" + lines[i];
+    std::ofstream(dir / "cr.csv") << cr << "\r";
+    const auto diagnose = [&](const std::string& file) {
+        return std::vector<std::string>{"diagnose", "--model", "oldal", "--no-plots", "--data", (dir / file).string()};
+    };
+    auto with_limit = diagnose("rows.csv");
+    with_limit.insert(with_limit.end(), {"--max-rows", "100"});
+    refused({{diagnose("rows.csv"), {"10001 rows", "more than the limit of 10000", "--max-rows"}},
+             {with_limit, {"10001 rows", "limit of 100 "}},
+             {diagnose("wide.csv"), {"columns, more than 200"}},
+             {diagnose("cr.csv"), {"CR alone"}}},
+            dir);
+    fs::remove_all(root);
+}
