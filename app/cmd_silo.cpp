@@ -517,6 +517,9 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         throw UserError("out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
                         " to start over");
+    if (fs::is_regular_file(dir / "summary.json"))  // a new run would leave the old results beside its own until its end
+        throw UserError("out = '" + dir.string() + "' holds the results of a finished run (summary.json): give "
+                        "another --out, or remove them to run again there");
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
@@ -740,16 +743,21 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"contact_law", r.contact_law}};
     if (!s.vtk_dir.empty()) j["vtk"] = {{"dir", s.vtk_dir}, {"files", r.vtk_files}};
     try {
+        // (the table first, then the summary that marks the run finished; a failure removes the table again below)
         orchestrator::write_text_file_atomically(dir / "discharge.csv", ks::discharge_csv_text(r.discharge));
         // sealed: the campaigns that read it back (vibration, cutoff, crosscheck, diagnose silo-dem) find a damaged one
         orchestrator::write_text_file_atomically(dir / "summary.json",
                                                  orchestrator::sealed_result_text(j.dump(2) + "\n"));
     } catch (const std::exception& e) {
-        // the checkpoint stays: resuming from it computes the end again and writes the results
+        std::error_code ec;
+        fs::remove(dir / "discharge.csv", ec);  // no table without its summary: a reader takes the pair for a result
+        // a checkpoint on disk stays: resuming from it computes the end again and writes the results
+        const bool resumable = !s.checkpoint_file.empty() && fs::exists(s.checkpoint_file, ec);
         throw std::runtime_error(std::string(e.what()) + "; the results are not written" +
-                                 (s.checkpoint_file.empty() ? std::string()
-                                                            : "; the checkpoint is kept: make room, then `demcal silo "
-                                                              "--resume " + dir.string() + "` finishes the run again"));
+                                 (resumable ? "; the checkpoint is kept: make room, then `demcal silo --resume " +
+                                                  dir.string() + "` finishes the run again"
+                                            : "; no checkpoint was written (none was due: --checkpoint-every), so "
+                                              "the run must be made again"));
     }
     // the results are written: the checkpoint has served its purpose (and would block a new run in this directory)
     if (!s.checkpoint_file.empty()) {

@@ -176,6 +176,13 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     const std::string summary = read_file(dir / "out" / "summary.json");
     CHECK_THAT(summary, Catch::Matchers::Contains("\"wall_to_axis_velocity_ratio\""));
     CHECK_THAT(summary, Catch::Matchers::Contains("\"grains\": 300"));
+    // a new run into the finished folder is refused (it left the old results beside its own checkpoint until its end)
+    const Run again = run_silo("--theta 40 --particles 300 --threads 1 --no-plots --out '" + (dir / "out").string() +
+                                   "'",
+                               dir);
+    CHECK(again.rc == 2);
+    CHECK_THAT(again.err, Catch::Matchers::Contains("holds the results of a finished run"));
+    CHECK(read_file(dir / "out" / "summary.json") == summary);
     fs::remove_all(dir);
 }
 
@@ -220,6 +227,7 @@ TEST_CASE("demcal silo: results that cannot be written keep the checkpoint, and 
     CHECK(r.rc == 1);
     CHECK_THAT(r.err, Catch::Matchers::Contains("the results are not written"));
     CHECK_THAT(r.err, Catch::Matchers::Contains("the checkpoint is kept"));
+    CHECK_FALSE(fs::exists(out / "discharge.csv"));  // no table without its summary
     REQUIRE(fs::exists(out / "checkpoint.bin"));
     fs::remove_all(out / "summary.json");
     const Run resumed = run_silo("--resume '" + out.string() + "' --threads 1", dir);
