@@ -9,6 +9,7 @@
 #include "app/silo_settings.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
+#include "orchestrator/folder_lock.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <nlohmann/json.hpp>
@@ -508,6 +509,15 @@ void print_progress(const ks::SiloProgress& p) {
 
 void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots);
 
+// The output folder's lock, for the whole run (or resume); a folder another demcal holds is refused.
+std::unique_ptr<orchestrator::FolderLock> lock_output_folder(const fs::path& dir) {
+    try {
+        return std::make_unique<orchestrator::FolderLock>(dir, "silo output folder");
+    } catch (const std::runtime_error& e) {
+        throw UserError(e.what());
+    }
+}
+
 // A new run into `dir` (refused when dir holds the checkpoint of an unfinished run: it would be overwritten).
 void run_silo(const SiloCli& o, CLI::App& sub) {
     ks::SiloCaseSettings s = settings_from(o, sub);
@@ -569,6 +579,10 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
             throw UserError("vtk = '" + s.vtk_dir + "': cannot create the directory: " + ec.message());
         }
     }
+    // one demcal per output folder: a second one (a repeated command, a sweep started twice) stops here
+    const auto lock = lock_output_folder(dir);
+    if (fs::exists(dir / kCheckpointName) || fs::is_regular_file(dir / "summary.json"))
+        throw UserError("out = '" + dir.string() + "': another demcal has just run into this folder");
     if (!o.no_checkpoint) {
         s.checkpoint_file = (dir / kCheckpointName).string();
         s.checkpoint_interval = o.checkpoint_every;
@@ -626,6 +640,8 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     // the results, the next checkpoints and the snapshots go where the run wrote before: still writable?
     check_output_folder(dir.string(), "--resume");
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "vtk (the run's snapshot folder, in its checkpoint)");
+    const auto lock = lock_output_folder(dir);  // two resumes of one run read and wrote one checkpoint at once
+    if (!fs::exists(file)) throw UserError("resume = '" + dir.string() + "': another demcal has just finished it");
     s.threads = threads;
     s.checkpoint_file = file.string();  // removed once the outputs are written
     s.wall_limit = o.wall_limit;

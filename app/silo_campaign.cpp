@@ -3,6 +3,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "orchestrator/executor.hpp"
+#include "orchestrator/folder_lock.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically, read_result_json
 #include "orchestrator/shear_campaign.hpp"  // pinned_program
 #include "orchestrator/slurm_executor.hpp"
@@ -273,6 +274,13 @@ void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& to
 SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<SiloRunPlan>& plans,
                                       const std::vector<std::string>& session_args, int jobs,
                                       const std::string& command, const SiloCampaignExecutor& where) {
+    // one demcal per campaign: two sweeps on one folder ran the same runs into the same run folders at once
+    std::unique_ptr<orchestrator::FolderLock> lock;
+    try {
+        lock = std::make_unique<orchestrator::FolderLock>(dir, "campaign directory");
+    } catch (const std::runtime_error& e) {
+        throw UserError(e.what());
+    }
     SiloCampaignOutcome outcome;
     std::vector<const SiloRunPlan*> todo;
     for (const SiloRunPlan& plan : plans) {

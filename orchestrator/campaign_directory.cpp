@@ -4,10 +4,6 @@
 #include "orchestrator/executor.hpp"
 #include "orchestrator/slurm_executor.hpp"
 
-#include <fcntl.h>
-#include <sys/file.h>
-#include <unistd.h>
-
 #include <stdexcept>
 
 namespace demcal::orchestrator {
@@ -23,22 +19,12 @@ CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& 
     if (ec || !fs::is_directory(dir_))
         throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +
                                     "': cannot create the campaign folder" + (ec ? ": " + ec.message() : std::string()));
-    const fs::path lock = dir_ / ".lock";
-    // O_CLOEXEC: children must not inherit the lock, or a resume right after kill -9 of the orchestrator finds the
-    // directory "in use" until the last orphan has died.
-    const bool lock_existed = fs::exists(lock, ec);
-    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (lock_fd_ < 0) throw std::runtime_error("cannot open " + lock.string());
-    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-        ::close(lock_fd_);
-        throw std::runtime_error("campaign directory " + dir_.string() + " is in use by another demcal process");
-    }
+    lock_ = std::make_unique<FolderLock>(dir_, "campaign directory");
     try {
         store_ = std::make_unique<CampaignStore>(dir_ / "campaign.sqlite");
     } catch (...) {
         // a file that is not our store was refused: leave its folder as it was found (no lock file of ours in it)
-        if (!lock_existed) ::unlink(lock.c_str());
-        ::close(lock_fd_);
+        lock_->release_and_forget();
         throw;
     }
     for (const auto& r : store_->runs_in_state(RunState::running)) {
@@ -60,8 +46,8 @@ CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& 
 }
 
 CampaignDirectory::~CampaignDirectory() {
-    store_.reset();
-    if (lock_fd_ >= 0) ::close(lock_fd_);
+    store_.reset();  // the store closed before the lock is given up
+    lock_.reset();
 }
 
 }  // namespace demcal::orchestrator

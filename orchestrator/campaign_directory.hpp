@@ -4,6 +4,7 @@
 // cross-check).
 #pragma once
 #include "orchestrator/campaign_store.hpp"
+#include "orchestrator/folder_lock.hpp"
 
 #include <filesystem>
 #include <functional>
@@ -32,7 +33,7 @@ public:
 
 private:
     std::filesystem::path dir_;
-    int lock_fd_ = -1;
+    std::unique_ptr<FolderLock> lock_;
     std::unique_ptr<CampaignStore> store_;
 };
 

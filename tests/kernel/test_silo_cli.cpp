@@ -5,6 +5,8 @@
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
+
+#include "orchestrator/folder_lock.hpp"
 #include <nlohmann/json.hpp>
 
 #include <signal.h>
@@ -183,6 +185,33 @@ TEST_CASE("demcal silo: a tiny run writes discharge.csv and summary.json", "[sil
     CHECK(again.rc == 2);
     CHECK_THAT(again.err, Catch::Matchers::Contains("holds the results of a finished run"));
     CHECK(read_file(dir / "out" / "summary.json") == summary);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("demcal silo: an output folder another demcal holds is refused at once, and so is a silo campaign's",
+          "[silo][cli]") {
+    // two `silo --resume D` resumed one checkpoint together, two vibration sweeps ran the same runs into one folder
+    require_demcal();
+    const fs::path dir = fs::temp_directory_path() / "demcal_test_silo_cli_lock";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "out");
+    fs::create_directories(dir / "camp");
+    {
+        const demcal::orchestrator::FolderLock held(dir / "out", "test");
+        const Run r = run_silo("--theta 40 --particles 300 --threads 1 --no-plots --out '" + (dir / "out").string() +
+                                   "'",
+                               dir);
+        CHECK(r.rc == 2);
+        CHECK_THAT(r.err, Catch::Matchers::Contains("silo output folder") &&
+                              Catch::Matchers::Contains("is in use by another demcal process"));
+        const demcal::orchestrator::FolderLock campaign(dir / "camp", "test");
+        const std::string sweep = "'" + std::string(DEMCAL_BINARY) + "' vibration --theta 40 --frequency 0 "
+                                  "--campaign '" + (dir / "camp").string() + "' -- --particles 300 --no-plots "
+                                  "--threads 1 > '" + (dir / "sweep.log").string() + "' 2>&1";
+        CHECK(WEXITSTATUS(std::system(sweep.c_str())) == 2);
+        CHECK_THAT(read_file(dir / "sweep.log"), Catch::Matchers::Contains("is in use by another demcal process"));
+    }
+    CHECK_FALSE(fs::exists(dir / "out" / "summary.json"));
     fs::remove_all(dir);
 }
 

@@ -1,0 +1,40 @@
+#include "orchestrator/folder_lock.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+namespace demcal::orchestrator {
+
+FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& what) : file_(folder / ".lock") {
+    std::error_code ec;
+    made_file_ = !std::filesystem::exists(std::filesystem::symlink_status(file_, ec));
+    // O_CLOEXEC: children must not inherit the lock, or a resume right after kill -9 of the holder finds the folder
+    // "in use" until the last orphan has died
+    fd_ = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+        throw std::runtime_error(what + " " + folder.string() + ": cannot open its lock " + file_.string() + " (" +
+                                 std::strerror(errno) + ")");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+        ::close(fd_);
+        fd_ = -1;
+        throw std::runtime_error(what + " " + folder.string() + " is in use by another demcal process");
+    }
+}
+
+FolderLock::~FolderLock() {
+    if (fd_ >= 0) ::close(fd_);
+}
+
+void FolderLock::release_and_forget() {
+    if (fd_ < 0) return;
+    if (made_file_) ::unlink(file_.c_str());
+    ::close(fd_);
+    fd_ = -1;
+}
+
+}  // namespace demcal::orchestrator
