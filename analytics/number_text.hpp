@@ -53,6 +53,8 @@ struct TypedNumber {
 inline TypedNumber read_typed_number(const std::string& text) {
     TypedNumber n;
     if (text.empty() || std::isspace(static_cast<unsigned char>(text.front()))) return n;
+    // strtod reads hexadecimal (0x10, 0x1p9) too; JSON and the integer options do not: one rule, decimal only
+    if (text.find_first_of("xX") != std::string::npos) return n;
     char* end = nullptr;
     errno = 0;
     n.value = std::strtod(text.c_str(), &end);

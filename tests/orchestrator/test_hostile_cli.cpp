@@ -71,7 +71,10 @@ TEST_CASE("every number and integer option follows the number rule, whatever its
              {{"silo", "--theta", "30", "--out", camp, "--vibration-start", "nan", "--vibration-frequency", "50",
                "--vibration-amplitude", "1e-4"},
               {"--vibration-start", "'nan' is not a number"}},
-             {{"shear-run", "p.json", "r.json", "--threads", "nan"}, {"--threads", "'nan' is not an integer"}}},
+             {{"shear-run", "p.json", "r.json", "--threads", "nan"}, {"--threads", "'nan' is not an integer"}},
+             // hexadecimal passed where strtod read it (the JSON and CSV readers and the integer options refuse it)
+             {{"cutoff", "--bracket", "0,0x1p9"}, {"--bracket", "give LO,HI in Hz"}},
+             {{"shear", tiny, "-s", "5e3,1e4,2e4", "-j", "0x10", "--campaign", camp}, {"--jobs", "'0x10' is not a number"}}},
             dir);
     fs::remove_all(root);
 }
