@@ -31,7 +31,7 @@ SCHEMA = "demcal.shear_result/2"
 # name: (unit, kind, lower bound, lower bound inclusive, upper bound, upper bound inclusive, meaning)
 PARAM_SPECS = {
     "density": ("kg/m^3", float, 10.0, True, 1e5, True, "particle material density"),
-    "young_modulus": ("Pa", float, 0.0, False, 1e13, True,
+    "young_modulus": ("Pa", float, 0.0, False, 1e12, True,
                       "Young modulus of particles and walls; linear contact kn = 2 Ea Ra Eb Rb / (Ea Ra + Eb Rb)"),
     "poisson_ratio": ("-", float, 0.0, False, 0.5, True,
                       "YADE's linear-law stiffness ratio ks/kn (CohFrictMat.poisson), not a physical Poisson ratio"),
@@ -53,7 +53,7 @@ PARAM_SPECS = {
     "shear_velocity": ("m/s", float, 0.0, False, 10.0, True, "velocity of the upper frame along x"),
     "shear_displacement": ("m", float, 0.0, False, 10.0, True, "total displacement of the upper frame"),
     "seed": ("-", int, 0, True, 2147483647, True, "seed of the random packing (positions and clump orientations)"),
-    "damping": ("-", float, 0.0, True, 1.0, False, "NewtonIntegrator (Cundall non-viscous) damping"),
+    "damping": ("-", float, 0.0, True, 0.9, True, "NewtonIntegrator (Cundall non-viscous) damping"),
     "samples": ("-", int, 10, True, 100000, True, "points of the sampled shear curve"),
 }
 # Keys that only document a material file (the orchestrator accepts and drops them too); never physics.

@@ -489,3 +489,23 @@ TEST_CASE("diagnose: a data file of more rows than the limit, too many columns o
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("shear-run: a damping that becomes the strength and a modulus stiffer than diamond are refused by name",
+          "[cli]") {
+    // damping 0.9999999 gave a peak of 4.77 MPa at 5 kPa with exit 0; young_modulus 1e13 made a 2 s box a 15 min run
+    const fs::path root = test::fresh_test_dir("hostile-shear-params"), dir = root / "work";
+    fs::create_directories(dir);
+    nlohmann::json p = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
+    for (const char* k : {"name", "description"}) p.erase(k);
+    p["normal_stress"] = 5e3;
+    p["seed"] = 1;
+    auto damped = p, stiff = p;
+    damped["damping"] = 0.99;
+    stiff["young_modulus"] = 1e13;
+    std::ofstream(dir / "damped.json") << damped.dump();
+    std::ofstream(dir / "stiff.json") << stiff.dump();
+    refused({{{"shear-run", (dir / "damped.json").string(), (dir / "r.json").string()}, {"damping", "0.99"}},
+             {{"shear-run", (dir / "stiff.json").string(), (dir / "r.json").string()}, {"young_modulus"}}},
+            dir);
+    fs::remove_all(root);
+}
