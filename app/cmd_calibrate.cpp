@@ -2,6 +2,7 @@
 // and the particle-enlargement laws (seed eqs. 3.1-3.2). Every simulation is a stored, cached, resumable campaign run.
 #include "analytics/number_text.hpp"
 #include "analytics/scaling_law.hpp"
+#include "analytics/user_input.hpp"
 #include "app/campaign_cli.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
@@ -379,8 +380,33 @@ void add_enlarge(CLI::App& app) {
         check_paths_apart(inputs, outputs);
         std::vector<double> r, e, nu;
         std::map<double, std::string> file_of_radius;
+        nlohmann::json first_rest;  // the first material without the fields the laws are about
+        std::string first_file;
         for (const auto& file : o->materials) {
             const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
+            // one material at several radii: every other field the same (friction, density, box ...), or the laws
+            // would mix materials and say nothing of enlargement
+            nlohmann::json rest = m;
+            for (const char* k : {"particle_radius", "young_modulus", "poisson_ratio", "name", "description"})
+                rest.erase(k);
+            if (first_file.empty()) {
+                first_rest = rest;
+                first_file = file;
+            } else {
+                for (const auto& [key, value] : first_rest.items())
+                    if (!rest.contains(key) || rest[key] != value)
+                        throw UserError("materials: " + key + " = " +
+                                        (rest.contains(key) ? analytics::json_value_text(rest[key]) : "(absent)") +
+                                        " in '" + analytics::shortened_text(file, 200) + "' but " +
+                                        analytics::json_value_text(value) + " in '" +
+                                        analytics::shortened_text(first_file, 200) +
+                                        "': the laws are fitted to one material at several radii (only "
+                                        "particle_radius, young_modulus and poisson_ratio may differ)");
+                for (const auto& [key, value] : rest.items())
+                    if (!first_rest.contains(key))
+                        throw UserError("materials: " + key + " is in '" + analytics::shortened_text(file, 200) +
+                                        "' but not in '" + analytics::shortened_text(first_file, 200) + "'");
+            }
             const double radius = m.at("particle_radius").get<double>();
             // the same radius twice (often the same file twice) is a point counted twice: it fakes the degrees of
             // freedom the intervals stand on (two radii given three times fitted "exactly", +/- 1e-15)

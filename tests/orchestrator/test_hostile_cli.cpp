@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -507,5 +508,24 @@ TEST_CASE("shear-run: a damping that becomes the strength and a modulus stiffer 
     refused({{{"shear-run", (dir / "damped.json").string(), (dir / "r.json").string()}, {"damping", "0.99"}},
              {{"shear-run", (dir / "stiff.json").string(), (dir / "r.json").string()}, {"young_modulus"}}},
             dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("enlarge: materials that differ in more than the radius, E and nu are refused with the field named",
+          "[cli]") {
+    // friction 0.5 / 0.9 / 0.5 at three radii was fitted into E(r) and nu(r) with exit 0
+    const fs::path root = test::fresh_test_dir("hostile-enlarge-mixed"), dir = root / "work";
+    fs::create_directories(dir);
+    nlohmann::json m = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand.json")));
+    std::vector<std::string> args{"enlarge", "--no-plot", "-o", (dir / "laws.json").string()};
+    for (double r : {0.002, 0.0025, 0.003}) {
+        m["particle_radius"] = r;
+        m["young_modulus"] = 1e10 * r + 5e6;
+        m["poisson_ratio"] = 0.01 / std::sqrt(r);
+        m["friction_coefficient"] = r == 0.0025 ? 0.9 : 0.5;
+        args.push_back((dir / ("m" + std::to_string(args.size()) + ".json")).string());
+        std::ofstream(args.back()) << m.dump();
+    }
+    refused({{args, {"friction_coefficient = 0.9", "one material at several radii"}}}, dir);
     fs::remove_all(root);
 }
