@@ -31,6 +31,31 @@ using orchestrator::check_run_count;
 
 namespace {
 
+// A study read with --sensitivity must be of the --start material: its responses hold around its base, so any field
+// it did not vary (box, density, radius, a parameter left out) must equal the start's. Throws UserError naming it.
+void check_study_matches_start(const SensitivityStudy& study, const nlohmann::json& start, const std::string& file) {
+    nlohmann::json base = study.base_material, here = start;
+    for (const auto& p : study.parameters) {
+        base.erase(p.name);
+        here.erase(p.name);
+    }
+    for (const char* k : {"name", "description"}) {
+        base.erase(k);
+        here.erase(k);
+    }
+    for (const auto& [key, value] : here.items())
+        if (!base.contains(key) || base[key] != value)
+            throw UserError("sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
+                            key + " = " + (base.contains(key) ? analytics::json_value_text(base[key]) : "(absent)") +
+                            ", the start material " + analytics::json_value_text(value) +
+                            ": a study holds for the material it varied (run it for this start, or start from its "
+                            "base)");
+    for (const auto& [key, value] : base.items())
+        if (!here.contains(key))
+            throw UserError("sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
+                            key + ", the start material has not");
+}
+
 // ---- sensitivity ----
 
 struct SensitivityCli {
@@ -261,12 +286,28 @@ void add_calibrate(CLI::App& app) {
                             std::to_string(camp.replicates) + " replicates");
         check_campaign(camp, start);
         SensitivityStudy study;
+        const auto pick_controls = [&] {
+            std::vector<ControlParameter> picked;
+            if (o->controls.empty()) return choose_controls(study, targets, o->tol, {}, bounds);
+            for (const auto& name : o->controls) {
+                const auto* p = study.find(name);
+                auto b = bounds.find(name);
+                if (!p && b == bounds.end())
+                    throw UserError("controls: '" + name + "' is neither in the study nor given --bounds");
+                picked.push_back({name, b != bounds.end() ? b->second.first : p->low(),
+                                  b != bounds.end() ? b->second.second : p->high()});
+            }
+            return picked;
+        };
+        std::vector<ControlParameter> controls;
         if (!o->sensitivity_file.empty()) {
             try {
                 study = SensitivityStudy::from_json(read_json_file(o->sensitivity_file, "sensitivity"));
             } catch (const nlohmann::json::exception& e) {  // a key missing or of the wrong type
                 throw UserError("sensitivity = '" + o->sensitivity_file + "': " + e.what());
             }
+            check_study_matches_start(study, start, o->sensitivity_file);
+            controls = pick_controls();  // a study that cannot serve is refused before the campaign folder exists
         }
         CampaignSession session(camp, "calibrate");
         const fs::path dir = camp.campaign_dir;
@@ -275,19 +316,7 @@ void add_calibrate(CLI::App& app) {
             study = run_study(start, o->study, session.evaluate);
             write_study(dir, study, camp.plot_format);
             std::cout << "\n" << study.table() << std::endl;
-        }
-        std::vector<ControlParameter> controls;
-        if (o->controls.empty()) {
-            controls = choose_controls(study, targets, o->tol, {}, bounds);
-        } else {
-            for (const auto& name : o->controls) {
-                const auto* p = study.find(name);
-                auto b = bounds.find(name);
-                if (!p && b == bounds.end())
-                    throw UserError("controls: '" + name + "' is neither in the study nor given --bounds");
-                controls.push_back({name, b != bounds.end() ? b->second.first : p->low(),
-                                    b != bounds.end() ? b->second.second : p->high()});
-            }
+            controls = pick_controls();
         }
         std::cout << "calibrating";
         for (std::size_t i = 0; i < targets.size(); ++i)

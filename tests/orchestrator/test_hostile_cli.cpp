@@ -529,3 +529,27 @@ TEST_CASE("enlarge: materials that differ in more than the radius, E and nu are 
     refused({{args, {"friction_coefficient = 0.9", "one material at several radii"}}}, dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("calibrate --sensitivity: a study of another material, or one that moves no target, is refused before the "
+          "campaign folder exists",
+          "[cli]") {
+    // a study of a base with young_modulus 1e20 steered a calibration of another material (exit 0); an unusable study
+    // was refused only after campaign.sqlite had been made
+    const fs::path root = test::fresh_test_dir("hostile-calibrate-study"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string stored = "examples/calibration/kernel-sand-bonded-far/sensitivity.json";
+    nlohmann::json study = nlohmann::json::parse(test::read_file(test::source_path(stored)));
+    auto foreign = study;
+    foreign["base_material"]["density"] = 2000;
+    std::ofstream(dir / "foreign.json") << foreign.dump();
+    const std::string camp = (dir / "camp").string(), start = test::source_path("examples/materials/sand-bonded.json");
+    const auto calibrate = [&](const std::string& file, const std::string& target) {
+        return std::vector<std::string>{"calibrate", "--start", start, "--target", target, "--engine", "kernel",
+                                        "--sensitivity", file, "-s", "5e3,1e4,1.5e4", "--campaign", camp};
+    };
+    refused({{calibrate((dir / "foreign.json").string(), "mu_b=1.3,tau_c=2e4"),
+              {"its base material has density = 2000", "the start material"}}},
+            dir);
+    CHECK_FALSE(fs::exists(camp));
+    fs::remove_all(root);
+}
