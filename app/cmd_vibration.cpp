@@ -218,10 +218,12 @@ void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<doubl
     }
 }
 
-void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
+// Returns how many cells have a rate (a mean over at least one run whose rate was determined).
+int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
     std::map<std::pair<double, long long>, RunResult> still_of;  // (theta, seed)
     std::vector<RunResult> results;
     json all = json::array();
+    int cells_with_rate = 0;
     for (const RunSpec& r : runs) {
         const RunResult res = read_run(dir, r);
         results.push_back(res);
@@ -269,6 +271,7 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
         const auto [mean, sd] = mean_sd(rates);
         std::size_t n = 0;
         for (double x : rates) n += std::isfinite(x);
+        cells_with_rate += n > 0;
         const double outlet_density = mean_sd(densities).first, outlet_speed = mean_sd(speeds).first;
         // a still cell is its own reference: no change to report
         const PairedChange rate_change = f > 0 ? paired_change(rates, still_rates) : PairedChange{};
@@ -302,6 +305,7 @@ void report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpe
     orchestrator::write_text_file_atomically(dir / "vibration.md", md.str());
     std::cout << md.str();
     plot_rates(o, dir, data_by_theta);
+    return cells_with_rate;
 }
 
 int run(const VibrationCli& o) {
@@ -325,7 +329,11 @@ int run(const VibrationCli& o) {
         return kExitResumeLater;
     }
     std::cout << outcome.finished << " runs finished, " << outcome.failed << " failed\n";
-    report(o, dir, runs);
+    if (report(o, dir, runs) == 0 && outcome.finished > 0) {
+        std::cout << "no cell has a rate: no run's discharge rate was determined (see each run's summary.json, "
+                     "rate.message), so the sweep measured nothing (exit 1)\n";
+        return 1;
+    }
     return outcome.failed == 0 ? 0 : 1;
 }
 

@@ -160,3 +160,17 @@ TEST_CASE("demcal vibration --executor slurm: the sweep's runs as SLURM array ta
   CHECK(fs::exists(dir / "slurm" / "runs" / "theta45_f100_seed1" / "stdout.log"));
   fs::remove_all(dir);
 }
+
+TEST_CASE("demcal vibration: a sweep in which no run's rate is determined ends with exit 1, saying so",
+          "[silo][vibration][cli]") {
+  // every cell n = 0 and "rate mean -" ended with exit 0
+  const fs::path dir = fs::temp_directory_path() / ("demcal-test-vibration-none-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string sweep = "vibration --theta 30 --frequency 0 --repeats 1 --campaign '" + (dir / "v").string() +
+                            "' -- --particles 50 --fill-time 0.02 --max-time 0.02 --no-plots --threads 1";
+  CHECK(demcal_run(sweep, dir / "run.log") == 1);
+  CHECK_THAT(demcal::test::read_file(dir / "run.log"), Catch::Matchers::Contains("no cell has a rate"));
+  CHECK(fs::exists(dir / "v" / "vibration.json"));  // the table is still written
+  fs::remove_all(dir);
+}
