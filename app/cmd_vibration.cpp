@@ -131,6 +131,14 @@ struct RunResult {
 RunResult read_run(const fs::path& dir, const RunSpec& r) {
     RunResult out;
     if (const auto s = silo_run_summary(dir, r.name())) {
+        // the run in this cell's folder is this cell's run (a summary copied from another cell was counted as this one)
+        const auto same = [](double a, double b) { return std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), 1.0); };
+        for (const auto& [field, want] : {std::pair{std::string("geometry/theta_deg"), r.theta},
+                                          std::pair{std::string("vibration/frequency_hz"), r.frequency},
+                                          std::pair{std::string("settings/seed"), double(r.seed)}})
+            if (!same(s->number(field), want))
+                s->fail(field, "= " + analytics::number_text(s->number(field)) + ", but the cell's run has " + analytics::number_text(want) +
+                                   ": not this cell's run");
         out.finished = true;
         // no rate where the run ended without a steady discharge
         out.rate = s->optional_number("rate/rate_kg_s").value_or(NAN) * 1e3;

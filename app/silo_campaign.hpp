@@ -70,11 +70,12 @@ public:
     // Empty when the field is absent (summaries of an older demcal); any other type than a number is an error.
     std::optional<double> optional_number(const std::string& field) const;
     std::string text(const std::string& field) const;
+    // Throws UserError naming the file and the field: "FIELD WHY" (a caller's own check of a value).
+    [[noreturn]] void fail(const std::string& field, const std::string& why) const;
 
 private:
     bool has(const std::string& field) const;
     const nlohmann::json& find(const std::string& field) const;
-    [[noreturn]] void fail(const std::string& field, const std::string& why) const;
     nlohmann::json j_;
     std::filesystem::path file_;
 };

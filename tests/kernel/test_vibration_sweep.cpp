@@ -105,6 +105,13 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
                Catch::Matchers::Contains(summary.string()) && Catch::Matchers::Contains(expect));
     CHECK(demcal::test::read_file(campaign / "vibration.json") == before);
   }
+  // a whole, sealed summary of another cell (the still run of the same seed) in this cell's folder
+  fs::copy_file(campaign / "runs" / "theta45_f0_seed2" / "summary.json", summary,
+                fs::copy_options::overwrite_existing);
+  CHECK(demcal_run(sweep, dir / "foreign.log") == 2);
+  CHECK_THAT(demcal::test::read_file(dir / "foreign.log"),
+             Catch::Matchers::Contains("vibration/frequency_hz = 0") &&
+                 Catch::Matchers::Contains("not this cell's run"));
   fs::remove_all(dir);
 }
 
