@@ -1,6 +1,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 
+#include <filesystem>
 #include <iostream>
 
 int main(int argc, char** argv) {
@@ -27,6 +28,12 @@ int main(int argc, char** argv) {
         return app.exit(e) == 0 ? 0 : 2;
     } catch (const demcal::UserError& e) {
         std::cerr << "demcal: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::filesystem::filesystem_error& e) {
+        // a path the user gave that the file system will not take (a file where a folder belongs, a link loop, a
+        // read-only folder): the path and the reason, not the library's text
+        std::cerr << "demcal: error: '" << e.path1().string() << "': " << e.code().message()
+                  << " (a file where a folder belongs, a link loop or a read-only folder in the path?)\n";
         return 2;
     } catch (const std::invalid_argument& e) {  // the libraries' word for bad input
         std::cerr << "demcal: error: " << e.what() << "\n";

@@ -553,3 +553,18 @@ TEST_CASE("calibrate --sensitivity: a study of another material, or one that mov
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);
 }
+
+TEST_CASE("a campaign path the file system will not take is named with its reason, exit 2, not a library's text",
+          "[cli]") {
+    // status on a symlink loop printed "failed: filesystem error: status: Too many levels of symbolic links", exit 1
+    const fs::path root = test::fresh_test_dir("hostile-fs-paths"), dir = root / "work";
+    fs::create_directories(dir);
+    const fs::path loops = root / "loops";  // (beside the watched folder: its listing cannot follow a loop)
+    fs::create_directories(loops);
+    fs::create_symlink(loops / "loopB", loops / "loopA");
+    fs::create_symlink(loops / "loopA", loops / "loopB");
+    refused({{{"status", (loops / "loopA").string()}, {"loop", "symbolic links"}},
+             {{"resume", (loops / "loopA").string()}, {"loop", "symbolic links"}}},
+            dir);
+    fs::remove_all(root);
+}
