@@ -132,8 +132,8 @@ run_case shear-kernel/template       2 "template"       -- "${K[@]}" -s 5e3,1e4 
 run_case shear-kernel/material-folder 2 "folder.json"   -- shear "$work/folder.json" --engine kernel -s 5e3,1e4 --campaign camp
 run_case shear-kernel/material-deep  2 "nest"           -- shear "$work/deep.json" --engine kernel -s 5e3,1e4 --campaign camp
 run_case shear-kernel/material-subnormal 2 "density"    -- shear "$work/subnormal.json" --engine kernel -s 5e3,1e4 --campaign camp
-run_case shear-kernel/campaign-readonly 2 "campaign" "$ro" -- shear "$tiny" --engine kernel -s 5e3,1e4 --campaign "$ro/camp"
-run_case shear-kernel/campaign-file  2 "campaign"       -- shear "$tiny" --engine kernel -s 5e3,1e4 --campaign "$tiny"
+run_case shear-kernel/campaign-readonly 2 "campaign" "$ro" -- shear "$tiny" --engine kernel -s 5e3,1e4,2e4 --campaign "$ro/camp"
+run_case shear-kernel/campaign-file  2 "campaign"       -- shear "$tiny" --engine kernel -s 5e3,1e4,2e4 --campaign "$tiny"
 run_case shear-kernel/timeout-subnormal 2 "--timeout"   -- "${K[@]}" -s 5e3,1e4 --timeout 1e-320
 run_case shear-kernel/retries-huge   2 "--retries"      -- "${K[@]}" -s 5e3,1e4 --retries 1e9
 run_case shear-kernel/retries-many   2 "--retries"      -- "${K[@]}" -s 5e3,1e4 --retries 1000000000
