@@ -6,6 +6,7 @@
 #include "app/shear_report.hpp"
 #include "analytics/failure_line.hpp"
 #include "calibration/failure_line_evaluation.hpp"
+#include "orchestrator/folder_lock.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
 #include "orchestrator/shear_params.hpp"
@@ -230,7 +231,13 @@ void add_shear_commands(CLI::App& app) {
             }
             std::cout << o.campaign.name << " [" << o.campaign.status << "] " << to_string(o.campaign.kind) << ": "
                       << o.runs.size() << " runs";
-            for (const auto& [s, n] : by_state) std::cout << ", " << n << " " << s;
+            // runs marked running while no demcal holds the folder belong to one that died: the next resume reruns them
+            const bool holder = orchestrator::FolderLock::held(*status_dir);
+            for (const auto& [s, n] : by_state)
+                std::cout << ", " << n << " "
+                          << (s == "running" && !holder ? "interrupted (no demcal holds the campaign: `demcal resume` "
+                                                          "reruns them)"
+                                                        : s);
             std::cout << "; run time " << duration_text(wall) << ", CPU " << duration_text(o.cpu_s) << "\n";
             const bool shear = o.campaign.kind == CampaignKind::shear;
             for (const auto& r : o.runs)

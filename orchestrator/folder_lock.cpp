@@ -26,6 +26,14 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& w
     }
 }
 
+bool FolderLock::held(const std::filesystem::path& folder) {
+    const int fd = ::open((folder / ".lock").c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return false;  // never locked here (or not readable: nothing to say)
+    const bool free = ::flock(fd, LOCK_SH | LOCK_NB) == 0;
+    ::close(fd);  // (closing drops the shared lock taken to test)
+    return !free;
+}
+
 FolderLock::~FolderLock() {
     if (fd_ >= 0) ::close(fd_);
 }

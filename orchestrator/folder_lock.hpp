@@ -16,6 +16,9 @@ public:
     FolderLock(const FolderLock&) = delete;
     FolderLock& operator=(const FolderLock&) = delete;
 
+    // Whether a process holds `folder`'s lock now; reads only (no lock file is made), for a report such as status.
+    static bool held(const std::filesystem::path& folder);
+
     // Gives the lock up and removes the lock file if this lock made it (a folder refused after its lock was taken is
     // left as it was found).
     void release_and_forget();

@@ -130,6 +130,10 @@ TEST_CASE("kill -9 of the orchestrator mid-campaign, then resume: nothing finish
     for (const auto& r : test::stored_runs(cdir))
         if (r.state == RunState::done) done_before[r.hash] = r.result;  // anything committed up to the kill
     REQUIRE(done_before.size() < 4);
+    // status sees that no demcal holds the folder: the runs left "running" are named interrupted, not running
+    REQUIRE(test::run_demcal({"status", cdir.string()}, dir / "status.log") == 0);
+    CHECK_THAT(test::read_file(dir / "status.log"), Catch::Matchers::Contains("interrupted (no demcal holds"));
+    CHECK_THAT(test::read_file(dir / "status.log"), !Catch::Matchers::Contains(" running"));
 
     REQUIRE(test::run_demcal({"resume", cdir.string()}, dir / "resume.log") == 0);
     INFO(test::read_file(dir / "resume.log"));
