@@ -220,6 +220,24 @@ void check_overlap(const nlohmann::json& p, double normal_stress, const std::str
 }
 }  // namespace
 
+namespace {
+// A bond holds until its tensile force normal_cohesion r^2 stretches the linear spring kn = E r: a stretch of
+// (bond_normal_strength / young_modulus) r before it breaks. Above one radius (a strain at break above 1) no solid
+// bridge is meant, and every pair within that stretch must be watched each step: the kernel's neighbour reach grows
+// with it (1e12 Pa on sand-tiny: 1 ms per step instead of 0.08 ms, a run of hours).
+void check_bond_stretch(const nlohmann::json& m, const std::string& where) {
+    const double young = m.at("young_modulus").get<double>();
+    for (const char* bond : {"bond_normal_strength", "bond_shear_strength"}) {
+        const double strength = m.at(bond).get<double>();
+        if (strength > young)
+            throw std::invalid_argument(where + ": " + bond + " = " + analytics::number_text(strength) +
+                                        " Pa is above young_modulus = " + analytics::number_text(young) +
+                                        " Pa: a bond would stretch by more than a particle radius before it breaks "
+                                        "(strength / young_modulus > 1)");
+    }
+}
+}  // namespace
+
 ShearRunWork estimate_shear_work(const nlohmann::json& m, std::optional<double> normal_stress) {
     auto d = [&](const char* k) { return m.at(k).get<double>(); };
     const double r = d("particle_radius"), spread = d("radius_spread"), form = d("particle_form");
@@ -268,6 +286,7 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
         out[s.name] = s.integer ? nlohmann::json(static_cast<long>(*s.default_value)) : nlohmann::json(*s.default_value);
     }
     check_geometry(out, where);
+    check_bond_stretch(out, where);
     check_work(out, std::nullopt, where);
     return out;
 }

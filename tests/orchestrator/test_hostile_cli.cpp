@@ -500,13 +500,17 @@ TEST_CASE("shear-run: a damping that becomes the strength and a modulus stiffer 
     for (const char* k : {"name", "description"}) p.erase(k);
     p["normal_stress"] = 5e3;
     p["seed"] = 1;
-    auto damped = p, stiff = p;
+    auto damped = p, stiff = p, bonded = p;
     damped["damping"] = 0.99;
     stiff["young_modulus"] = 1e13;
+    bonded["bond_normal_strength"] = 1e12;  // (the declared maximum: 1 ms a step, the neighbour reach of the bonds)
     std::ofstream(dir / "damped.json") << damped.dump();
     std::ofstream(dir / "stiff.json") << stiff.dump();
+    std::ofstream(dir / "bonded.json") << bonded.dump();
     refused({{{"shear-run", (dir / "damped.json").string(), (dir / "r.json").string()}, {"damping", "0.99"}},
-             {{"shear-run", (dir / "stiff.json").string(), (dir / "r.json").string()}, {"young_modulus"}}},
+             {{"shear-run", (dir / "stiff.json").string(), (dir / "r.json").string()}, {"young_modulus"}},
+             {{"shear-run", (dir / "bonded.json").string(), (dir / "r.json").string()},
+              {"bond_normal_strength = 1e+12", "above young_modulus", "more than a particle radius"}}},
             dir);
     fs::remove_all(root);
 }
