@@ -286,7 +286,6 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
         out[s.name] = s.integer ? nlohmann::json(static_cast<long>(*s.default_value)) : nlohmann::json(*s.default_value);
     }
     check_geometry(out, where);
-    check_bond_stretch(out, where);
     check_work(out, std::nullopt, where);
     return out;
 }
@@ -299,6 +298,7 @@ nlohmann::json make_run_params(const nlohmann::json& validated_material, double 
     check_value(*find_shear_param("normal_stress"), p["normal_stress"], where);
     check_value(*find_shear_param("seed"), p["seed"], where);
     check_overlap(p, normal_stress, where);
+    check_bond_stretch(p, where);  // (after the overlap: an absurd modulus is named as such first)
     check_work(p, normal_stress, where);
     return p;
 }
