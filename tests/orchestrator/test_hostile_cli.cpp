@@ -36,6 +36,15 @@ std::vector<std::string> listing(const fs::path& dir) {
     return out;
 }
 
+// The params of one sand-tiny run at 5 kPa, seed 1 (what shear-run reads), its documentation fields dropped.
+nlohmann::json tiny_run_params() {
+    nlohmann::json p = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
+    for (const char* k : {"name", "description"}) p.erase(k);
+    p["normal_stress"] = 5e3;
+    p["seed"] = 1;
+    return p;
+}
+
 struct Case {
     std::vector<std::string> args;
     std::vector<std::string> expect;  // every one must be in the message
@@ -101,13 +110,7 @@ TEST_CASE("output paths are tried for real before any work: a folder nobody can 
     const fs::path root = test::fresh_test_dir("hostile-outputs"), dir = root / "work";
     fs::create_directories(dir);
     const std::string params = (dir / "params.json").string();
-    {
-        nlohmann::json p = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
-        for (auto it = p.begin(); it != p.end();) it = it.key().rfind('_', 0) == 0 ? p.erase(it) : std::next(it);
-        p["normal_stress"] = 5e3;
-        p["seed"] = 1;
-        std::ofstream(params) << p.dump();
-    }
+    std::ofstream(params) << tiny_run_params().dump();
     const std::string geometry = test::source_path("examples/silo/seed_conical_30deg.json").string();
     refused({{{"cutoff", "--bond-number", "10", "--json", "/proc/cutoff.json"},
               {"--json = '/proc/cutoff.json'", "the folder /proc is not writable"}},
@@ -319,11 +322,7 @@ TEST_CASE("an output on an input's path or on another output's is refused before
     const std::string out = (dir / "o").string(), same = (dir / "same.json").string();
     const std::string residuals = copy("examples/diagnose/oldal_clean.csv", "r_residuals.dat");
     const std::string m1_dat = copy("examples/materials/sand-tiny.json", "e.dat");
-    nlohmann::json run_params = nlohmann::json::parse(test::read_file(m1));
-    for (const char* k : {"name", "description"}) run_params.erase(k);
-    run_params["normal_stress"] = 5e3;
-    run_params["seed"] = 1;
-    std::ofstream(dir / "p.json") << run_params.dump();
+    std::ofstream(dir / "p.json") << tiny_run_params().dump();
     const std::vector<std::string> silo{"silo", "--theta", "30", "--particles", "50", "--out", out, "--check"};
     const auto with = [&](std::vector<std::string> extra) {
         std::vector<std::string> a = silo;
@@ -363,11 +362,7 @@ TEST_CASE("an output that is a device, a FIFO or a dangling link is refused; a l
     const std::string geometry = (dir / "geometry.json").string(), fifo = (dir / "fifo").string();
     REQUIRE(::mkfifo(fifo.c_str(), 0644) == 0);
     fs::create_symlink(dir / "nowhere" / "x.json", dir / "dangling.json");
-    nlohmann::json run_params = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
-    for (const char* k : {"name", "description"}) run_params.erase(k);
-    run_params["normal_stress"] = 5e3;
-    run_params["seed"] = 1;
-    std::ofstream(dir / "p.json") << run_params.dump();
+    std::ofstream(dir / "p.json") << tiny_run_params().dump();
     refused({{{"predict", geometry, "--json", fifo}, {"--json", "not a regular file"}},
              {{"predict", geometry, "--json", "/dev/null"}, {"--json", "not a regular file"}},
              {{"shear-run", (dir / "p.json").string(), "/dev/null"}, {"result", "not a regular file"}},
@@ -496,10 +491,7 @@ TEST_CASE("shear-run: a damping that becomes the strength and a modulus stiffer 
     // damping 0.9999999 gave a peak of 4.77 MPa at 5 kPa with exit 0; young_modulus 1e13 made a 2 s box a 15 min run
     const fs::path root = test::fresh_test_dir("hostile-shear-params"), dir = root / "work";
     fs::create_directories(dir);
-    nlohmann::json p = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
-    for (const char* k : {"name", "description"}) p.erase(k);
-    p["normal_stress"] = 5e3;
-    p["seed"] = 1;
+    const nlohmann::json p = tiny_run_params();
     auto damped = p, stiff = p, bonded = p;
     damped["damping"] = 0.99;
     stiff["young_modulus"] = 1e13;
