@@ -279,12 +279,19 @@ void validate(const SiloCaseSettings& s) {
                        "must lie in [1, 2.6] (length / width of the 3-sphere grain; the seed's 1.833)");
     validate(s.geometry, grain_length(s.materials));
     if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
-    if (s.fill_mass == 0 && s.particles < 1) reject_setting("particles", double(s.particles), "must be at least 1");
+    // a bed is many grains: one grain has no bulk density, no flow pattern and no steady rate (`--particles 1` ran,
+    // reported a bulk density of 0 and no rate, exit 0)
+    constexpr int kMinGrains = 10;
+    if (s.fill_mass == 0 && s.particles < kMinGrains)
+        reject_setting("particles", double(s.particles),
+                       "must be at least " + std::to_string(kMinGrains) + " (a bed, not a few grains)");
     constexpr double kMaxGrains = 5e6;  // 15e6 spheres: about 9 GB of state, beyond any machine this runs on
     if (s.particles > kMaxGrains) reject_setting("particles", double(s.particles), "more than 5,000,000 grains");
     const double grain_mass = s.materials.wheat.density * wheat_grain_volume();
-    if (s.fill_mass > 0 && s.fill_mass < 0.5 * grain_mass)  // would round to no grain (it was silently one)
-        reject_setting("fill_mass", s.fill_mass, "less than one grain of " + setting_text(grain_mass * 1e3) + " g");
+    if (s.fill_mass > 0 && s.fill_mass < (kMinGrains - 0.5) * grain_mass)  // (below one grain it was silently one)
+        reject_setting("fill_mass", s.fill_mass,
+                       "less than " + std::to_string(kMinGrains) + " grains of " + setting_text(grain_mass * 1e3) +
+                           " g (a bed, not a few grains)");
     if (s.fill_mass / grain_mass > kMaxGrains)
         reject_setting("fill_mass", s.fill_mass,
                        "more than 5,000,000 grains of " + setting_text(grain_mass * 1e3) + " g");

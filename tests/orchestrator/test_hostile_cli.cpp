@@ -153,14 +153,15 @@ TEST_CASE("silo: a time step that never lets the run end, or a snapshot every st
     fs::remove_all(root);
 }
 
-TEST_CASE("silo: a fill mass of 0 or of less than one grain is refused, not run as the default or as one grain",
+TEST_CASE("silo: a fill mass of 0 or of less than ten grains, or fewer than ten particles, is refused",
           "[cli]") {
     // --fill-mass 0 was the setting's "not given" and ran 50,000 grains; 1e-9 kg ran one grain
     const fs::path root = test::fresh_test_dir("hostile-silo-fill-mass"), dir = root / "work";
     fs::create_directories(dir);
     const std::string out = (dir / "o").string();
     refused({{{"silo", "--theta", "30", "--out", out, "--fill-mass", "0"}, {"--fill-mass = 0: must be > 0 kg"}},
-             {{"silo", "--theta", "30", "--out", out, "--fill-mass", "1e-9"}, {"fill_mass", "less than one grain"}}},
+             {{"silo", "--theta", "30", "--out", out, "--fill-mass", "1e-9"}, {"fill_mass", "less than 10 grains"}},
+             {{"silo", "--theta", "30", "--out", out, "--particles", "1"}, {"particles = 1", "at least 10"}}},
             dir);
     fs::remove_all(root);
 }
