@@ -354,7 +354,7 @@ TEST_CASE("an output on an input's path or on another output's is refused before
     fs::remove_all(root);
 }
 
-TEST_CASE("an output that is a device, a FIFO or a dangling link is refused; a link is written through", "[cli]") {
+TEST_CASE("an output that is a device, a FIFO or a dangling link is refused, and a link is written through", "[cli]") {
     // a temporary file renamed over the path replaced the node itself: as root, `shear-run p.json /dev/null` turned
     // /dev/null into a regular file
     const fs::path root = test::fresh_test_dir("hostile-nodes"), dir = root / "work";
