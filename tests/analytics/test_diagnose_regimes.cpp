@@ -203,11 +203,13 @@ TEST_CASE("diagnose: rates of the flow-mode effect and of false positives", "[.]
     std::ostringstream both;
     both << "\n| beverloo + hopper_angle+vibration_by_mode | seeds | both named | only the angle | phi_d within 2 se "
             "of the generating | CV RMSE at most half |\n|---|---|---|---|---|---|\n";
+    for (double noise : {0.02, 0.03})
     for (double size : {0.2, 0.25, 0.3}) {
         int named = 0, angle_only = 0, phi_within = 0, halved = 0;
         for (int seed = 1; seed <= seeds; ++seed) {
             const auto r = diagnose(
-                make_synthetic_set(spec("beverloo", "hopper_angle+vibration_by_mode", size, 4000 + seed)), "beverloo");
+                make_synthetic_set(spec("beverloo", "hopper_angle+vibration_by_mode", size, 4000 + seed, noise)),
+                "beverloo");
             const auto* vibration = find_effect(r, "vibration_Hz", "regime");
             const auto* angle = find_effect(r, "theta_deg", "physical");
             named += vibration && vibration->regime == "flow_mode" && angle;
@@ -216,7 +218,7 @@ TEST_CASE("diagnose: rates of the flow-mode effect and of false positives", "[.]
                 phi_within += std::abs(angle->params[0].value - generating_phi_d(size)) < 2 * angle->params[0].std_error;
             halved += r.after.cv_rmse <= 0.5 * r.before.cv_rmse;
         }
-        both << "| " << size * 100 << " % each, noise 3 % | " << seeds << " | " << named << " | " << angle_only << " | "
+        both << "| " << size * 100 << " % each, noise " << noise * 100 << " % | " << seeds << " | " << named << " | " << angle_only << " | "
              << phi_within << " | " << halved << " |\n";
     }
     std::cout << both.str();
