@@ -29,6 +29,20 @@ std::optional<json> read_result(const fs::path& file) {
     }
 }
 
+// Why a job the store has as done must run again, or "" to reuse it: its result file gone or damaged, not the result
+// the store recorded when the run ended (a result file that carries no seal, e.g. YADE's silo.py's, is checked this
+// way: a report reads the file, so a file changed since would be reported as the run's), or another output gone.
+std::string why_done_job_is_stale(const StoredJob& job, const RunRecord& rec) {
+    const fs::path file = job.dir / job.result_file;
+    const std::optional<json> now = read_result(file);
+    if (!now) return "its output " + file.string() + " is gone or damaged";
+    if (!rec.result.is_null() && *now != rec.result)
+        return "its output " + file.string() + " is not the result recorded when the run ended";
+    for (const auto& f : job.outputs)
+        if (!fs::exists(f)) return "its output " + f.string() + " is gone";
+    return "";
+}
+
 std::string seconds_text(double s) {
     std::ostringstream o;
     o.precision(3);
@@ -71,11 +85,9 @@ StoredJobsOutcome run_stored_jobs(CampaignStore& store, std::int64_t campaign_id
         if (!by_hash.emplace(job.hash, &job).second) continue;  // the same run twice: once
         RunRecord rec = store.ensure_run(campaign_id, job.hash, job.params, job.dir, job.label);
         if (rec.state == RunState::done) {
-            std::string gone = read_result(job.dir / job.result_file) ? "" : (job.dir / job.result_file).string();
-            for (const auto& f : job.outputs)
-                if (gone.empty() && !fs::exists(f)) gone = f.string();
-            if (!gone.empty()) {
-                store.reset_to_pending(job.hash, "its output " + gone + " is gone");
+            const std::string why = why_done_job_is_stale(job, rec);
+            if (!why.empty()) {
+                store.reset_to_pending(job.hash, why);
                 rec.state = RunState::pending;
             }
         }

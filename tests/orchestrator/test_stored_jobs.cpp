@@ -118,3 +118,31 @@ TEST_CASE("stored jobs: a result file nested 100000 deep or with a repeated key 
     CHECK(out.executed == 0);
     fs::remove_all(root);
 }
+
+TEST_CASE("stored jobs: a done job whose result file is no longer the result the store recorded runs again",
+          "[store]") {
+    // YADE's silo.py writes no seal, and the cross-check's report reads the file: a file changed after the run (a bit
+    // flipped, another run's result copied in) must not be reported as this run's
+    const fs::path root = fs::temp_directory_path() / ("demcal-test-stored-changed-" + std::to_string(::getpid()));
+    fs::remove_all(root);
+    std::vector<StoredJob> jobs = {shell_job(root, "counted", "echo '{\"rate\": 0.25}' > result.json"),
+                                   shell_job(root, "kept", "echo '{\"rate\": 0.5}' > result.json")};
+    {
+        CampaignDirectory d(root, stored_job_result);
+        StoredJobsOutcome out;
+        run_all(d, jobs, out);
+        CHECK(out.executed == 2);
+    }
+    std::ofstream(root / "counted" / "result.json") << "{\"rate\": 0.35}\n";  // valid JSON, not the run's result
+    CampaignDirectory d(root, stored_job_result);
+    StoredJobsOutcome out;
+    auto events = run_all(d, jobs, out);
+    CHECK(events["counted"] == "done");  // ran again
+    CHECK(events.count("kept") == 0);    // reused
+    CHECK(out.reused == 1);
+    CHECK(out.executed == 1);
+    const auto run = d.store().run(jobs[0].hash);
+    REQUIRE(run);
+    CHECK(run->result["rate"] == 0.25);
+    fs::remove_all(root);
+}
