@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -46,6 +47,7 @@ struct Task {
     long array_id;
     int index;
     std::chrono::steady_clock::time_point submitted;
+    std::chrono::steady_clock::time_point last_listed;  // when squeue last listed it (or its submission)
     bool cancel_sent = false;
 };
 
@@ -80,13 +82,13 @@ bool read_exit_status(const Job& job, JobOutcome& o) {
 }
 
 // Task index -> SLURM state for an array job, from `squeue -r` (one line per task; finished tasks stay listed for
-// MinJobAge seconds).
-std::map<int, std::string> array_task_states(long array_id) {
+// MinJobAge seconds); nothing when squeue itself failed (the controller unreachable: the tasks may still run).
+std::optional<std::map<int, std::string>> array_task_states(long array_id) {
     int code = 0;
     const std::string out =
         capture("squeue -h -r -t all -j " + std::to_string(array_id) + " -o '%i %T'", &code);
     std::map<int, std::string> states;
-    if (code != 0) return states;
+    if (code != 0) return std::nullopt;
     std::istringstream in(out);
     std::string id, state;
     while (in >> id >> state) {
@@ -105,7 +107,44 @@ bool is_terminal(const std::string& state) {
            state != "SUSPENDED" && state != "REQUEUED" && state != "RESIZING";
 }
 
+std::string shortened(const std::string& text) {
+    return text.size() <= 300 ? text : text.substr(0, 300) + "... (" + std::to_string(text.size()) + " characters)";
+}
+
 }  // namespace
+
+std::optional<long> parse_sbatch_job_id(const std::string& output) {
+    // `sbatch --parsable` prints "jobid" or "jobid;cluster"; warnings (stderr, merged) may come before it
+    std::optional<long> id;
+    std::istringstream in(output);
+    std::string line;
+    while (std::getline(in, line)) {
+        const std::string head = line.substr(0, line.find(';'));
+        if (head.empty() || head.size() > 18 || head.find_first_not_of("0123456789") != std::string::npos) continue;
+        const long v = std::stol(head);
+        if (v > 0) id = v;
+    }
+    return id;
+}
+
+long parse_max_array_size(const std::string& config) {
+    // a line "MaxArraySize            = 1001" of `scontrol show config`; SLURM's default where it is not found
+    std::istringstream in(config);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::istringstream words(line);
+        std::string key, eq, value;
+        if (!(words >> key >> eq >> value) || key != "MaxArraySize" || eq != "=") continue;
+        if (value.empty() || value.size() > 9 || value.find_first_not_of("0123456789") != std::string::npos) break;
+        const long v = std::stol(value);
+        return v >= 1 ? v : kSlurmDefaultMaxArraySize;
+    }
+    return kSlurmDefaultMaxArraySize;
+}
+
+bool task_vanished(bool listed_now, double seconds_since_listed) {
+    return !listed_now && seconds_since_listed > kTaskVanishedAfterS;
+}
 
 SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition)
     : slots_(slots), work_dir_(std::move(work_dir)), partition_(std::move(partition)) {
@@ -115,15 +154,15 @@ SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition
     if (code != 0)
         throw std::invalid_argument("executor = 'slurm' but sbatch is not on PATH (install slurm-client and reach a "
                                     "SLURM controller)");
+    // an array of more tasks than the cluster's MaxArraySize is refused by sbatch: larger batches are split
+    const std::string config = capture("scontrol show config", &code);
+    max_array_size_ = code == 0 ? parse_max_array_size(config) : kSlurmDefaultMaxArraySize;
 }
 
 void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events) {
     fs::create_directories(work_dir_);
     std::vector<Task> tasks;
-    auto submit_ready_jobs = [&] {
-        std::vector<Job> batch;
-        while (auto j = next_job()) batch.push_back(*j);
-        if (batch.empty()) return;
+    auto submit_batch = [&](const std::vector<Job>& batch) {
         const std::string stem = "batch-" + std::to_string(::getpid()) + "-" + std::to_string(batches_++);
         const fs::path list = work_dir_ / (stem + ".tasks"), script = work_dir_ / (stem + ".sbatch");
         std::ostringstream l;
@@ -142,26 +181,42 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
           << "exec bash \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" " << shell_quote(list.string()) << ")\"\n";
         write_text_file_atomically(script, s.str());
         const std::string out = capture("sbatch --parsable " + shell_quote(script.string()));
-        const long array_id = std::stol(out.substr(0, out.find_first_of(";\n")));
+        const std::optional<long> array_id = parse_sbatch_job_id(out);
+        if (!array_id) throw std::runtime_error("sbatch printed no job id: " + shortened(out));
+        const auto now = std::chrono::steady_clock::now();
         for (std::size_t i = 0; i < batch.size(); ++i) {
-            tasks.push_back({batch[i], array_id, static_cast<int>(i), std::chrono::steady_clock::now()});
-            if (events.started) events.started(batch[i], array_id * kTaskBase + static_cast<long>(i));
+            tasks.push_back({batch[i], *array_id, static_cast<int>(i), now, now});
+            if (events.started) events.started(batch[i], *array_id * kTaskBase + static_cast<long>(i));
         }
+    };
+    auto submit_ready_jobs = [&] {
+        std::vector<Job> batch;
+        while (auto j = next_job()) {
+            batch.push_back(*j);
+            if (static_cast<long>(batch.size()) == std::min<long>(max_array_size_, kTaskBase)) {
+                submit_batch(batch);
+                batch.clear();
+            }
+        }
+        if (!batch.empty()) submit_batch(batch);
     };
 
     submit_ready_jobs();
     while (!tasks.empty()) {
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
         const bool stop = interrupted();
-        std::map<long, std::map<int, std::string>> states;
+        std::map<long, std::optional<std::map<int, std::string>>> states;
         for (std::size_t i = 0; i < tasks.size();) {
             Task& t = tasks[i];
             JobOutcome o;
             bool ended = read_exit_status(t.job, o);
             if (!ended) {
                 if (!states.count(t.array_id)) states[t.array_id] = array_task_states(t.array_id);
-                const auto& s = states[t.array_id];
+                static const std::map<int, std::string> unknown;
+                const auto& s = states[t.array_id] ? *states[t.array_id] : unknown;
                 const auto it = s.find(t.index);
+                const auto now = std::chrono::steady_clock::now();
+                if (it != s.end() || !states[t.array_id]) t.last_listed = now;  // (squeue failed: no news)
                 // a task that ended between the file's read and SLURM's answer left its record by then: read again
                 if (it != s.end() && is_terminal(it->second) && read_exit_status(t.job, o)) {
                     ended = true;
@@ -173,6 +228,18 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
                     o.failure_cause = o.timed_out ? "timeout" : o.interrupted ? "interrupted" : "slurm";
                     o.message = "SLURM ended the task in state " + it->second;
                     o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t.submitted).count();
+                } else if (task_vanished(it != s.end(), std::chrono::duration<double>(now - t.last_listed).count())) {
+                    // purged from SLURM's memory: the controller restarted without its state, the job removed by
+                    // hand. Waiting would never end; without a record of its own it is tried again like a node failure
+                    ended = true;
+                    if (!read_exit_status(t.job, o)) {
+                        o.exit_code = -1;
+                        o.interrupted = t.cancel_sent;
+                        o.failure_cause = o.interrupted ? "interrupted" : "slurm";
+                        o.message = "SLURM no longer lists array task " + std::to_string(t.array_id) + "_" +
+                                    std::to_string(t.index) + " and it left no exit status";
+                        o.wall_s = std::chrono::duration<double>(now - t.submitted).count();
+                    }
                 }
             }
             if (!ended && stop && !t.cancel_sent) {

@@ -7,6 +7,8 @@
 #include "orchestrator/executor.hpp"
 
 #include <memory>
+#include <optional>
+#include <string>
 
 namespace demcal::orchestrator {
 
@@ -22,10 +24,22 @@ public:
 
 private:
     int slots_;
+    long max_array_size_ = 1001;  // the cluster's MaxArraySize: larger batches go as several arrays
     std::filesystem::path work_dir_;
     std::string partition_;
     int batches_ = 0;
 };
+
+// What the executor reads from SLURM's output (pure functions, tested without a cluster):
+// the job id `sbatch --parsable` printed among any warnings, or nothing;
+std::optional<long> parse_sbatch_job_id(const std::string& output);
+// MaxArraySize from `scontrol show config` (SLURM's default, 1001, where it is missing or not a number);
+constexpr long kSlurmDefaultMaxArraySize = 1001;
+long parse_max_array_size(const std::string& config);
+// whether a task that left no exit status is gone for good: not listed by a squeue that answered, for longer than
+// kTaskVanishedAfterS since it was last listed (longer than a poll's hiccup, far shorter than MinJobAge's default 300)
+constexpr double kTaskVanishedAfterS = 120;
+bool task_vanished(bool listed_now, double seconds_since_listed);
 
 // The executor a campaign asked for by name: "local" (LocalExecutor, `slots` processes) or "slurm" (SlurmExecutor,
 // `slots` array tasks at once, its batch files in `work_dir`, on `partition` or the default one). Throws

@@ -9,6 +9,8 @@ MEM_MB=$(( $(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 - 1024 ))
 mkdir -p /etc/slurm
 sed -e "s/^NodeName=.*/NodeName=localhost NodeAddr=127.0.0.1 CPUs=$CPUS RealMemory=$MEM_MB State=UNKNOWN/" \
   "$HERE/slurm.conf" > /etc/slurm/slurm.conf
+# SLURM_MAX_ARRAY_SIZE=N: a cluster that takes arrays of at most N tasks (demcal's test of splitting a large batch)
+if [ -n "${SLURM_MAX_ARRAY_SIZE:-}" ]; then echo "MaxArraySize=$SLURM_MAX_ARRAY_SIZE" >> /etc/slurm/slurm.conf; fi
 mkdir -p /run/munge /run/slurm /var/spool/slurmctld /var/spool/slurmd /var/log/slurm
 chown munge:munge /run/munge; chown slurm:slurm /var/spool/slurmctld /var/log/slurm
 [ -s /etc/munge/munge.key ] || { mungekey -c -f; chown munge:munge /etc/munge/munge.key; }

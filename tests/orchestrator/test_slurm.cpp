@@ -1,6 +1,7 @@
 // The SLURM executor against a real single-node SLURM that this test starts (scripts/slurm/slurm_up.sh) and stops.
 #include "slurm_for_test.hpp"
 #include "campaign_test_support.hpp"
+#include "orchestrator/slurm_executor.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -16,9 +17,14 @@ TEST_CASE("a tiny shear campaign runs as a SLURM job array", "[yade][slurm]") {
         WARN("not root: cannot start SLURM daemons here, skipped");
         return;
     }
+    // a cluster that takes arrays of 2 tasks at most: the 3 runs must go as two arrays (sbatch refuses a larger one)
+    ::setenv("SLURM_MAX_ARRAY_SIZE", "2", 1);
     test::SlurmForTest cluster;
+    ::unsetenv("SLURM_MAX_ARRAY_SIZE");
     REQUIRE(cluster.up());
     const fs::path dir = test::fresh_test_dir("slurm-campaign");
+    REQUIRE(std::system(("scontrol show config > '" + (dir / "config.txt").string() + "'").c_str()) == 0);
+    const long max_array_size = orchestrator::parse_max_array_size(test::read_file(dir / "config.txt"));
     const int code = test::run_demcal({"shear", test::source_path("examples/materials/sand-tiny.json").string(),
                                        "--normal-stress", "2e3,4e3,6e3", "--executor", "slurm", "--jobs", "2",
                                        "--timeout", "600", "--campaign", dir.string()},
@@ -39,5 +45,8 @@ TEST_CASE("a tiny shear campaign runs as a SLURM job array", "[yade][slurm]") {
         CHECK(attempts[0].executor == "slurm");
     }
     CHECK(log.find("Peak failure line") != std::string::npos);
+    int arrays = 0;
+    for (const auto& f : fs::directory_iterator(dir / "slurm")) arrays += f.path().extension() == ".sbatch";
+    CHECK(arrays == (3 + max_array_size - 1) / max_array_size);
     fs::remove_all(dir);
 }
