@@ -21,10 +21,24 @@ inline std::string number_text(double value, int significant_digits = 6) {
 }
 
 // A value as a message shows it: whole when short, else its start and how long it was (a 50 MB string in an input
-// must not end up on stderr in full).
+// must not end up on stderr in full); control characters escaped (\n, \x1b), so that a message stays one line and a
+// value cannot move the terminal's cursor or colour.
 inline std::string shortened_text(std::string_view text, std::size_t max_chars = 60) {
-    if (text.size() <= max_chars) return std::string(text);
-    return std::string(text.substr(0, max_chars)) + "... (" + std::to_string(text.size()) + " characters)";
+    std::string shown;
+    for (char c : text.substr(0, max_chars)) {
+        const auto u = static_cast<unsigned char>(c);
+        if (c == '\n') shown += "\\n";
+        else if (c == '\t') shown += "\\t";
+        else if (c == '\r') shown += "\\r";
+        else if (u < 0x20 || u == 0x7f) {
+            static const char hex[] = "0123456789abcdef";
+            shown += "\\x";
+            shown += hex[u >> 4];
+            shown += hex[u & 15];
+        } else shown += c;
+    }
+    if (text.size() <= max_chars) return shown;
+    return shown + "... (" + std::to_string(text.size()) + " characters)";
 }
 
 // Beyond this magnitude no input of demcal is a measurement or a setting, only a typo (1e308 for 1e3).

@@ -3,6 +3,7 @@
 #include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
 #include "app/commands.hpp"
+#include "orchestrator/slurm_executor.hpp"
 
 #include <cctype>
 #include <cerrno>
@@ -77,6 +78,12 @@ void refuse_empty_values(CLI::App& app) {
     // No description: the type name says it, and "an integer between -9223372036854775808 and ..." in every
     // option's help says nothing a user needs.
     CLI::Validator any_number = number_check("a number", [](double) { return true; });
+    CLI::Validator slurm_partition(
+        [](std::string& text) {
+            const std::string defect = orchestrator::slurm_partition_defect(text);
+            return defect.empty() ? std::string() : "'" + analytics::shortened_text(text) + "': " + defect;
+        },
+        "");
     CLI::Validator any_integer = integer_in(std::numeric_limits<long long>::min(),
                                             std::numeric_limits<long long>::max());
     any_number.description("");
@@ -87,6 +94,7 @@ void refuse_empty_values(CLI::App& app) {
         const std::string type = opt->get_type_name();
         if (type == "FLOAT") opt->check(any_number);
         else if (type == "INT" || type == "UINT") opt->check(any_integer);
+        if (opt->check_lname("partition")) opt->check(slurm_partition);  // every command's SLURM partition
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
 }

@@ -3,6 +3,7 @@
 #include "orchestrator/run_identity.hpp"
 
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -142,6 +143,23 @@ long parse_max_array_size(const std::string& config) {
     return kSlurmDefaultMaxArraySize;
 }
 
+std::string slurm_partition_defect(const std::string& partition) {
+    if (partition.empty()) return "";  // the cluster's default partition
+    if (partition.size() > 256) return "longer than 256 characters";
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = partition.find(',', start);
+        const std::string name = partition.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        if (name.empty()) return "an empty name in the list";
+        if (name.front() == '-') return "a name starts with '-'";
+        for (char c : name)
+            if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.')
+                return "holds a character that is not a letter, a digit, '_', '-', '.' or ','";
+        if (comma == std::string::npos) return "";
+        start = comma + 1;
+    }
+}
+
 bool task_vanished(bool listed_now, double seconds_since_listed) {
     return !listed_now && seconds_since_listed > kTaskVanishedAfterS;
 }
@@ -149,6 +167,8 @@ bool task_vanished(bool listed_now, double seconds_since_listed) {
 SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition)
     : slots_(slots), work_dir_(std::move(work_dir)), partition_(std::move(partition)) {
     if (slots < 1) throw std::invalid_argument("jobs = " + std::to_string(slots) + " must be at least 1");
+    if (const std::string defect = slurm_partition_defect(partition_); !defect.empty())
+        throw std::invalid_argument("partition = '" + shortened(partition_) + "': " + defect);
     int code = 0;
     capture("command -v sbatch", &code);
     if (code != 0)

@@ -41,6 +41,11 @@ long parse_max_array_size(const std::string& config);
 constexpr double kTaskVanishedAfterS = 120;
 bool task_vanished(bool listed_now, double seconds_since_listed);
 
+// Why `partition` cannot be a SLURM partition for --partition, or "" when it can: one name or a comma-separated list
+// of names of letters, digits, '_', '-' and '.' (it goes into the batch script's #SBATCH line: a newline in it
+// would have added a line of shell to the script).
+std::string slurm_partition_defect(const std::string& partition);
+
 // The executor a campaign asked for by name: "local" (LocalExecutor, `slots` processes) or "slurm" (SlurmExecutor,
 // `slots` array tasks at once, its batch files in `work_dir`, on `partition` or the default one). Throws
 // std::invalid_argument naming any other.

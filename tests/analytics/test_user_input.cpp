@@ -1,5 +1,6 @@
 // The one JSON reader and the data-file reader: every refusal names the input, the field and the rule, never crashes.
 #include "analytics/measured_data.hpp"
+#include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
 
 #include <catch2/catch.hpp>
@@ -41,6 +42,15 @@ TEST_CASE("a value in a message is shortened", "[input]") {
     const auto text = json_value_text(nlohmann::json(std::string(50'000'000, 'z')));
     CHECK(text.size() < 100);
     CHECK_THAT(text, Contains("50000002 characters"));
+}
+
+TEST_CASE("a value in a message has its control characters escaped: the message stays one line", "[input]") {
+    CHECK(demcal::analytics::shortened_text("debug\ntouch x") == "debug\\ntouch x");
+    CHECK(demcal::analytics::shortened_text("a\x1b[31mred\t\r") == "a\\x1b[31mred\\t\\r");
+    CHECK(demcal::analytics::shortened_text("sand \xc3\xa9") == "sand \xc3\xa9");  // UTF-8 kept as it is
+    const auto long_one = demcal::analytics::shortened_text(std::string(100, '\n'));
+    CHECK(long_one.find('\n') == std::string::npos);
+    CHECK_THAT(long_one, Contains("100 characters"));
 }
 
 TEST_CASE("input files: a folder, a missing file and an oversized file are refused by name", "[input]") {

@@ -565,3 +565,23 @@ TEST_CASE("a campaign path the file system will not take is named with its reaso
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("every command's SLURM partition option takes partition names only: a newline cannot add a line to the batch script",
+          "[cli]") {
+    // the value goes into the batch script's "#SBATCH --partition=" line
+    const fs::path root = test::fresh_test_dir("hostile-partition"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "camp").string(), bad = "debug\ntouch " + (root / "INJECTED").string();
+    refused({{{"shear", tiny, "-s", "2e3,4e3", "--executor", "slurm", "-c", camp, "--partition", bad},
+              {"--partition", "debug\\ntouch", "not a letter"}},
+             {{"vibration", "--theta", "30", "--frequency", "0", "--campaign", camp, "--executor", "slurm",
+               "--partition", bad},
+              {"--partition", "not a letter"}},
+             {{"crosscheck", "silo", "--theta", "30", "-c", camp, "--executor", "slurm", "--partition", "a,,b"},
+              {"--partition", "an empty name"}},
+             {{"cutoff", "--executor", "slurm", "--partition", "-x", "--", "--theta", "30"}, {"--partition"}}},
+            dir);
+    CHECK_FALSE(fs::exists(root / "INJECTED"));
+    fs::remove_all(root);
+}
