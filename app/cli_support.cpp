@@ -239,3 +239,18 @@ std::string duration_text(double seconds) {
 }
 
 }  // namespace demcal
+
+namespace demcal {
+
+void check_side_files_free(const std::string& output, const std::vector<std::string>& side_files,
+                           const std::string& option) {
+    if (output.empty() || std::filesystem::exists(std::filesystem::symlink_status(output))) return;
+    for (const std::string& f : side_files)
+        if (std::filesystem::exists(std::filesystem::symlink_status(f)))
+            throw UserError(option + " = '" + analytics::shortened_text(output, 200) + "': " +
+                            analytics::shortened_text(f, 200) + " is already there, and it would be written beside " +
+                            "it: not from an earlier run (the output itself is not there); give another name, or "
+                            "remove that file");
+}
+
+}  // namespace demcal

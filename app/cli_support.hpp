@@ -52,6 +52,12 @@ struct NamedPath {
     std::string option;  // e.g. "--json", "geometry (the input file)"
 };
 
+// Files a command writes beside its output under derived names (a report's plots, their data): one that is already
+// there while the output itself is not, was not written by an earlier run of the command but by someone else (a
+// user's laws.png beside a new laws.json). Throws UserError naming `option`, the file and the way out.
+void check_side_files_free(const std::string& output, const std::vector<std::string>& side_files,
+                           const std::string& option);
+
 // Refuses, before any work starts, an output that is one of the inputs (it would be overwritten) and two outputs on
 // one path (one would overwrite the other, or a file would be written where a folder goes). Paths are compared as
 // the file system resolves them: relative or absolute, "..", symbolic links. Throws UserError naming both options.

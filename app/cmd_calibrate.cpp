@@ -108,7 +108,7 @@ void plot_parameter(const fs::path& dir, const ParameterSensitivity& p, const st
     const double pad = 0.05 * (p.high() - p.low());
     std::ostringstream g;
     g << "set multiplot layout 1,2 title 'Sensitivity to " << p.name << " (error bars: 1 standard error)' noenhanced\n"
-      << "set grid\nset xlabel '" << p.name << "' noenhanced\nset key bottom right\n"
+      << "set grid\nset xlabel " << gnuplot_text(p.name) << " noenhanced\nset key bottom right\n"
       << "set xrange [" << p.low() - pad << ":" << p.high() + pad << "]\n"
       << "set ylabel 'mu_b [-]'\nset title 'internal friction: " << analytics::to_string(p.mu_b.shape) << "'\n"
       << "plot " << gnuplot_quote(data) << " using 1:2:3 with yerrorbars pt 7 lc rgb '#08519c' title 'simulated', "
@@ -403,10 +403,14 @@ void add_enlarge(CLI::App& app) {
         std::vector<NamedPath> inputs;
         for (const auto& file : o->materials) inputs.push_back({file, "material"});
         std::vector<NamedPath> outputs = {{o->output, "output"}};
+        std::vector<std::string> side_files;
         if (!o->no_plot)  // the plot's files are written beside the output, by its name
-            for (const fs::path& f : enlargement_plot_files(o->output, o->plot_format))
+            for (const fs::path& f : enlargement_plot_files(o->output, o->plot_format)) {
                 outputs.push_back({f.string(), "output's plot file"});
+                side_files.push_back(f.string());
+            }
         check_paths_apart(inputs, outputs);
+        check_side_files_free(o->output, side_files, "output");
         std::vector<double> r, e, nu;
         std::map<double, std::string> file_of_radius;
         nlohmann::json first_rest;  // the first material without the fields the laws are about

@@ -218,24 +218,26 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
         const int col = which == 0 ? 5 : 6, fitted = which == 0 ? 3 : 4;
         const std::string title = which == 0 ? "before" : "after";
         std::ostringstream g;
-        g << "set multiplot layout 1,2 title '" << r.model << " residuals " << title
-          << (which == 1 ? " (" + std::to_string(r.effects.size()) + " effect(s) added)" : std::string()) << "' noenhanced\n"
+        g << "set multiplot layout 1,2 title "
+          << gnuplot_text(r.model + " residuals " + title +
+                          (which == 1 ? " (" + std::to_string(r.effects.size()) + " effect(s) added)" : std::string()))
+          << " noenhanced\n"
           << "set grid\nset ylabel '" << unit << "'\nset key top right\nset title noenhanced\n"
-          << "set xlabel 'fitted " << r.response << "' noenhanced\n";
+          << "set xlabel " << gnuplot_text("fitted " + r.response) << " noenhanced\n";
         // Outliers (column 8 = 1) drawn apart, so that the eye does not read them as a trend.
         auto points = [&](const std::string& x) {
             const std::string q = gnuplot_quote(dat), y = "$" + std::to_string(col);
             std::string series;
             for (std::size_t k = 0; k < levels.size(); ++k)
                 series += q + " using " + x + ":($8 == 0 && $9 == " + std::to_string(k) + " ? " + y +
-                          " : 1/0) with points pt 7 ps 0.8 lc " + std::to_string(k + 1) + " title '" + levels[k] +
-                          "', ";
+                          " : 1/0) with points pt 7 ps 0.8 lc " + std::to_string(k + 1) + " title " + gnuplot_text(levels[k]) +
+                          " noenhanced, ";
             if (!r.outliers.rows.empty())
                 series += q + " using " + x + ":($8 == 1 ? " + y +
                           " : 1/0) with points pt 6 ps 2 lc rgb '#d62728' title 'outliers', ";
             return series + "0 lt -1 notitle\n";
         };
-        g << "plot " << points(std::to_string(fitted)) << "set xlabel '" << x_name << "' noenhanced\n"
+        g << "plot " << points(std::to_string(fitted)) << "set xlabel " << gnuplot_text(x_name) << " noenhanced\n"
           << "plot " << points("7") << "unset multiplot\n";
         render_gnuplot(which == 0 ? before : after, g.str(), 1100, 450);
     }
@@ -347,9 +349,15 @@ int run_diagnose(const DiagnoseArgs& a) {
     check_output_file_in_new_folders(a.json_out, "--json");
     check_output_file_in_new_folders(a.report_out, "--report");
     std::vector<NamedPath> outputs = {{a.json_out, "--json"}, {a.report_out, "--report"}};
+    std::vector<std::string> side_files;
     if (!a.report_out.empty() && !a.no_plots)  // the report's plots and their data, beside it by its name
-        for (const auto& f : report_plot_files(a.report_out)) outputs.push_back({f.string(), "--report's plot file"});
+        for (const auto& f : report_plot_files(a.report_out)) {
+            outputs.push_back({f.string(), "--report's plot file"});
+            side_files.push_back(f.string());
+        }
     check_paths_apart({{a.data, "--data"}}, outputs);
+    check_side_files_free(a.report_out, side_files, "--report");
+    if (!a.report_out.empty() && !a.no_plots) require_gnuplot("--no-plots");
     analytics::MeasuredData data;
     analytics::DiagnoseResult r;
     try {

@@ -89,7 +89,10 @@ constexpr int kExitSuspended = 75;
 
 constexpr const char* kCheckpointName = "checkpoint.bin";
 // Every file a run writes into its --out folder (write_outputs, the checkpoint): an exported bed must not take one.
-constexpr const char* kRunFiles[] = {kCheckpointName, "summary.json", "discharge.csv", "section.png", "discharge.png"};
+constexpr const char* kRunFiles[] = {kCheckpointName,       "summary.json",         "discharge.csv",
+                                     "section.png",         "discharge.png",        "section.dat",
+                                     "section_outline.dat", "section.png.gp",       "section.png.gp.log",
+                                     "discharge.png.gp",    "discharge.png.gp.log"};
 
 // SIGTERM (a batch system's time limit or scancel, kill) and SIGINT (Ctrl-C) during a checkpointed run: the run ends
 // its record interval, writes its checkpoint and exits 75, as at --wall-limit. The handler only records the signal
@@ -530,6 +533,14 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     if (fs::is_regular_file(dir / "summary.json"))  // a new run would leave the old results beside its own until its end
         throw UserError("out = '" + dir.string() + "' holds the results of a finished run (summary.json): give "
                         "another --out, or remove them to run again there");
+    // any other file a run writes, already there in a folder no silo run has held (no .lock of one): a user's file
+    // (a measured discharge.csv in a data folder was replaced by the run's own). In a folder a run held, they are an
+    // earlier attempt's (a campaign's retry in its run folder), replaced.
+    for (const char* name : kRunFiles)
+        if (!fs::exists(fs::symlink_status(dir / ".lock")) && fs::exists(fs::symlink_status(dir / name)))
+            throw UserError("out = '" + dir.string() + "' already holds " + name + ", a file a silo run writes: give "
+                            "another --out (a new or empty folder), or remove it");
+    if (!o.no_plots) require_gnuplot("--no-plots");
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
@@ -641,6 +652,7 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     check_output_folder(dir.string(), "--resume");
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "vtk (the run's snapshot folder, in its checkpoint)");
     const auto lock = lock_output_folder(dir);  // two resumes of one run read and wrote one checkpoint at once
+    if (!o.no_plots) require_gnuplot("--no-plots");
     if (!fs::exists(file)) throw UserError("resume = '" + dir.string() + "': another demcal has just finished it");
     s.threads = threads;
     s.checkpoint_file = file.string();  // removed once the outputs are written

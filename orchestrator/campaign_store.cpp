@@ -138,10 +138,23 @@ nlohmann::json stored_json(const Statement& st, int column, const char* name) {
 // Run folders are stored relative to the store's directory, so a campaign moved or copied (cluster to laptop) finds
 // its own runs. Rows of older stores hold absolute paths; every demcal run folder is CAMPAIGN/runs/<name>, so such a
 // row is read as that layout under the store's directory, never as a folder of the campaign it was copied from.
+// Any other path (absolute, or leading out of the campaign folder by "..") is a damaged or edited row: demcal writes
+// into a run's folder, so following it would write over files outside the campaign.
 std::filesystem::path resolved_run_dir(const std::filesystem::path& stored, const std::filesystem::path& base_dir) {
-    if (stored.is_relative()) return base_dir / stored;
-    if (stored.parent_path().filename() == "runs") return base_dir / "runs" / stored.filename();
-    return stored;
+    const auto refuse = [&](const char* why) -> std::filesystem::path {
+        throw std::invalid_argument("campaign store in '" + analytics::shortened_text(base_dir.string(), 200) +
+                                    "': runs.run_dir = '" + analytics::shortened_text(stored.string(), 200) + "' " +
+                                    why + " (the store is damaged or was edited; demcal writes into run folders)");
+    };
+    if (stored.is_relative()) {
+        const auto normal = stored.lexically_normal();
+        if (normal.empty() || normal == "." || *normal.begin() == "..") return refuse("leads out of the campaign folder");
+        return base_dir / normal;
+    }
+    if (stored.parent_path().filename() == "runs" && stored.filename() != ".." && stored.filename() != "." &&
+        !stored.filename().empty())
+        return base_dir / "runs" / stored.filename();
+    return refuse("is not a folder of the campaign");
 }
 
 std::string stored_run_dir(const std::filesystem::path& run_dir, const std::filesystem::path& base_dir) {
