@@ -1,5 +1,7 @@
 #include "analytics/failure_line.hpp"
 
+#include "analytics/number_text.hpp"
+
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_fit.h>
 
@@ -21,6 +23,14 @@ void check_failure_line_design(std::span<const double> normal_stresses, int repl
     if (distinct.size() < 2)
         throw std::invalid_argument("normal-stress: a failure line needs at least 2 distinct normal stresses, got " +
                                     std::to_string(distinct.size()));
+    // stresses closer than the box's servo holds them (a few % of the target, up to 15 % in a small box) make a line
+    // of that noise: 5000, 5000.0000001, 5000.0000002 Pa gave mu_b = 2e9 with exit 0
+    const double lowest = *distinct.begin(), highest = *distinct.rbegin();
+    if (highest - lowest < kMinNormalStressSpread * std::fabs(highest))
+        throw std::invalid_argument("normal-stress: " + number_text(lowest) + " to " + number_text(highest) +
+                                    " Pa: a failure line needs normal stresses at least " +
+                                    number_text(100 * kMinNormalStressSpread) +
+                                    " % apart (the largest - the smallest), more than the box's servo spreads them");
     if (static_cast<double>(distinct.size()) * replicates < 3)
         throw std::invalid_argument("replicates = " + std::to_string(replicates) + " at " +
                                     std::to_string(distinct.size()) +

@@ -43,5 +43,7 @@ FailureLine fit_failure_line(std::span<const double> sigma, std::span<const doub
 // stresses and 3 points. Throws std::invalid_argument naming --normal-stress or --replicates and the values, so that
 // a campaign whose line cannot be fitted is refused before its runs, not after them.
 void check_failure_line_design(std::span<const double> normal_stresses, int replicates);
+// The smallest spread of a design's normal stresses, (largest - smallest) / largest.
+inline constexpr double kMinNormalStressSpread = 0.2;
 
 }  // namespace demcal::analytics

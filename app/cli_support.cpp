@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <map>
 #include <string_view>
 
 #include <unistd.h>
@@ -251,6 +252,59 @@ void check_side_files_free(const std::string& output, const std::vector<std::str
                             analytics::shortened_text(f, 200) + " is already there, and it would be written beside " +
                             "it: not from an earlier run (the output itself is not there); give another name, or "
                             "remove that file");
+}
+
+}  // namespace demcal
+
+namespace demcal {
+
+namespace {
+
+// The names (--long and -s) of every option of `app` and its subcommands that takes a comma-separated list, each
+// with the name a message gives it (the long one).
+void collect_list_options(const CLI::App& app, std::map<std::string, std::string>& names) {
+    for (const CLI::Option* opt : app.get_options()) {
+        if (opt->get_delimiter() != ',') continue;
+        const std::string shown = opt->get_lnames().empty() ? "-" + opt->get_snames().front() : "--" + opt->get_lnames().front();
+        for (const auto& l : opt->get_lnames()) names.emplace("--" + l, shown);
+        for (const auto& sn : opt->get_snames()) names.emplace("-" + sn, shown);
+    }
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) collect_list_options(*sub, names);
+}
+
+bool has_empty_item(std::string_view list) {
+    return list.empty() || list.front() == ',' || list.back() == ',' || list.find(",,") != std::string_view::npos;
+}
+
+}  // namespace
+
+void check_command_line_shape(const CLI::App& app, int argc, const char* const* argv) {
+    if (argc > 1 && argv[1][0] != '-') {
+        std::string known;
+        bool found = false;
+        for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+            found = found || sub->check_name(argv[1]);
+            known += (known.empty() ? "" : ", ") + sub->get_name();
+        }
+        if (!found)
+            throw UserError("'" + analytics::shortened_text(argv[1]) + "' is not a demcal command (" + known + ")");
+    }
+    std::map<std::string, std::string> lists;
+    collect_list_options(app, lists);
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg(argv[i]);
+        if (arg == "--") break;  // a run's own options, checked by that run's command line
+        const auto eq = arg.find('=');
+        const std::string name(arg.substr(0, eq));
+        if (!lists.count(name)) continue;
+        std::string_view value;
+        if (eq != std::string_view::npos) value = arg.substr(eq + 1);
+        else if (i + 1 < argc) value = argv[i + 1];
+        else continue;
+        if (value.find(',') != std::string_view::npos && has_empty_item(value))
+            throw UserError(lists.at(name) + ": '" + analytics::shortened_text(value) +
+                            "' has an empty item (two commas in a row, or one at an end)");
+    }
 }
 
 }  // namespace demcal

@@ -28,6 +28,11 @@ void refuse_empty_values(CLI::App& app);
 // The longest command-line argument demcal takes: a path (PATH_MAX) or a list of numbers.
 inline constexpr std::size_t kMaxArgumentChars = 4096;
 
+// Refuses, before CLI11 sees them: a first argument that is no command of `app` (CLI11 said only "A subcommand is
+// required" for `demcal shaer`), and an empty item in the value of a list option ("5e3,,1e4": CLI11 dropped it, and
+// the campaign ran the stresses left). Throws UserError naming the argument or the option.
+void check_command_line_shape(const CLI::App& app, int argc, const char* const* argv);
+
 // Refuses, before CLI11 sees them, arguments longer than kMaxArgumentChars, naming the option and the value
 // shortened (CLI11 echoed a 100 kB value in full in its own messages).
 void check_argument_lengths(int argc, const char* const* argv);

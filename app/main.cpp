@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     demcal::refuse_empty_values(app);
     try {
         demcal::check_argument_lengths(argc, argv);
+        demcal::check_command_line_shape(app, argc, argv);
         app.parse(argc, argv);
     } catch (const CLI::RuntimeError& e) {  // a command's own exit status (75: suspended, resume it)
         return app.exit(e);

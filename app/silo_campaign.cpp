@@ -1,6 +1,7 @@
 #include "app/silo_campaign.hpp"
 
 #include "app/cli_support.hpp"
+#include "analytics/number_text.hpp"
 #include "app/commands.hpp"
 #include "orchestrator/executor.hpp"
 #include "orchestrator/folder_lock.hpp"
@@ -15,6 +16,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <csignal>
 #include <cstring>
 #include <fstream>
@@ -127,8 +129,27 @@ void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const 
                 throw UserError("silo option " + a + " after --: " + command + " sets it for every run");
 }
 
+namespace {
+
+// The folder for the check's scratch runs: TMPDIR (or /tmp), tried for real, named when it cannot take them.
+fs::path scratch_parent() {
+    const char* env = std::getenv("TMPDIR");
+    const fs::path tmp = env && *env ? fs::path(env) : fs::path("/tmp");
+    std::string probe = (tmp / ".demcal-tmp-probe-XXXXXX").string();
+    const int fd = ::mkstemp(probe.data());
+    if (fd < 0)
+        throw UserError(std::string(env && *env ? "TMPDIR" : "/tmp (TMPDIR is not set)") + " = '" +
+                        analytics::shortened_text(tmp.string(), 200) + "': " + std::strerror(errno) +
+                        ": the runs' settings are checked by a short run in it; set TMPDIR to a writable folder");
+    ::close(fd);
+    ::unlink(probe.c_str());
+    return tmp;
+}
+
+}  // namespace
+
 void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
-    const fs::path scratch = fs::temp_directory_path() / ("demcal-silo-check-" + std::to_string(::getpid()));
+    const fs::path scratch = scratch_parent() / ("demcal-silo-check-" + std::to_string(::getpid()));
     const fs::path log = scratch.string() + ".log";
     for (const SiloRunPlan& plan : plans) {
         int status = 0;

@@ -15,6 +15,7 @@ CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& 
     std::error_code ec;
     // a store this demcal refuses is refused before anything is written: the lock file, the folder, the store
     if (fs::exists(dir_ / "campaign.sqlite", ec)) CampaignStore(dir_ / "campaign.sqlite", StoreAccess::read_only);
+    CampaignStore::check_store_path(dir_ / "campaign.sqlite");
     fs::create_directories(dir_, ec);  // the first thing a campaign writes: a folder it cannot make is bad input
     if (ec || !fs::is_directory(dir_))
         throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +

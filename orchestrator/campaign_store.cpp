@@ -4,6 +4,7 @@
 #include "analytics/user_input.hpp"
 
 #include <sqlite3.h>
+#include <unistd.h>
 
 #include <cctype>
 #include <charconv>
@@ -313,9 +314,19 @@ CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess a
     if (existed && std::filesystem::file_size(db_path, ec) == 0)
         throw std::invalid_argument("campaign store '" + db_path.string() +
                                     "' is empty (0 bytes), not a demcal campaign store; nothing was written to it");
+    check_store_path(db_path);
+    if (!existed) {
+        // made whole under another name, then renamed into place: a kill -9 in its first milliseconds left a store of
+        // 0 or 4096 bytes that every later command refused as not demcal's
+        const std::filesystem::path fresh = db_path.string() + ".new-" + std::to_string(::getpid());
+        std::filesystem::remove(fresh, ec);
+        {
+            CampaignStore made(fresh, db_path.parent_path());
+        }
+        std::filesystem::rename(fresh, db_path);
+    }
     const std::string name = read_only ? read_only_uri(db_path) : db_path.string();
-    const int flags = read_only ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI
-                                : SQLITE_OPEN_READWRITE | (existed ? 0 : SQLITE_OPEN_CREATE);
+    const int flags = read_only ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI : SQLITE_OPEN_READWRITE;
     if (sqlite3_open_v2(name.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
         std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
         sqlite3_close(db_);
@@ -331,6 +342,10 @@ CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess a
         }
     }
     if (read_only) return;
+    create_schema();
+}
+
+void CampaignStore::create_schema() {
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=FULL");
     exec("PRAGMA foreign_keys=ON");
@@ -358,6 +373,38 @@ CREATE TABLE IF NOT EXISTS attempts(
   started_at REAL NOT NULL, finished_at REAL, exit_code INTEGER, cause TEXT, message TEXT, wall_s REAL, cpu_s REAL);
 CREATE INDEX IF NOT EXISTS runs_by_state ON runs(state);
 )sql");
+}
+
+CampaignStore::CampaignStore(const std::filesystem::path& fresh_path, const std::filesystem::path& base_dir)
+    : path_(fresh_path), base_dir_(std::filesystem::absolute(base_dir).lexically_normal()) {
+    if (sqlite3_open_v2(fresh_path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
+        std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        sqlite3_close(db_);
+        std::error_code ec;
+        std::filesystem::remove(fresh_path, ec);
+        throw std::runtime_error("store: cannot create " + fresh_path.string() + ": " + m);
+    }
+    try {
+        create_schema();
+    } catch (...) {
+        sqlite3_close(db_);
+        db_ = nullptr;
+        std::error_code ec;
+        for (const char* tail : {"", "-wal", "-shm", "-journal"})
+            std::filesystem::remove(fresh_path.string() + tail, ec);
+        throw;
+    }
+}
+
+void CampaignStore::check_store_path(const std::filesystem::path& db_path) {
+    // SQLite's unix file layer takes paths of at most 512 bytes (with its -wal and -shm names): a longer one failed
+    // with "unable to open database file" after the campaign folder was made
+    const std::string full = std::filesystem::absolute(db_path).lexically_normal().string();
+    if (full.size() + 4 > kMaxStorePathBytes)
+        throw std::invalid_argument("campaign = '" + analytics::shortened_text(db_path.parent_path().string(), 80) +
+                                    "': its store's path is " + std::to_string(full.size()) +
+                                    " bytes long, SQLite opens at most " + std::to_string(kMaxStorePathBytes - 4) +
+                                    ": give a shorter folder");
 }
 
 CampaignStore::~CampaignStore() { sqlite3_close(db_); }

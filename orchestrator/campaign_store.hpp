@@ -63,6 +63,12 @@ public:
     CampaignStore(const CampaignStore&) = delete;
     CampaignStore& operator=(const CampaignStore&) = delete;
 
+    // The longest store path SQLite's unix file layer opens (its -wal/-shm names included).
+    static constexpr std::size_t kMaxStorePathBytes = 512;
+    // Throws std::invalid_argument naming the folder when a store at `db_path` could not be opened for its length
+    // (CampaignDirectory calls it before it makes the folder).
+    static void check_store_path(const std::filesystem::path& db_path);
+
     // Returns the campaign of that name, creating it with `spec` if new.
     CampaignRecord ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec);
     std::optional<CampaignRecord> find_campaign(const std::string& name);
@@ -93,6 +99,9 @@ public:
     std::vector<Attempt> attempts(const std::string& hash);
 
 private:
+    // A new store under `fresh_path` with demcal's schema (then renamed into place by the public constructor).
+    CampaignStore(const std::filesystem::path& fresh_path, const std::filesystem::path& base_dir);
+    void create_schema();
     void exec(const std::string& sql);
     sqlite3* db_ = nullptr;
     std::filesystem::path path_;

@@ -70,7 +70,7 @@ bool is_executable_file(const fs::path& p) {
 fs::path find_yade(const std::string& yade) {
     if (yade.empty()) throw std::invalid_argument("yade = '': empty; give the YADE launcher's name or path");
     if (yade.find('/') != std::string::npos) {
-        if (is_executable_file(yade)) return yade;
+        if (is_executable_file(yade)) return fs::absolute(yade);  // runs start in their own folders
         std::error_code ec;
         const std::string why = !fs::exists(yade, ec)        ? "does not exist"
                                 : fs::is_directory(yade, ec) ? "is a folder, not a program"
@@ -83,7 +83,7 @@ fs::path find_yade(const std::string& yade) {
             std::size_t b = p.find(':', a);
             if (b == std::string::npos) b = p.size();
             const fs::path cand = fs::path(p.substr(a, b - a)) / yade;
-            if (is_executable_file(cand)) return cand;
+            if (is_executable_file(cand)) return fs::absolute(cand);  // (an empty or "." entry of PATH)
             a = b + 1;
         }
     }
