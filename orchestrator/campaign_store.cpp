@@ -2,6 +2,7 @@
 
 #include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
+#include "orchestrator/shear_campaign.hpp"  // check_shear_result_values
 
 #include <sqlite3.h>
 #include <unistd.h>
@@ -164,6 +165,8 @@ std::string stored_run_dir(const std::filesystem::path& run_dir, const std::file
     return inside ? relative.string() : run_dir.string();
 }
 
+constexpr double kLongestRunSeconds = 1e9;  // (31 years) no run's wall or CPU time is longer
+
 RunRecord read_run(const Statement& st, bool with_label, const std::filesystem::path& base_dir) {
     RunRecord r;
     r.hash = st.text(0);
@@ -176,6 +179,9 @@ RunRecord read_run(const Statement& st, bool with_label, const std::filesystem::
     r.exit_code = static_cast<int>(st.integer(7));
     r.wall_s = st.real(8);
     r.cpu_s = st.real(9);
+    for (const double t : {r.wall_s, r.cpu_s})  // (1e300 s printed as a negative count of seconds)
+        if (!std::isfinite(t) || t < 0 || t > kLongestRunSeconds)
+            throw std::invalid_argument("runs.wall_s/cpu_s = " + analytics::number_text(t) + " s is not a run's time");
     r.run_dir = resolved_run_dir(st.text(10), base_dir);
     r.pgid = static_cast<long>(st.integer(11));
     r.owner_pid = static_cast<long>(st.integer(12));
@@ -276,6 +282,26 @@ void check_existing_store(sqlite3* db, const std::string& name) {
     readable("run", kRunColumnsQuery, [](const Statement& st) { read_run(st, false, {}); });
     readable("a run of campaign", "SELECT campaign_id, label FROM campaign_runs",
              [](const Statement& st) { stored_json(st, 1, "campaign_runs.label"); });
+    // a shear run's numbers, which status and the reports fit lines to: its label's stress the run's, its result
+    // one a box can give (an edited row made a line of 9e99 Pa, or of another run's result, with exit 0)
+    readable("shear run",
+             "SELECT r.hash, r.params, r.result, cr.label FROM runs r JOIN campaign_runs cr ON cr.hash = r.hash "
+             "JOIN campaigns c ON c.id = cr.campaign_id WHERE c.kind = 'shear' AND r.state = 'done'",
+             [](const Statement& st) {
+                 const nlohmann::json params = stored_json(st, 1, "runs.params");
+                 const nlohmann::json label = stored_json(st, 3, "campaign_runs.label");
+                 if (st.is_null(2)) throw std::invalid_argument("runs.result is empty for a finished run");
+                 const nlohmann::json result = stored_json(st, 2, "runs.result");
+                 if (!result.is_object() || !result.contains("peak_shear_stress") ||
+                     !result["peak_shear_stress"].is_number())
+                     throw std::invalid_argument("runs.result has no number peak_shear_stress");
+                 check_shear_result_values(result, "runs.result", &params);
+                 if (label.is_object() && label.contains("normal_stress") &&
+                     (!params.is_object() || label["normal_stress"] != params.value("normal_stress", nlohmann::json())))
+                     throw std::invalid_argument("campaign_runs.label's normal_stress " +
+                                                 analytics::json_value_text(label["normal_stress"]) +
+                                                 " is not the run's");
+             });
 }
 
 // The store as a SQLite URI for a read-only open. A read-only connection to a WAL store leaves a -wal and a -shm

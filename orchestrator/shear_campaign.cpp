@@ -244,7 +244,7 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
         throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");
 }
 
-nlohmann::json read_shear_result(const fs::path& file) {
+nlohmann::json read_shear_result(const fs::path& file, const nlohmann::json* run_params) {
     const std::string what = "result = '" + file.string() + "'";
     auto [result, sealed] = read_result_file(file, what);
     if (!result.is_object()) throw std::invalid_argument(what + ": not a JSON object");
@@ -255,16 +255,53 @@ nlohmann::json read_shear_result(const fs::path& file) {
                             " without its SHA-256 seal: damaged or not a demcal result");
     if (!result.contains("peak_shear_stress") || !result["peak_shear_stress"].is_number())
         throw std::invalid_argument(what + ": no number 'peak_shear_stress'");
+    check_shear_result_values(result, what, run_params);
     return result;
+}
+
+void check_shear_result_values(const nlohmann::json& result, const std::string& what,
+                               const nlohmann::json* run_params) {
+    // the stresses a box can hold: a simulator (or a file planted in a run folder) that reports a negative peak or
+    // one of 1e99 Pa made a failure line of them, R^2 = 1, exit 0
+    const auto number = [&](const char* field) -> std::optional<double> {
+        if (!result.contains(field)) return std::nullopt;
+        const auto& v = result[field];
+        if (!v.is_number() || !std::isfinite(v.get<double>()))
+            throw std::invalid_argument(what + ": " + field + " = " + analytics::json_value_text(v) +
+                                        " is not a finite number");
+        return v.get<double>();
+    };
+    const std::optional<double> target = number("normal_stress_target");
+    if (target && !(*target > 0))
+        throw std::invalid_argument(what + ": normal_stress_target = " + analytics::number_text(*target) +
+                                    " Pa is not positive");
+    for (const char* field : {"peak_shear_stress", "residual_shear_stress"}) {
+        const std::optional<double> tau = number(field);
+        if (!tau) continue;
+        // tau / sigma_n beyond 100 is no granular material's (friction coefficients stay below about 2)
+        const double limit = target ? kMaxShearOverNormalStress * *target : analytics::kLargestPlausibleNumber;
+        if (*tau < 0 || *tau > limit)
+            throw std::invalid_argument(what + ": " + field + " = " + analytics::number_text(*tau) +
+                                        " Pa is outside [0, " + analytics::number_text(limit) +
+                                        "] (not a shear box's result)");
+    }
+    // the run's own result, not another run's copied into its folder
+    if (run_params && target && run_params->contains("normal_stress") && (*run_params)["normal_stress"].is_number()) {
+        const double own = (*run_params)["normal_stress"].get<double>();
+        if (std::fabs(*target - own) > 1e-9 * std::fabs(own))
+            throw std::invalid_argument(what + ": the result of a run at normal stress " +
+                                        analytics::number_text(*target) + " Pa, not of this run's " +
+                                        analytics::number_text(own) + " Pa");
+    }
 }
 
 namespace {
 // The result a run left in its directory, if it is a usable one (a damaged one is not: the run is run again).
-std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
-    const fs::path file = run_dir / "result.json";
+std::optional<nlohmann::json> finished_result(const RunRecord& run) {
+    const fs::path file = run.run_dir / "result.json";
     if (!fs::exists(file)) return std::nullopt;
     try {
-        return read_shear_result(file);
+        return read_shear_result(file, &run.params);
     } catch (const std::exception&) {
     }
     return std::nullopt;
@@ -272,7 +309,7 @@ std::optional<nlohmann::json> finished_result(const fs::path& run_dir) {
 }  // namespace
 
 ShearCampaignRunner::ShearCampaignRunner(const fs::path& dir, ExecutionOptions options)
-    : directory_(dir, [](const RunRecord& r) { return finished_result(r.run_dir); }),
+    : directory_(dir, [](const RunRecord& r) { return finished_result(r); }),
       dir_(directory_.dir()),
       options_(std::move(options)),
       store_(&directory_.store()) {}
@@ -362,7 +399,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         nlohmann::json result;
         if (o.succeeded()) {
             try {
-                result = read_shear_result(job.dir / "result.json");
+                result = read_shear_result(job.dir / "result.json", &by_hash.at(job.id)->params);
             } catch (const DamagedResult& e) {
                 // damaged between its write and this read (disk, copy): not the run's physics, so run it again
                 cause = kDamagedResult;

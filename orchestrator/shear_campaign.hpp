@@ -77,7 +77,12 @@ inline constexpr const char* kDamagedResult = "damaged_result";
 // A run's result.json, read under the input rules and checked against its seal (run_identity.hpp: a file of schema
 // demcal.shear_result/2 must carry a matching one; /1, from older templates, has none) and for a number
 // peak_shear_stress. Throws DamagedResult for a damaged file, std::invalid_argument for one that is not a result.
-nlohmann::json read_shear_result(const std::filesystem::path& file);
+nlohmann::json read_shear_result(const std::filesystem::path& file, const nlohmann::json* run_params = nullptr);
+// A result's stresses within what a shear box can report (finite, 0 <= tau <= kMaxShearOverNormalStress x its
+// normal stress) and, given the run's params, its normal stress the run's: throws std::invalid_argument naming `what`.
+inline constexpr double kMaxShearOverNormalStress = 100;
+void check_shear_result_values(const nlohmann::json& result, const std::string& what,
+                               const nlohmann::json* run_params = nullptr);
 
 struct CampaignProgress {
     int total = 0, done = 0, failed = 0, running = 0, pending = 0, reused = 0;
