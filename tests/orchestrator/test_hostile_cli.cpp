@@ -9,7 +9,10 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -583,5 +586,105 @@ TEST_CASE("every command's SLURM partition option takes partition names only: a 
              {{"cutoff", "--executor", "slurm", "--partition", "-x", "--", "--theta", "30"}, {"--partition"}}},
             dir);
     CHECK_FALSE(fs::exists(root / "INJECTED"));
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 44: a command, a list item or a design a user mistyped is refused with what was typed named", "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-typed"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "camp").string();
+    refused({{{"shaer", tiny}, {"'shaer' is not a demcal command", "shear, status"}},
+             {{"shear", tiny, "-s", "5e3,,1e4,2e4", "-c", camp}, {"--normal-stress", "'5e3,,1e4,2e4' has an empty item"}},
+             {{"shear", tiny, "--normal-stress=5e3,1e4,", "-c", camp}, {"--normal-stress", "empty item"}},
+             {{"vibration", "--theta", "30,,50", "--frequency", "0", "--campaign", camp}, {"--theta", "empty item"}},
+             // closer than the box's servo holds a stress: a line of its noise (mu_b = 2e9 with exit 0)
+             {{"shear", tiny, "--engine", "kernel", "-s", "5000,5000.0000001,5000.0000002", "-c", camp},
+              {"normal-stress", "5000 to 5000", "at least 20 % apart"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 44: outputs beside an output never replace a user's files, and a long campaign path is refused "
+          "before its folder is made",
+          "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-side-files"), dir = root / "work";
+    fs::create_directories(dir / "data");
+    std::ofstream(dir / "data" / "discharge.csv") << "t,mass\n0,1\n";  // a user's measurement, not a run's output
+    std::ofstream(dir / "laws.png") << "my photo";
+    // enlarge's materials: any three radii of one material (refused before they are read further)
+    refused({{{"silo", "--theta", "30", "--particles", "200", "--out", (dir / "data").string()},
+              {"out = ", "already holds discharge.csv", "a file a silo run writes"}},
+             {{"enlarge", "-o", (dir / "laws.json").string(), test::source_path("examples/materials/sand-tiny.json").string(),
+               test::source_path("examples/materials/sand.json").string(),
+               test::source_path("examples/materials/sand-bonded.json").string()},
+              {"output = ", "laws.png is already there"}}},
+            dir);
+    CHECK(test::read_file(dir / "laws.png") == "my photo");
+    // SQLite opens store paths of at most 512 bytes: said before the folder is made, not after
+    fs::path deep = root;
+    for (int i = 0; i < 6; ++i) deep /= std::string(90, 'e');
+    fs::create_directories(deep);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    CHECK(test::run_demcal({"shear", tiny, "--engine", "kernel", "-s", "5e3,1e4", "-r", "2", "-c", (deep / "camp").string()},
+                           root / "long.log") == 2);
+    CHECK_THAT(test::read_file(root / "long.log"), Contains("SQLite opens at most"));
+    CHECK_FALSE(fs::exists(deep / "camp"));
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 44: a measured CSV's text reaches gnuplot quoted (a column name ran a command), paths with a quote "
+          "plot, and a missing gnuplot is said before the work",
+          "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-gnuplot");
+    std::string csv = test::read_file(test::source_path("examples/diagnose/oldal_moisture.csv"));
+    const std::string column = "moisture_pct";
+    const std::string evil = "m'`touch " + (root / "PWNED").string() + "`'";
+    csv.replace(csv.find(column), column.size(), evil);
+    std::ofstream(root / "evil.csv") << csv;
+    const fs::path report = root / "it's.md";  // a quote in the path: gnuplot started without a shell
+    CHECK(test::run_demcal({"diagnose", "--model", "oldal", "--data", (root / "evil.csv").string(), "--report",
+                            report.string()},
+                           root / "evil.log") == 0);
+    INFO(test::read_file(root / "evil.log"));
+    CHECK_FALSE(fs::exists(root / "PWNED"));
+    CHECK(fs::exists(report));
+    CHECK(fs::exists(root / "it's_residuals_before.png"));
+    // without gnuplot on PATH: refused at once, nothing written
+    const std::string path = std::getenv("PATH");
+    ::setenv("PATH", "/nonexistent", 1);
+    const int rc = test::run_demcal({"diagnose", "--model", "oldal", "--data", (root / "evil.csv").string(),
+                                     "--report", (root / "out" / "r.md").string()},
+                                    root / "nognuplot.log");
+    ::setenv("PATH", path.c_str(), 1);
+    CHECK(rc == 2);
+    CHECK_THAT(test::read_file(root / "nognuplot.log"), Contains("gnuplot is not on PATH") && Contains("--no-plots"));
+    CHECK_FALSE(fs::exists(root / "out"));
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 44: kill -9 in a campaign's first milliseconds leaves no store that later commands refuse", "[cli]") {
+    // the store is made whole under another name and renamed into place: a kill while SQLite wrote its first pages
+    // left a 0- or 4096-byte campaign.sqlite that status, resume and the same command refused as not demcal's
+    const fs::path root = test::fresh_test_dir("hostile-early-kill");
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    for (int delay_ms = 0; delay_ms <= 40; delay_ms += 4) {
+        INFO("killed after " << delay_ms << " ms");
+        const fs::path camp = root / ("camp" + std::to_string(delay_ms));
+        const int pid = test::spawn_demcal({"shear", tiny, "--engine", "kernel", "-s", "5e3,1e4", "-r", "2", "-c",
+                                            camp.string()},
+                                           root / "spawn.log");
+        ::usleep(static_cast<useconds_t>(delay_ms) * 1000);
+        ::kill(pid, SIGKILL);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        for (int p : test::processes_under(camp)) ::kill(p, SIGKILL);  // a run it had started
+        if (!fs::exists(camp / "campaign.sqlite")) continue;
+        test::run_demcal({"status", camp.string()}, root / "status.log");
+        const std::string log = test::read_file(root / "status.log");
+        INFO(log);
+        CHECK(log.find("not a demcal campaign store") == std::string::npos);
+        CHECK(log.find("is empty") == std::string::npos);
+    }
     fs::remove_all(root);
 }

@@ -121,6 +121,18 @@ TEST_CASE("status and resume refuse a newer schema, an unknown kind or an unread
         {"UPDATE campaigns SET kind = 'martian'", "campaign 1: kind 'martian' is not one demcal knows (shear"},
         {"UPDATE campaigns SET spec = '{not json'", "campaigns.spec is not valid JSON"},
         {"UPDATE runs SET result = '{\"peak' WHERE rowid = 1", "runs.result is not valid JSON"},
+        // rows edited to send demcal's writes outside the campaign, or to make nonsense of its line (probe 44)
+        {"UPDATE runs SET run_dir = '/tmp' WHERE rowid = 1", "runs.run_dir = '/tmp' is not a folder of the campaign"},
+        {"UPDATE runs SET run_dir = 'runs/../../victim' WHERE rowid = 1", "leads out of the campaign folder"},
+        {"UPDATE runs SET result = '{\"schema\": \"demcal.shear_result/1\", \"peak_shear_stress\": -5000}' "
+         "WHERE rowid = 1",
+         "peak_shear_stress = -5000 Pa is outside [0, "},
+        {"UPDATE runs SET result = json_set(result, '$.normal_stress_target', 123456.0) WHERE rowid = 1",
+         "the result of a run at normal stress 123456 Pa, not of this run's"},
+        {"UPDATE runs SET result = '{}' WHERE rowid = 1", "runs.result has no number peak_shear_stress"},
+        {"UPDATE campaign_runs SET label = json_set(label, '$.normal_stress', 9e99) WHERE rowid = 1",
+         "campaign_runs.label's normal_stress 9e+99 is not the run's"},
+        {"UPDATE runs SET cpu_s = 1e300 WHERE rowid = 1", "runs.wall_s/cpu_s = 1e+300 s is not a run's time"},
     };
     for (const auto& c : cases) {
         INFO(c.damage);
