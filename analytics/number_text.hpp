@@ -74,7 +74,9 @@ inline TypedNumber read_typed_number(const std::string& text) {
     n.value = std::strtod(text.c_str(), &end);
     n.is_number = end == text.c_str() + text.size();
     if (!n.is_number) return n;
-    n.defect = errno == ERANGE && std::isinf(n.value) ? "is too large for a double" : number_defect(n.value);
+    if (errno == ERANGE && std::isinf(n.value)) n.defect = "is too large for a double";
+    else if (errno == ERANGE && n.value == 0) n.defect = "is too close to 0 for a double (it would read as 0)";
+    else n.defect = number_defect(n.value);
     return n;
 }
 

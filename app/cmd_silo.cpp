@@ -331,6 +331,12 @@ void check_run_size(const ks::SiloCaseSettings& s) {
     const double dt = ks::planned_time_step(s);
     const double simulated = s.fill_time_max + s.max_time;
     const double steps = simulated / dt;
+    // (1e-9 s ran no step of the discharge and ended "not determined" with exit 0)
+    for (const auto& [option, t] : {std::pair<const char*, double>{"--max-time", s.max_time},
+                                    std::pair<const char*, double>{"--fill-time", s.fill_time_max}})
+        if (t < dt)
+            throw UserError(std::string(option) + " " + ks::setting_text(t) + " s is shorter than one time step (" +
+                            ks::setting_text(dt) + " s): nothing of it would be simulated");
     if (!(steps <= kMaxSiloSteps)) {
         const std::string given = s.time_step > 0 ? "--dt " + ks::setting_text(s.time_step) + " s"
                                                   : "--dt-fraction " + ks::setting_text(s.time_step_fraction) +
