@@ -542,8 +542,10 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     // any other file a run writes, already there in a folder no silo run has held (no .lock of one): a user's file
     // (a measured discharge.csv in a data folder was replaced by the run's own). In a folder a run held, they are an
     // earlier attempt's (a campaign's retry in its run folder), replaced.
+    // (files only: a folder in a file's place cannot be replaced, the write fails and says so)
     for (const char* name : kRunFiles)
-        if (!fs::exists(fs::symlink_status(dir / ".lock")) && fs::exists(fs::symlink_status(dir / name)))
+        if (!fs::exists(fs::symlink_status(dir / ".lock")) &&
+            (fs::is_regular_file(fs::symlink_status(dir / name)) || fs::is_symlink(fs::symlink_status(dir / name))))
             throw UserError("out = '" + dir.string() + "' already holds " + name + ", a file a silo run writes: give "
                             "another --out (a new or empty folder), or remove it");
     if (!o.no_plots) require_gnuplot("--no-plots");
