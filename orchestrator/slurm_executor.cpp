@@ -1,5 +1,6 @@
 #include "orchestrator/slurm_executor.hpp"
 
+#include "analytics/number_text.hpp"
 #include "orchestrator/run_identity.hpp"
 
 #include <array>
@@ -108,10 +109,6 @@ bool is_terminal(const std::string& state) {
            state != "SUSPENDED" && state != "REQUEUED" && state != "RESIZING";
 }
 
-std::string shortened(const std::string& text) {
-    return text.size() <= 300 ? text : text.substr(0, 300) + "... (" + std::to_string(text.size()) + " characters)";
-}
-
 }  // namespace
 
 std::optional<long> parse_sbatch_job_id(const std::string& output) {
@@ -168,7 +165,7 @@ SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition
     : slots_(slots), work_dir_(std::move(work_dir)), partition_(std::move(partition)) {
     if (slots < 1) throw std::invalid_argument("jobs = " + std::to_string(slots) + " must be at least 1");
     if (const std::string defect = slurm_partition_defect(partition_); !defect.empty())
-        throw std::invalid_argument("partition = '" + shortened(partition_) + "': " + defect);
+        throw std::invalid_argument("partition = '" + analytics::shortened_text(partition_, 300) + "': " + defect);
     int code = 0;
     capture("command -v sbatch", &code);
     if (code != 0)
@@ -202,7 +199,7 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
         write_text_file_atomically(script, s.str());
         const std::string out = capture("sbatch --parsable " + shell_quote(script.string()));
         const std::optional<long> array_id = parse_sbatch_job_id(out);
-        if (!array_id) throw std::runtime_error("sbatch printed no job id: " + shortened(out));
+        if (!array_id) throw std::runtime_error("sbatch printed no job id: " + analytics::shortened_text(out, 300));
         const auto now = std::chrono::steady_clock::now();
         for (std::size_t i = 0; i < batch.size(); ++i) {
             tasks.push_back({batch[i], *array_id, static_cast<int>(i), now, now});
