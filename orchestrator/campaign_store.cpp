@@ -5,9 +5,11 @@
 #include "orchestrator/shear_campaign.hpp"  // check_shear_result_values
 
 #include <sqlite3.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cctype>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -325,6 +327,39 @@ std::string read_only_uri(const std::filesystem::path& db_path) {
     return may_be_open ? uri : uri + "?immutable=1";
 }
 
+// True when the file is a store another process began to make (DB.new-PID, or its -wal/-shm/-journal) and that
+// process is gone: what a kill during a store's creation leaves behind.
+bool is_abandoned_fresh_store(const std::string& file_name, const std::string& db_name) {
+    const std::string prefix = db_name + ".new-";
+    if (file_name.compare(0, prefix.size(), prefix) != 0) return false;
+    std::string_view rest(file_name);
+    rest.remove_prefix(prefix.size());
+    for (const char* suffix : {"-wal", "-shm", "-journal"}) {
+        const std::string_view s(suffix);
+        if (rest.size() > s.size() && rest.substr(rest.size() - s.size()) == s) {
+            rest.remove_suffix(s.size());
+            break;
+        }
+    }
+    long pid = 0;
+    const auto [end, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), pid);
+    if (ec != std::errc() || end != rest.data() + rest.size() || pid <= 0) return false;
+    if (pid == ::getpid()) return false;
+    return ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+}
+
+void remove_abandoned_fresh_stores(const std::filesystem::path& db_path) {
+    std::error_code ec;
+    const std::filesystem::path folder = db_path.has_parent_path() ? db_path.parent_path() : ".";
+    const std::string db_name = db_path.filename().string();
+    std::vector<std::filesystem::path> abandoned;
+    for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+        if (!it->is_regular_file(ec)) continue;
+        if (is_abandoned_fresh_store(it->path().filename().string(), db_name)) abandoned.push_back(it->path());
+    }
+    for (const auto& file : abandoned) std::filesystem::remove(file, ec);
+}
+
 }  // namespace
 
 CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess access)
@@ -341,6 +376,7 @@ CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess a
         throw std::invalid_argument("campaign store '" + db_path.string() +
                                     "' is empty (0 bytes), not a demcal campaign store; nothing was written to it");
     check_store_path(db_path);
+    if (!read_only) remove_abandoned_fresh_stores(db_path);
     if (!existed) {
         // made whole under another name, then renamed into place: a kill -9 in its first milliseconds left a store of
         // 0 or 4096 bytes that every later command refused as not demcal's

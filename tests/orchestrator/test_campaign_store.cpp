@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <sqlite3.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -174,5 +175,42 @@ TEST_CASE("run folders are stored relative to the campaign, so a copied campaign
     CampaignStore copy(d / "b" / "campaign.sqlite");
     CHECK(copy.run("h1")->run_dir == d / "b" / "runs" / "h1");
     CHECK(copy.run("h2")->run_dir == d / "b" / "runs" / "h2");
+    fs::remove_all(d);
+}
+
+TEST_CASE("a store another process began to make and never finished is removed when the store is next opened",
+          "[store]") {
+    // a kill during a store's creation leaves DB.new-PID (and maybe its -wal/-shm); the next writer removes those of
+    // processes that are gone, never a live process's, never another file
+    const fs::path d = fresh_dir("store-abandoned");
+    const pid_t gone = ::fork();
+    if (gone == 0) ::_exit(0);
+    REQUIRE(gone > 0);
+    int status = 0;
+    ::waitpid(gone, &status, 0);
+    const std::string dead = std::to_string(gone), live = std::to_string(::getppid());
+    const std::vector<std::string> abandoned = {"c.sqlite.new-" + dead, "c.sqlite.new-" + dead + "-wal",
+                                                "c.sqlite.new-" + dead + "-shm"};
+    const std::vector<std::string> kept = {"c.sqlite.new-" + live, "c.sqlite.new-" + dead + "x",
+                                           "c.sqlite.new-", "other.sqlite.new-" + dead, "c.sqlite.new--1"};
+    for (const auto& name : abandoned) std::ofstream(d / name) << "x";
+    for (const auto& name : kept) std::ofstream(d / name) << "x";
+    SECTION("on creation") { CampaignStore s(d / "c.sqlite"); }
+    SECTION("on reopening") {
+        { CampaignStore s(d / "c2.sqlite"); }
+        fs::rename(d / "c2.sqlite", d / "c.sqlite");
+        CampaignStore s(d / "c.sqlite");
+    }
+    SECTION("never by a reader") {
+        { CampaignStore s(d / "c2.sqlite"); }
+        fs::rename(d / "c2.sqlite", d / "c.sqlite");
+        CampaignStore s(d / "c.sqlite", StoreAccess::read_only);
+        for (const auto& name : abandoned) CHECK(fs::exists(d / name));
+        fs::remove_all(d);
+        return;
+    }
+    for (const auto& name : abandoned) CHECK_FALSE(fs::exists(d / name));
+    for (const auto& name : kept) CHECK(fs::exists(d / name));
+    CHECK(fs::exists(d / "c.sqlite"));
     fs::remove_all(d);
 }
