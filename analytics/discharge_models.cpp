@@ -17,6 +17,7 @@ double deg(double rad) { return rad * 180.0 / pi; }
 
 // Smallest outlet-to-particle ratio for which Beverloo-type correlations hold (Mankoc et al. 2007: d > 5-6 d_p).
 constexpr double min_outlet_particle_ratio = 6.0;
+constexpr double min_coarse_particle_size = 0.4e-3;  // [m] below it, a powder: air-retarded flow
 // Silo-to-outlet ratio below which wall effects matter (the seed: D/d > 2.5 is conventional).
 constexpr double min_silo_outlet_ratio = 2.5;
 }  // namespace
@@ -107,6 +108,20 @@ void validate(const SiloGeometry& g) {
     positive("outlet_m", g.outlet);
     positive("d_p_m", g.particle_size);
     positive("rho_b_kg_m3", g.bulk_density);
+    // Finite but absurd values (a bulk density of 0.001 kg/m^3, a silo 1e99 m across) gave rates reported as valid.
+    // The bounds are those of bulk solids and silos, wide enough for any real case.
+    auto plausible = [](const char* field, double v, double lo, double hi, const char* unit, const char* why) {
+        if (!(v >= lo && v <= hi))
+            throw std::invalid_argument(std::string(field) + "=" + number_text(v) + " outside [" + number_text(lo) +
+                                        ", " + number_text(hi) + "]" + (*unit ? std::string(" ") + unit : std::string()) + " (" +
+                                        why + ")");
+    };
+    constexpr double largest_silo_m = 100;  // the largest silos are about 50 m across
+    const char* silo_size = "no silo is larger than 100 m";
+    plausible("outlet_m", g.outlet, 0, largest_silo_m, "m", silo_size);
+    plausible("d_p_m", g.particle_size, 1e-6, 1, "m", "bulk solids: from 1 um powders to 1 m rocks");
+    plausible("rho_b_kg_m3", g.bulk_density, 10, 2e4, "kg/m^3",
+              "bulk solids: from about 30 kg/m^3 (expanded perlite) to about 12000 (tungsten powder)");
     if (!(g.half_angle_deg > 0 && g.half_angle_deg <= 90))
         throw std::invalid_argument("theta_deg=" + number_text(g.half_angle_deg) + " not in (0, 90] (90 = flat bottom)");
     if (g.outlet <= g.particle_size)
@@ -114,26 +129,34 @@ void validate(const SiloGeometry& g) {
                                     number_text(g.particle_size) + ")");
     if (g.shape == SiloShape::conical) {
         positive("D_m", g.silo_diameter);
+        plausible("D_m", g.silo_diameter, 0, largest_silo_m, "m", silo_size);
         if (g.outlet >= g.silo_diameter)
             throw std::invalid_argument("outlet_m=" + number_text(g.outlet) + " is not smaller than the silo, D_m=" +
                                         number_text(g.silo_diameter));
     } else {
         positive("b_m", g.depth);
         positive("c_m", g.width);
+        plausible("b_m", g.depth, 0, largest_silo_m, "m", silo_size);
+        plausible("c_m", g.width, 0, largest_silo_m, "m", silo_size);
         if (g.outlet >= g.width)
             throw std::invalid_argument("outlet_m=" + number_text(g.outlet) + " is not smaller than the silo width, c_m=" +
                                         number_text(g.width));
     }
     positive("beverloo_C", g.beverloo_c);
     if (!(g.beverloo_k >= 0)) throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + " must be >= 0");
+    positive("slot_C", g.slot_c);
+    positive("delta", g.arch_delta);
+    // model constants: several times their literature values at most (C 0.55-0.65, k 1-3, C' ~1.03, delta ~0.5)
+    plausible("beverloo_C", g.beverloo_c, 0, 3, "", "Beverloo's C is 0.55-0.65 in the literature");
+    plausible("beverloo_k", g.beverloo_k, 0, 10, "", "Beverloo's k is 1-3 in the literature");
+    plausible("slot_C", g.slot_c, 0, 5, "", "Myers and Sellers' C' is about 1");
+    plausible("delta", g.arch_delta, 0, 10, "", "Oldal's arch height over the outlet is about 0.5");
     // Beverloo's empty annulus k d_p must leave an opening, or its rate is 0 for any silo (k is 1-3 in the literature)
     const double opening = g.shape == SiloShape::rectangular ? std::min(g.outlet, g.depth) : g.outlet;
     if (g.beverloo_k * g.particle_size >= opening)
         throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + ": k d_p = " +
                                     number_text(g.beverloo_k * g.particle_size) + " m is not smaller than the outlet (" +
                                     number_text(opening) + " m): Beverloo's effective outlet would be empty");
-    positive("slot_C", g.slot_c);
-    positive("delta", g.arch_delta);
     if (!(g.stagnant_angle_deg > 0 && g.stagnant_angle_deg < 90))
         throw std::invalid_argument("phi_d_deg=" + number_text(g.stagnant_angle_deg) + " not in (0, 90)");
     if (g.effective_friction_deg.has_value() != g.wall_friction_deg.has_value())
@@ -183,6 +206,16 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
                                  number_text(min_outlet_particle_ratio) + ": intermittent flow and clogging, correlation not valid");
         }
     };
+    // Every model here is for coarse, free-flowing grains: below about 0.4 mm the interstitial air's pressure gradient
+    // slows the flow (Nedderman 1992, Statics and Kinematics of Granular Materials) and they overpredict it.
+    auto needs_coarse_particles = [&](DischargePrediction& p) {
+        if (g.particle_size < min_coarse_particle_size) {
+            p.valid = false;
+            p.warnings.push_back("d_p = " + number_text(g.particle_size) + " m < " +
+                                 number_text(min_coarse_particle_size) +
+                                 " m: a fine powder, the interstitial air slows the flow, the model overpredicts");
+        }
+    };
     auto wrong_shape = [&](DischargePrediction& p) {
         p.valid = false;
         p.warnings.push_back(std::string("applies to ") + (conical ? "rectangular" : "conical") + " silos only");
@@ -202,6 +235,7 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
                 p.warnings.push_back("hopper steeper than the stagnant zone (theta < 90 - phi_d): Beverloo "
                                      "underestimates, see beverloo+rose-tanaka");
         }
+        if (p.rate) needs_coarse_particles(p);
         out.push_back(p);
     }
     {
@@ -213,6 +247,7 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
                      rose_tanaka_factor(theta, g.stagnant_angle_deg);
             needs_outlet_ratio(p, g.outlet);
         }
+        if (p.rate) needs_coarse_particles(p);
         out.push_back(p);
     }
     {
@@ -223,6 +258,7 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
             p.rate = beverloo_slot_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.slot_c, g.beverloo_k);
             needs_outlet_ratio(p, g.outlet);
         }
+        if (p.rate) needs_coarse_particles(p);
         out.push_back(p);
     }
     {
@@ -241,6 +277,7 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
                 p.warnings.push_back(pattern_note);
             }
         }
+        if (p.rate) needs_coarse_particles(p);
         out.push_back(p);
     }
     {
@@ -251,6 +288,7 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
             p.rate = oldal_rate(g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
             funnel_flow_model(p);
         }
+        if (p.rate) needs_coarse_particles(p);
         out.push_back(p);
     }
     {
@@ -265,6 +303,7 @@ std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
             }
             funnel_flow_model(p);
         }
+        if (p.rate) needs_coarse_particles(p);
         out.push_back(p);
     }
     return out;

@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -122,4 +123,52 @@ TEST_CASE("geometry JSON errors name the key and the value", "[discharge]") {
     auto missing = j;
     missing.erase("D_m");
     CHECK_THROWS_WITH(geometry_from_json(missing), Catch::Contains("missing key D_m"));
+}
+
+TEST_CASE("absurd but finite geometries are refused with the field and its plausible range", "[discharge]") {
+    // a bulk density of 0.001 kg/m^3 or a silo 1e99 m across gave rates reported as valid
+    const nlohmann::json conical{{"geometry", "conical"}, {"D_m", 0.105},     {"outlet_m", 0.035}, {"theta_deg", 30},
+                                 {"d_p_m", 0.0055},      {"rho_b_kg_m3", 800}};
+    const nlohmann::json rectangular{{"geometry", "rectangular"}, {"b_m", 0.2},     {"c_m", 0.4}, {"outlet_m", 0.1},
+                                     {"theta_deg", 30},           {"d_p_m", 0.004}, {"rho_b_kg_m3", 800}};
+    CHECK_NOTHROW(geometry_from_json(conical));
+    CHECK_NOTHROW(geometry_from_json(rectangular));
+    struct Case {
+        const nlohmann::json& base;
+        const char* key;
+        double value;
+    };
+    for (const Case& c : {Case{conical, "rho_b_kg_m3", 0.001}, Case{conical, "rho_b_kg_m3", 1e308},
+                          Case{conical, "D_m", 1e99}, Case{conical, "D_m", 250}, Case{conical, "d_p_m", 1e-9},
+                          Case{conical, "beverloo_C", 1e6}, Case{conical, "beverloo_k", 11},
+                          Case{conical, "delta", 1e8}, Case{rectangular, "slot_C", 7}, Case{rectangular, "b_m", 1e5},
+                          Case{rectangular, "c_m", 101}}) {
+        auto j = c.base;
+        j[c.key] = c.value;
+        INFO(c.key << " = " << c.value);
+        CHECK_THROWS_WITH(geometry_from_json(j), Catch::Contains(std::string(c.key) + "=") && Catch::Contains("outside ["));
+    }
+    auto huge = conical;  // a large silo inside the bounds is fine
+    huge["D_m"] = 40.0;
+    huge["outlet_m"] = 0.5;
+    CHECK_NOTHROW(geometry_from_json(huge));
+}
+
+TEST_CASE("predict marks every model invalid for a fine powder", "[discharge]") {
+    nlohmann::json j{{"geometry", "conical"}, {"D_m", 0.105},    {"outlet_m", 0.035}, {"theta_deg", 30},
+                     {"d_p_m", 0.0055},      {"rho_b_kg_m3", 800}};
+    for (const auto& p : predict_discharge(geometry_from_json(j)))
+        if (p.rate) CHECK(std::none_of(p.warnings.begin(), p.warnings.end(),
+                                       [](const std::string& w) { return w.find("fine powder") != std::string::npos; }));
+    j["d_p_m"] = 1e-4;  // 100 um: air-retarded flow
+    int evaluated = 0;
+    for (const auto& p : predict_discharge(geometry_from_json(j))) {
+        if (!p.rate) continue;
+        ++evaluated;
+        INFO(p.model);
+        CHECK_FALSE(p.valid);
+        CHECK(std::any_of(p.warnings.begin(), p.warnings.end(),
+                          [](const std::string& w) { return w.find("fine powder") != std::string::npos; }));
+    }
+    CHECK(evaluated >= 3);
 }
