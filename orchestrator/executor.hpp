@@ -3,6 +3,7 @@
 // (SlurmExecutor). Both pull jobs from a callback, so the campaign can re-queue a retry while others still run.
 #pragma once
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -11,11 +12,19 @@
 
 namespace demcal::orchestrator {
 
+// 4 GiB: a checkpoint of several million grains fits, a log that grows without end does not.
+inline constexpr std::uintmax_t kMaxJobFileBytes = std::uintmax_t{4} << 30;
+// A job stopped for passing its file-size limit: the cause recorded for it (a run that did it once does it again).
+inline constexpr const char* kOutputLimitCause = "output_limit";
+
 struct Job {
     std::string id;                   // the run's identity
     std::filesystem::path dir;        // working directory; stdout.log and stderr.log are written there
     std::vector<std::string> argv;    // command, run in `dir`
     double timeout_s = 3600;          // wall-clock limit: terminate, then kill after the grace period
+    // the largest file the job may write (RLIMIT_FSIZE, `ulimit -f` on SLURM): a simulator whose output runs away
+    // (a print in a loop) stops there instead of filling the disk
+    std::uintmax_t max_file_bytes = kMaxJobFileBytes;
 };
 
 struct JobOutcome {
@@ -56,6 +65,11 @@ public:
 
 // Reads the tail of a job's stderr.log for the failure cause and message.
 void read_failure_from_stderr(const std::filesystem::path& stderr_log, JobOutcome& out);
+
+// After a job ended: when it was stopped for writing a file past job.max_file_bytes (SIGXFSZ, or a shell's exit code
+// 128 + SIGXFSZ with such a file in its folder), the outcome says so (cause kOutputLimitCause) and each of its logs
+// that reached the limit is cut to its last 64 KiB, so that a failed run does not keep gigabytes of repeated lines.
+void note_file_size_limit(const Job& job, JobOutcome& out);
 
 class LocalExecutor : public Executor {
 public:

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
+#include <iterator>
 #include <signal.h>
 #include <stdexcept>
 #include <sys/prctl.h>
@@ -66,6 +67,50 @@ void read_failure_from_stderr(const std::filesystem::path& stderr_log, JobOutcom
     out.message = last;
 }
 
+namespace {
+
+// Keeps the last `keep` bytes of a log that passed its limit, under a first line that says what was dropped.
+void cut_runaway_log(const std::filesystem::path& log, std::uintmax_t size, std::uintmax_t limit) {
+    constexpr std::uintmax_t keep = 64 * 1024;
+    std::ifstream in(log, std::ios::binary);
+    if (!in) return;
+    in.seekg(static_cast<std::streamoff>(size > keep ? size - keep : 0));
+    std::string tail((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    const std::filesystem::path cut = log.string() + ".cut";
+    {
+        std::ofstream out(cut, std::ios::binary | std::ios::trunc);
+        out << "[demcal: this log passed the limit of " << limit << " bytes per file and the run was stopped; its first "
+            << (size - tail.size()) << " bytes were dropped]\n"
+            << tail;
+        if (!out) return;
+    }
+    std::error_code ec;
+    std::filesystem::rename(cut, log, ec);
+}
+
+}  // namespace
+
+void note_file_size_limit(const Job& job, JobOutcome& out) {
+    const bool killed_by_limit = out.term_signal == SIGXFSZ;
+    if (!killed_by_limit && out.exit_code != 128 + SIGXFSZ) return;
+    std::error_code ec;
+    std::string largest;
+    for (std::filesystem::directory_iterator it(job.dir, ec), end; !ec && it != end; it.increment(ec)) {
+        std::error_code size_ec;
+        if (!it->is_regular_file(size_ec)) continue;
+        const std::uintmax_t size = it->file_size(size_ec);
+        if (size_ec || size < job.max_file_bytes) continue;
+        largest = it->path().filename().string();
+        if (it->path().extension() == ".log") cut_runaway_log(it->path(), size, job.max_file_bytes);
+    }
+    if (largest.empty() && !killed_by_limit) return;  // a shell's exit code 153 of its own
+    out.failure_cause = kOutputLimitCause;
+    out.message = "stopped for writing a file past the limit of " + std::to_string(job.max_file_bytes) +
+                  " bytes per file" + (largest.empty() ? std::string() : " (" + largest + ")") +
+                  ": its output ran away";
+}
+
 bool process_group_runs_in(long pgid, const std::filesystem::path& dir) {
     if (pgid <= 0 || ::kill(-static_cast<pid_t>(pgid), 0) != 0) return false;
     std::error_code ec;
@@ -109,6 +154,11 @@ pid_t spawn(const Job& job) {
         ::signal(SIGINT, SIG_DFL);
         ::signal(SIGTERM, SIG_DFL);
         if (::chdir(job.dir.c_str()) != 0) ::_exit(126);
+        struct rlimit file_size {};
+        if (::getrlimit(RLIMIT_FSIZE, &file_size) == 0 && file_size.rlim_cur > job.max_file_bytes) {
+            file_size.rlim_cur = static_cast<rlim_t>(job.max_file_bytes);
+            ::setrlimit(RLIMIT_FSIZE, &file_size);
+        }
         const int out = ::open("stdout.log", O_WRONLY | O_CREAT | O_APPEND, 0644);
         const int err = ::open("stderr.log", O_WRONLY | O_CREAT | O_APPEND, 0644);
         if (out < 0 || err < 0) ::_exit(126);
@@ -160,6 +210,7 @@ void LocalExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
                 o.timed_out = r.timed_out;
                 o.interrupted = r.interrupted;
                 read_failure_from_stderr(r.job.dir / "stderr.log", o);
+                note_file_size_limit(r.job, o);
                 if (o.timed_out) {
                     o.failure_cause = "timeout";
                     char buf[64];
@@ -168,7 +219,7 @@ void LocalExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
                 } else if (o.interrupted) {
                     o.failure_cause = "interrupted";
                     o.message = "stopped by the user";
-                } else if (o.term_signal) {
+                } else if (o.term_signal && o.failure_cause != kOutputLimitCause) {
                     o.failure_cause = "signal";
                     o.message = std::string("killed by signal ") + ::strsignal(o.term_signal);
                 }

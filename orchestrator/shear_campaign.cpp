@@ -198,7 +198,7 @@ constexpr const char* kSimulatorNotStarted = "exec";
 // Physical failures and bad parameters are deterministic: a retry would fail the same way.
 bool retry_is_pointless(const std::string& cause) {
     static const std::set<std::string> final_causes = {"nan", "kinetic_energy", "escaped", "normal_stress", "params",
-                                                       "no_result"};
+                                                       "no_result", kOutputLimitCause};
     return final_causes.count(cause) > 0;
 }
 

@@ -57,7 +57,9 @@ struct Task {
 void write_task_script(const Job& job) {
     std::ostringstream s;
     s << "#!/bin/bash\n# Written by demcal's SLURM executor: runs this job, then records how it ended.\n"
-      << "cd " << shell_quote(job.dir.string()) << " || exit 1\nrm -f exit_status\nstart=$(date +%s.%N)\n";
+      << "cd " << shell_quote(job.dir.string()) << " || exit 1\nrm -f exit_status\n"
+      // the job's file-size limit in 1024-byte blocks (the soft limit only: a hard limit below it stays)
+      << "ulimit -S -f " << job.max_file_bytes / 1024 << " 2>/dev/null\nstart=$(date +%s.%N)\n";
     for (const auto& a : job.argv) s << shell_quote(a) << ' ';
     s << ">>stdout.log 2>>stderr.log </dev/null\ncode=$?\nend=$(date +%s.%N)\n"
       // `times` in this shell, not in $(...): a subshell's children times start at zero.
@@ -80,6 +82,7 @@ bool read_exit_status(const Job& job, JobOutcome& o) {
     o.wall_s = end - start;
     o.cpu_s = cpu;
     read_failure_from_stderr(job.dir / "stderr.log", o);
+    note_file_size_limit(job, o);
     return true;
 }
 

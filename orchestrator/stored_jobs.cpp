@@ -125,7 +125,8 @@ StoredJobsOutcome run_stored_jobs(CampaignStore& store, std::int64_t campaign_id
             event("done", job, seconds_text(o.wall_s));
             return;
         }
-        const bool final = o.exit_code == 2;  // its input was refused: the same input fails the same way
+        // its input was refused, or its output ran away: the same job fails the same way
+        const bool final = o.exit_code == 2 || cause == kOutputLimitCause;
         store.mark_attempt_failed(j.id, cause, message, o.exit_code, o.wall_s, o.cpu_s, final);
         ++(final ? out.failed : out.pending);
         event(final ? "failed" : "retry later", job, cause + ": " + message);
