@@ -1,5 +1,6 @@
 // The local executor's file-size limit: a job whose output runs away is stopped at its limit, recorded as such, and
 // its log cut to its tail.
+#include "campaign_test_support.hpp"
 #include "orchestrator/executor.hpp"
 
 #include <catch2/catch.hpp>
@@ -17,13 +18,6 @@ using namespace demcal::orchestrator;
 namespace fs = std::filesystem;
 
 namespace {
-fs::path fresh_dir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() / ("demcal-test-" + name + "-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
 JobOutcome run_one(const Job& job) {
     LocalExecutor executor(1);
     bool given = false;
@@ -46,7 +40,7 @@ std::string first_line(const fs::path& file) {
 }  // namespace
 
 TEST_CASE("a job whose log runs away is stopped at its file-size limit and its log cut to the tail", "[executor]") {
-    const fs::path d = fresh_dir("executor-runaway");
+    const fs::path d = demcal::test::fresh_test_dir("executor-runaway");
     Job job{"runaway", d / "run", {"sh", "-c", "echo start; while :; do echo 'the same line again'; done"}, 60};
     job.max_file_bytes = 1 << 20;
     const JobOutcome o = run_one(job);
@@ -62,7 +56,7 @@ TEST_CASE("a job whose log runs away is stopped at its file-size limit and its l
 }
 
 TEST_CASE("a job that writes large files below its limit is not touched by it", "[executor]") {
-    const fs::path d = fresh_dir("executor-below-limit");
+    const fs::path d = demcal::test::fresh_test_dir("executor-below-limit");
     Job job{"big", d / "run", {"sh", "-c", "head -c 2000000 /dev/zero > data.bin && echo written"}, 60};
     job.max_file_bytes = 4 << 20;
     const JobOutcome o = run_one(job);
@@ -74,7 +68,7 @@ TEST_CASE("a job that writes large files below its limit is not touched by it", 
 
 TEST_CASE("a shell's exit code 153 is an output limit only when a file reached the limit", "[executor]") {
     // what a SLURM task's run.sh reports: bash gives 128 + SIGXFSZ for a command the limit stopped
-    const fs::path d = fresh_dir("executor-153");
+    const fs::path d = demcal::test::fresh_test_dir("executor-153");
     Job job{"slurm-like", d, {"true"}, 60};
     job.max_file_bytes = 1 << 20;
     JobOutcome own_code;
