@@ -68,13 +68,13 @@ inline kernel::silo::SiloCaseSettings check_resumes_bit_for_bit(kernel::silo::Si
                     SimulatedCrash);
     CHECK_FALSE(opened);
     const SiloCaseSettings stored = read_checkpoint_settings(s.checkpoint_file);
-    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0},
+    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}},
                                      [&](const SiloProgress& p) {
                                          if (p.phase == "checkpoint" && p.discharge_time > second_kill_after)
                                              throw SimulatedCrash{};
                                      }),
                     SimulatedCrash);
-    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0});
+    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}});
     CHECK(resumed.sessions == 3);
     CHECK(resumed.fill_steps == whole.fill_steps);
     CHECK(resumed.fill_kinetic_energy == whole.fill_kinetic_energy);

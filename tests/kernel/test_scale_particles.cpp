@@ -10,7 +10,7 @@ using namespace demcal::kernel;
 
 TEST_CASE("particles grow in place as YADE's growParticles makes them", "[kernel][scale_particles]") {
   YadeLawSimulation sim;
-  const int m = sim.add_material({.young = 1e7, .poisson = 0.3, .density = 2000});
+  const int m = sim.add_material({.young = 1e7, .poisson = 0.3, .density = 2000, .name = {}});
   sim.set_pair(m, m, {{}, {.friction = 0.5}});
   const BodyId sphere = sim.add_sphere(Vec3(0, 0, 0), 0.01, m, Vec3(0.1, 0, 0));
   // YADE: two spheres r = 0.01 at x = 0.1 and 0.11, after growParticles(1.1): r = 0.011 at x = 0.0995 and 0.1105
@@ -41,7 +41,7 @@ TEST_CASE("particles grow in place as YADE's growParticles makes them", "[kernel
 
 TEST_CASE("grown particles find the contacts their new size makes at once", "[kernel][scale_particles]") {
   YadeLawSimulation sim;
-  const int m = sim.add_material({.young = 1e7, .poisson = 0.3, .density = 2000});
+  const int m = sim.add_material({.young = 1e7, .poisson = 0.3, .density = 2000, .name = {}});
   sim.set_pair(m, m, {{}, {.friction = 0.5}});
   sim.set_gravity(Vec3::Zero());
   sim.add_sphere(Vec3(0, 0, 0), 0.01, m);
@@ -58,8 +58,8 @@ TEST_CASE("grown particles find the contacts their new size makes at once", "[ke
 
 TEST_CASE("the unbalanced force is YADE's: mean body force over mean contact force", "[kernel][scale_particles]") {
   YadeLawSimulation sim;
-  const int m = sim.add_material({.young = 1e6, .poisson = 0.3, .density = 2000});
-  const int floor_mat = sim.add_material({.young = 1e6, .poisson = 0.3, .density = 2000});
+  const int m = sim.add_material({.young = 1e6, .poisson = 0.3, .density = 2000, .name = {}});
+  const int floor_mat = sim.add_material({.young = 1e6, .poisson = 0.3, .density = 2000, .name = {}});
   sim.set_pair(m, m, {{}, {.friction = 0.5}});
   sim.set_pair(m, floor_mat, {{}, {.friction = 0.5}});
   sim.add_wall(Wall::plane(Vec3::Zero(), Vec3::UnitZ(), floor_mat));
@@ -69,7 +69,7 @@ TEST_CASE("the unbalanced force is YADE's: mean body force over mean contact for
   CHECK(sim.unbalanced_force() == 0.0);
   // one sphere resting on the floor: body force |F_contact + m g| -> 0 against contact force m g
   YadeLawSimulation rest;
-  const int a = rest.add_material({.young = 1e6, .poisson = 0.3, .density = 2000});
+  const int a = rest.add_material({.young = 1e6, .poisson = 0.3, .density = 2000, .name = {}});
   rest.set_pair(a, a, {{}, {.friction = 0.5}});
   rest.add_wall(Wall::plane(Vec3::Zero(), Vec3::UnitZ(), a));
   rest.add_sphere(Vec3(0, 0, 0.0099), 0.01, a);
@@ -87,7 +87,7 @@ TEST_CASE("growth is charged to the neighbour skin - the list keeps every contac
   // a loose random cloud, no gravity, random velocities; 200 growth calls of 0.2 % each (49 % in radius) with a step
   // after each: through the list, the contacts are always the brute-force ones
   YadeLawSimulation sim;
-  const int m = sim.add_material({.young = 1e7, .poisson = 0.3, .density = 2000});
+  const int m = sim.add_material({.young = 1e7, .poisson = 0.3, .density = 2000, .name = {}});
   sim.set_pair(m, m, {{}, {.friction = 0.5}});
   sim.set_gravity(Vec3::Zero());
   std::uint64_t state = 12345;

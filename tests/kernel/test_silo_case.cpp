@@ -197,7 +197,7 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
                     SimulatedCrash);
     CHECK(read_checkpoint_settings(s.checkpoint_file).particles == 600);
     // second session, two threads: dies at the first checkpoint 0.1 s after the opening
-    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0},
+    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}},
                                      [&](const SiloProgress& p) {
                                          if (p.phase == "checkpoint" && p.discharge_time > 0.1) throw SimulatedCrash{};
                                      }),
@@ -205,7 +205,7 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
     // third session: stops itself at its wall limit (reached within the first record interval), checkpoint written
     long steps_reported = 0;
     const SiloCaseResult suspended =
-        resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 1e6, .wall_limit = 1e-6},
+        resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 1e6, .wall_limit = 1e-6, .stop_request = {}},
                          [&](const SiloProgress& p) { steps_reported = p.step; });
     CHECK(suspended.suspended);
     CHECK(suspended.steps == steps_reported);
@@ -216,11 +216,11 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
         const auto appended = dir / "appended.bin";
         std::filesystem::copy_file(s.checkpoint_file, appended);
         std::ofstream(appended, std::ios::app | std::ios::binary) << "garbage";
-        CHECK_THROWS_WITH(resume_silo_case(appended.string(), {.threads = 1}),
+        CHECK_THROWS_WITH(resume_silo_case(appended.string(), {.threads = 1, .checkpoint_interval = 900, .wall_limit = 0, .stop_request = {}}),
                           Catch::Matchers::Contains("appended.bin") && Catch::Matchers::Contains("bytes after its end"));
     }
     // fourth session: to the end
-    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0});
+    const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}});
     CHECK_FALSE(resumed.suspended);
     CHECK(resumed.sessions == 4);
     CHECK(resumed.cpu_sessions == 4);

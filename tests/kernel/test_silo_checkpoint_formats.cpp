@@ -44,14 +44,14 @@ void check_resumes_as_its_writer_finished(const std::string& format) {
     CHECK(stored.particles == expected.at("particles").get<long>());
     // checkpoints after every record interval, stopped before the end: the run's state in this demcal's format
     struct Stop {};
-    CHECK_THROWS_AS(resume_silo_case(file.string(), {.threads = 1, .checkpoint_interval = 0},
+    CHECK_THROWS_AS(resume_silo_case(file.string(), {.threads = 1, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}},
                                      [](const SiloProgress& p) {
                                          if (p.phase == "checkpoint") throw Stop{};
                                      }),
                     Stop);
     CHECK(head_of(file).find(tag) == std::string::npos);  // rewritten in a newer format
     CHECK(head_of(file).find("demcal-silo-checkpoint/") != std::string::npos);
-    const SiloCaseResult r = resume_silo_case(file.string(), {.threads = 1, .checkpoint_interval = 1e9});
+    const SiloCaseResult r = resume_silo_case(file.string(), {.threads = 1, .checkpoint_interval = 1e9, .wall_limit = 0, .stop_request = {}});
     CHECK(r.sessions == 3);
     CHECK(r.steps == expected.at("steps").get<long>());
     CHECK(r.grains_discharged == expected.at("grains_discharged").get<long>());
