@@ -69,7 +69,7 @@ ShearBoxParams to_kernel_params(const nlohmann::json& j) {
     return p;
 }
 
-nlohmann::json to_json(const ShearBoxResult& r) {
+nlohmann::json to_json(const ShearBoxResult& r, const std::string& params_sha256) {
     return {{"schema", orchestrator::kShearResultSchema},
             {"curve",
              {{"displacement", r.displacement},
@@ -100,13 +100,17 @@ nlohmann::json to_json(const ShearBoxResult& r) {
             {"steps", r.steps},
             {"timestep", r.timestep},
             {"wall_time_s", r.wall_time_s},
-            {"engine", kernel::cases::kShearBoxEngine}};
+            {"engine", kernel::cases::kShearBoxEngine},
+            {"params_sha256", params_sha256}};
 }
 
 void run(const std::string& params_path, const std::string& result_path, int threads) {
     ShearBoxParams params;
+    std::string params_sha256;
     try {
-        params = to_kernel_params(checked_run_params(analytics::read_json_input(params_path, "params"), params_path));
+        const nlohmann::json raw = analytics::read_json_input(params_path, "params");
+        params_sha256 = orchestrator::params_digest(raw);
+        params = to_kernel_params(checked_run_params(raw, params_path));
         kernel::cases::validate(params);
     } catch (const kernel::cases::ShearBoxFailure& e) {
         fail(2, "params", e.what());
@@ -128,7 +132,7 @@ void run(const std::string& params_path, const std::string& result_path, int thr
     }
     try {
         orchestrator::write_text_file_atomically(result_path,
-                                                 orchestrator::sealed_result_text(to_json(result).dump(1) + "\n"));
+                                                 orchestrator::sealed_result_text(to_json(result, params_sha256).dump(1) + "\n"));
     } catch (const std::exception& e) {
         fail(3, "output", e.what());
     }

@@ -104,6 +104,8 @@ std::string run_identity(const std::string& template_text, const nlohmann::json&
     return sha256_hex(sha256_hex(template_text) + "\n" + canonical_numbers(params).dump());
 }
 
+std::string params_digest(const nlohmann::json& params) { return sha256_hex(canonical_numbers(params).dump()); }
+
 std::string read_text_file(const std::filesystem::path& p) {
     std::ifstream f(p, std::ios::binary);
     if (!f) throw std::runtime_error("cannot read " + p.string());

@@ -15,6 +15,11 @@ std::string sha256_hex(const std::string& bytes);
 // double counts as the integer (30000.0 and 30000 are one run).
 std::string run_identity(const std::string& template_text, const nlohmann::json& params);
 
+// SHA-256 of the parameters' canonical form alone. A result that carries it ("params_sha256": demcal shear-run writes
+// it; YADE's template does not) tells which run it belongs to: a result copied from another run's folder, even of the
+// same normal stress and another seed, is not taken for this run's.
+std::string params_digest(const nlohmann::json& params);
+
 // result.json of a shear run (schema demcal.shear_result/2) is sealed with the SHA-256 of its own text, so that a
 // file damaged after its atomic write (a flipped byte, a truncated copy) is found when the orchestrator reads it. The
 // rule, the same for every writer (yade_scripts/shear_box.py's write_result_atomically, demcal shear-run): BODY is the

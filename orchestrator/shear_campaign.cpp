@@ -285,7 +285,18 @@ void check_shear_result_values(const nlohmann::json& result, const std::string& 
                                         " Pa is outside [0, " + analytics::number_text(limit) +
                                         "] (not a shear box's result)");
     }
-    // the run's own result, not another run's copied into its folder
+    // the run's own result, not another run's copied into its folder: by its parameters' digest where the writer
+    // gave one (the kernel engine), else by its normal stress (YADE's template records no more of its run)
+    if (result.contains("params_sha256")) {
+        const auto& digest = result["params_sha256"];
+        if (!digest.is_string() || digest.get<std::string>().size() != 64 ||
+            digest.get<std::string>().find_first_not_of("0123456789abcdef") != std::string::npos)
+            throw std::invalid_argument(what + ": params_sha256 = " + analytics::json_value_text(digest) +
+                                        " is not 64 lowercase hex digits");
+        if (run_params && digest.get<std::string>() != params_digest(*run_params))
+            throw std::invalid_argument(what + ": the result of a run with other parameters (its params_sha256 is "
+                                        "not this run's): another run's result in this run's folder");
+    }
     if (run_params && target && run_params->contains("normal_stress") && (*run_params)["normal_stress"].is_number()) {
         const double own = (*run_params)["normal_stress"].get<double>();
         if (std::fabs(*target - own) > 1e-9 * std::fabs(own))

@@ -3,11 +3,15 @@
 #include <catch2/catch.hpp>
 
 #include "campaign_test_support.hpp"
+#include "orchestrator/campaign_store.hpp"
 #include "orchestrator/run_identity.hpp"
+#include "orchestrator/shear_campaign.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <set>
 
 namespace fs = std::filesystem;
@@ -43,6 +47,7 @@ TEST_CASE("a kernel-engine campaign fits a failure line, stores its runs beside 
         const std::string yade_identity = orchestrator::run_identity(
             test::read_file(test::source_path("yade_scripts/shear_box.py")), r.params);
         CHECK(r.hash != yade_identity);
+        CHECK(r.result.at("params_sha256") == orchestrator::params_digest(r.params));  // the run it belongs to
         hashes.insert(r.hash);
     }
     CHECK(hashes.size() == 3);
@@ -93,4 +98,62 @@ TEST_CASE("runs that timed out are tried again by resume (a longer --timeout), r
     for (const auto& r : test::stored_runs(camp)) CHECK(r.state == RunState::done);
     CHECK_THAT(test::read_file(dir / "resume.log"), Catch::Matchers::Contains("Peak failure line"));
     fs::remove_all(dir);
+}
+
+TEST_CASE("resume does not take another replicate's result, copied into an interrupted run's folder, for the run's",
+          "[kernel_engine]") {
+    // two replicates of one stress differ only in their seed: a result copied from one to the other passed every
+    // check of the result's own values (probe 44); the kernel's results carry their parameters' digest
+    const fs::path dir = test::fresh_test_dir("kernel-copied-result");
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3,6e3", "-r", "2", "--engine", "kernel", "--jobs", "2",
+                              "--campaign", dir.string()},
+                             dir / "first.log") == 0);
+    auto runs = test::stored_runs(dir);
+    REQUIRE(runs.size() == 4);
+    const orchestrator::RunRecord* a = nullptr;
+    const orchestrator::RunRecord* b = nullptr;
+    for (const auto& r : runs)
+        if (r.params.at("normal_stress").get<double>() == 3e3) (a ? b : a) = &r;
+    REQUIRE((a && b));
+    REQUIRE(a->params.at("seed") != b->params.at("seed"));
+    const std::string own_result = test::read_file(b->run_dir / "result.json");
+    const pid_t gone = ::fork();  // a pid that is no process's: the orchestrator that "died" while b ran
+    if (gone == 0) ::_exit(0);
+    ::waitpid(gone, nullptr, 0);
+    {
+        orchestrator::CampaignStore store(dir / "campaign.sqlite");
+        store.mark_running(b->hash, 0, gone, "local");
+        store.set_campaign_status(store.campaigns().front().id, "interrupted");
+    }
+    fs::copy_file(a->run_dir / "result.json", b->run_dir / "result.json", fs::copy_options::overwrite_existing);
+    REQUIRE(test::run_demcal({"resume", dir.string()}, dir / "resume.log") == 0);
+    INFO(test::read_file(dir / "resume.log"));
+    for (const auto& r : test::stored_runs(dir)) {
+        if (r.hash != b->hash) continue;
+        CHECK(r.state == RunState::done);
+        CHECK(r.result.at("params_sha256") == orchestrator::params_digest(b->params));
+        CHECK(r.result.at("peak_shear_stress") != a->result.at("peak_shear_stress"));
+    }
+    // the rerun computes the run's own result again (the kernel is deterministic; only the wall time differs)
+    auto without_wall_time = [](const std::string& text) {
+        auto j = nlohmann::json::parse(orchestrator::unsealed_result_text(text));
+        j.erase("wall_time_s");
+        return j;
+    };
+    CHECK(without_wall_time(test::read_file(b->run_dir / "result.json")) == without_wall_time(own_result));
+}
+
+TEST_CASE("a result whose parameters' digest is not the run's, or is no digest, is refused", "[kernel_engine]") {
+    const nlohmann::json params{{"normal_stress", 5e3}, {"seed", 1}, {"density", 2650}};
+    nlohmann::json result{{"peak_shear_stress", 3e3}, {"normal_stress_target", 5e3}};
+    CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", &params));  // YADE's: no digest
+    result["params_sha256"] = orchestrator::params_digest(params);
+    CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", &params));
+    nlohmann::json other_seed = params;
+    other_seed["seed"] = 2;
+    CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &other_seed),
+                      Catch::Contains("other parameters"));
+    result["params_sha256"] = "ABC";
+    CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &params),
+                      Catch::Contains("params_sha256 = \"ABC\" is not 64 lowercase hex digits"));
 }
