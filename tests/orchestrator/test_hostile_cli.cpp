@@ -391,7 +391,7 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
     const std::string camp = (dir / "camp").string(), out = (dir / "o").string();
     fs::copy_file(test::source_path("examples/diagnose/silo_105mm_wheat.json"), dir / "geometry.json");
     nlohmann::json wide = nlohmann::json::parse(test::read_file(dir / "geometry.json"));
-    wide["beverloo_k"] = 100;  // k d_p wider than the outlet
+    wide["beverloo_k"] = 7;  // k d_p = 38.5 mm, wider than the 35 mm outlet
     std::ofstream(dir / "wide_k.json") << wide.dump();
     refused({{{"vibration", "--theta", "30,30.0000001", "--frequency", "0", "--campaign", camp},
               {"--theta 30.0000001", "the same run folder"}},
@@ -408,7 +408,7 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--threads", "2147483647"}, {"--threads"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--body-height", "1e5"},
               {"body_height = 100000", "20 silo sizes"}},
-             {{"predict", (dir / "wide_k.json").string()}, {"beverloo_k=100", "effective outlet would be empty"}},
+             {{"predict", (dir / "wide_k.json").string()}, {"beverloo_k=7", "effective outlet would be empty"}},
              // a shear campaign that cannot give a failure line ran and ended "no failure line" with exit 0
              {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,5e3,5e3",
                "--engine", "kernel", "--campaign", camp},
