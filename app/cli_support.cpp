@@ -18,6 +18,7 @@
 #include <map>
 #include <string_view>
 
+#include <climits>
 #include <unistd.h>
 
 namespace demcal {
@@ -140,12 +141,42 @@ bool can_create_files_in(const std::filesystem::path& folder) {
     return true;
 }
 
+// Room demcal needs beyond an output's own name and path: its temporary copies (".tmp" and a process id) and the
+// files it writes beside an output under derived names ("_residuals.png", ...).
+constexpr std::size_t kDerivedNameChars = 40;
+
+// Refuses a path the file system would refuse only when the first file is written, hours later ("File name too
+// long"): a name longer than NAME_MAX (a file's own name less the room for its derived names), or a whole path that
+// leaves no room below PATH_MAX for the files demcal writes into it.
+enum class PathKind { file, folder };
+void check_name_lengths(const std::string& path, const std::string& named, PathKind kind) {
+    namespace fs = std::filesystem;
+    const fs::path p(path);
+    for (const fs::path& part : p) {
+        const bool own_name = kind == PathKind::file && part == p.filename();
+        const std::size_t most = own_name ? NAME_MAX - kDerivedNameChars : NAME_MAX;
+        if (part.native().size() > most)
+            throw UserError(named + ": a name in the path is " + std::to_string(part.native().size()) +
+                            " characters long; at most " + std::to_string(most) + " (the file system takes " +
+                            std::to_string(NAME_MAX) +
+                            (own_name ? ", demcal adds up to " + std::to_string(kDerivedNameChars) +
+                                            " for its temporary and side files)"
+                                      : ")"));
+    }
+    std::error_code ec;
+    const std::size_t whole = fs::absolute(p, ec).native().size();
+    if (whole + 2 * kDerivedNameChars > PATH_MAX)
+        throw UserError(named + ": the path is " + std::to_string(whole) + " characters long as an absolute path; at most " +
+                        std::to_string(PATH_MAX - 2 * kDerivedNameChars));
+}
+
 }  // namespace
 
 void check_output_file(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
     if (path.empty()) throw UserError(option + ": an empty path");
+    check_name_lengths(path, named, PathKind::file);
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
     const fs::file_status st = fs::status(path, ec);  // (through a link: what the output would be written into)
@@ -182,6 +213,7 @@ void check_output_folder(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
     if (path.empty()) throw UserError(option + ": an empty path");
+    check_name_lengths(path, named, PathKind::folder);
     std::error_code ec;
     if (fs::exists(path, ec) && !fs::is_directory(path, ec)) throw UserError(named + " is a file, not a folder");
     check_files_can_be_created_below(path, named);
@@ -193,7 +225,9 @@ void check_output_file_in_new_folders(const std::string& path, const std::string
     std::error_code ec;
     const fs::path parent = fs::path(path).parent_path();
     if (parent.empty() || fs::exists(parent, ec)) return check_output_file(path, option);
-    check_files_can_be_created_below(parent, option + " = '" + analytics::shortened_text(path, 200) + "'");
+    const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
+    check_name_lengths(path, named, PathKind::file);
+    check_files_can_be_created_below(parent, named);
 }
 
 namespace {

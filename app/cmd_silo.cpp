@@ -532,6 +532,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     ks::SiloCaseSettings s = settings_from(o, sub);
     const fs::path dir =
         o.out.empty() ? fs::path("silo_theta" + fixed(s.geometry.half_angle_deg, 0)) : fs::path(o.out);
+    check_output_folder(dir.string(), "--out");  // first: a path the file system refuses fails every look into it
     if (fs::exists(dir / kCheckpointName))
         throw UserError("out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +

@@ -1,10 +1,15 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_command(int argc, char** argv) {
     CLI::App app{"demcal: DEM calibration, YADE campaigns, discharge models and a native DEM kernel"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "demcal 0.1");
@@ -45,3 +50,20 @@ int main(int argc, char** argv) {
     }
     return 0;
 }
+
+// A result printed into a full disk or a closed file is lost: say so and fail, whatever the command's own status
+// (`demcal predict geometry.json > /dev/full` printed nothing and exited 0).
+int with_standard_output_checked(int status) {
+    errno = 0;
+    std::cout.flush();
+    const bool flushed = std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good();
+    if (flushed) return status;
+    const int why = errno;
+    std::cerr << "demcal: error: the standard output could not be written"
+              << (why != 0 ? std::string(" (") + std::strerror(why) + ")" : std::string()) << "; what was printed is incomplete\n";
+    return status == 0 ? 1 : status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return with_standard_output_checked(run_command(argc, argv)); }

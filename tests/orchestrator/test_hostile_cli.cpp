@@ -692,3 +692,25 @@ TEST_CASE("probe 44: kill -9 in a campaign's first milliseconds leaves no store 
     }
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 46: a result printed into a full disk fails the command, and a name too long to write is refused "
+          "before any work",
+          "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-probe46"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string geometry = test::source_path("examples/diagnose/silo_105mm_wheat.json").string();
+    // predict's table went into /dev/full, nothing of it was written, and the exit status said success
+    const std::string cmd = std::string("'") + DEMCAL_BINARY + "' predict '" + geometry + "' > /dev/full 2> '" +
+                            (root / "full.log").string() + "'";
+    const int status = std::system(cmd.c_str());
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 1);
+    CHECK_THAT(test::read_file(root / "full.log"), Contains("standard output could not be written"));
+    // a name past NAME_MAX was accepted and failed at the write ("File name too long"), the option unnamed
+    refused({{{"predict", geometry, "--json", (dir / (std::string(300, 'a') + ".json")).string()},
+              {"--json", "a name in the path is 305 characters long", "characters)'"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", (dir / std::string(260, 'c')).string()},
+              {"--out", "a name in the path is 260 characters long", "at most 255"}}},
+            dir);
+    fs::remove_all(root);
+}
