@@ -312,6 +312,66 @@ bool has_empty_item(std::string_view list) {
 
 }  // namespace
 
+namespace {
+
+// Whether `arg` is written as a number ("-5", "-1e-3"): a value, not an option.
+bool looks_like_number(std::string_view arg) {
+    double x = 0;
+    const auto [end, ec] = std::from_chars(arg.data(), arg.data() + arg.size(), x);
+    return ec == std::errc() && end == arg.data() + arg.size();
+}
+
+// Whether the command passes the arguments after `--` on to the runs it starts (its positional "silo_args").
+bool passes_arguments_on(const CLI::App& command) {
+    return !command
+                .get_options([](const CLI::Option* o) {
+                    const std::string& name = o->get_name();
+                    return o->get_positional() && name.size() > 5 && name.compare(name.size() - 5, 5, "_args") == 0;
+                })
+                .empty();
+}
+
+// Refuses an option the command does not have, before `--`. CLI11 took it for a positional value of commands that
+// pass arguments on (vibration, cutoff: `-j 2` became a silo option) and named other words than the one mistyped.
+void check_options_known(const CLI::App& app, int argc, const char* const* argv) {
+    std::vector<const CLI::App*> chain{&app};
+    int i = 1;
+    for (; i < argc; ++i) {  // the command and its subcommands, as far as they are named
+        const CLI::App* deeper = nullptr;
+        for (const CLI::App* sub : chain.back()->get_subcommands([](const CLI::App*) { return true; }))
+            if (sub->check_name(argv[i])) deeper = sub;
+        if (!deeper) break;
+        chain.push_back(deeper);
+    }
+    if (chain.size() < 2) return;  // no command: CLI11 and the check above say so
+    auto option_named = [&chain](const std::string& name) -> const CLI::Option* {
+        for (const CLI::App* a : chain)
+            for (const CLI::Option* opt : a->get_options())
+                if (opt->check_name(name)) return opt;
+        return nullptr;
+    };
+    for (; i < argc; ++i) {
+        const std::string_view arg(argv[i]);
+        if (arg == "--") break;  // a run's own options, checked by that run's command line
+        if (arg.size() < 2 || arg[0] != '-' || looks_like_number(arg)) continue;
+        if (std::isdigit(static_cast<unsigned char>(arg[1])) || arg[1] == '.') continue;  // "-10,400": a value
+        std::string name(arg.substr(0, arg.find('=')));
+        if (arg[1] != '-') name = std::string(arg.substr(0, 2));  // -j2: the short option -j with its value
+        if (const CLI::Option* opt = option_named(name)) {
+            // its value, whatever it looks like, is the option's to check ("--partition -x")
+            if (opt->get_items_expected_min() > 0 && name.size() == arg.size()) ++i;
+            continue;
+        }
+        std::string command;
+        for (std::size_t k = 1; k < chain.size(); ++k) command += (k > 1 ? " " : "") + chain[k]->get_name();
+        throw UserError(command + ": '" + analytics::shortened_text(name) + "' is not an option of this command (" +
+                        "see demcal " + command + " --help" +
+                        (passes_arguments_on(*chain.back()) ? "; options for the runs go after --" : "") + ")");
+    }
+}
+
+}  // namespace
+
 void check_command_line_shape(const CLI::App& app, int argc, const char* const* argv) {
     if (argc > 1 && argv[1][0] != '-') {
         std::string known;
@@ -323,6 +383,7 @@ void check_command_line_shape(const CLI::App& app, int argc, const char* const* 
         if (!found)
             throw UserError("'" + analytics::shortened_text(argv[1]) + "' is not a demcal command (" + known + ")");
     }
+    check_options_known(app, argc, argv);
     std::map<std::string, std::string> lists;
     collect_list_options(app, lists);
     for (int i = 1; i < argc; ++i) {

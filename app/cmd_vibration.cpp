@@ -370,7 +370,7 @@ void add_vibration_command(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--first-seed", o->first_seed, "seed of the first repeat")->check(integer_in(0, 1LL << 62));
     sub->add_option("--campaign", o->campaign, "campaign directory (the same command continues it)")->required();
-    sub->add_option("--jobs", o->jobs, "runs at once (locally 1 by default: each run takes the cores --threads "
+    sub->add_option("--jobs,-j", o->jobs, "runs at once (locally 1 by default: each run takes the cores --threads "
                                        "gives it; on SLURM the array's slots)")
         ->check(integer_in(1, 256))
         ->capture_default_str();

@@ -714,3 +714,27 @@ TEST_CASE("probe 46: a result printed into a full disk fails the command, and a 
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 46: an option the command does not have is named, even where the command passes arguments on",
+          "[cli]") {
+    // vibration took `-j 2` (an option it lacked) for silo arguments and named "--no-plots 400 --particles" instead
+    const fs::path root = test::fresh_test_dir("hostile-unknown-option"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string geometry = test::source_path("examples/diagnose/silo_105mm_wheat.json").string();
+    refused({{{"vibration", "--theta", "30", "--frequency", "0,50", "--amplitude", "1e-4", "--bogus", "2",
+               "--campaign", (dir / "vib").string(), "--", "--particles", "400"},
+              {"vibration: '--bogus' is not an option", "options for the runs go after --"}},
+             {{"predict", "--jsn", (dir / "x.json").string(), geometry}, {"predict: '--jsn' is not an option"}},
+             {{"crosscheck", "shear", test::source_path("examples/materials/sand-tiny.json").string(), "-q"},
+              {"crosscheck shear: '-q' is not an option"}}},
+            dir);
+    // negative numbers stay values, options after -- belong to the runs
+    CHECK(test::run_demcal({"silo", "--theta", "30", "--vibration-start", "-1", "--check"}, root / "neg.log") == 2);
+    CHECK_THAT(test::read_file(root / "neg.log"), Contains("vibration-start") && !Contains("is not an option"));
+    CHECK(test::run_demcal({"vibration", "--theta", "30", "--frequency", "0", "-j", "1", "--campaign",
+                            (dir / "vib").string(), "--", "--bogus-silo-option", "1"},
+                           root / "after.log") == 2);
+    CHECK_THAT(test::read_file(root / "after.log"), Contains("silo: '--bogus-silo-option' is not an option"));  // the run's
+    CHECK_FALSE(fs::exists(dir / "vib"));
+    fs::remove_all(root);
+}
