@@ -130,7 +130,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                                "vibration_frequency = 1000: a period is only"},
                           // the command-line parser's own refusals exit 2 as well
                           Case{"--theta abc", "--theta: 'abc' is not a number"},
-                          Case{"--theta 30 --thetaa 3", "not expected"}}) {
+                          Case{"--theta 30 --thetaa 3", "'--thetaa' is not an option"}}) {
         INFO(c.args);
         const Run r = run_silo(c.args + " --out '" + out.string() + "'", dir);
         CHECK(r.rc == 2);
