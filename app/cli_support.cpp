@@ -101,6 +101,54 @@ void refuse_empty_values(CLI::App& app) {
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
 }
 
+namespace {
+// An option of `cmd` by its long name, or nullptr if the command has none.
+const CLI::Option* option_named(const CLI::App& cmd, const std::string& name) {
+    for (const CLI::Option* opt : cmd.get_options())
+        if (opt->check_lname(name)) return opt;
+    return nullptr;
+}
+
+// The value an option ended with: the one given, else its default (an empty default: `fallback`).
+std::string value_or_default(const CLI::Option& opt, const std::string& fallback) {
+    if (opt.count() > 0) return opt.as<std::string>();
+    const std::string d = opt.get_default_str();
+    return d.empty() ? fallback : d;
+}
+
+// An option that takes effect only when another option has a given value (the other's default when it is not given).
+struct OptionNeeds {
+    const char* option;
+    const char* other;
+    const char* value;
+    const char* other_default;
+    const char* what;  // what the option is, for the message
+};
+constexpr OptionNeeds kOptionNeeds[] = {
+    {"partition", "executor", "slurm", "local", "a SLURM partition"},
+    {"yade", "engine", "yade", "yade", "YADE's launcher"},
+    {"grid-points", "method", "grid", "surrogate", "the grid's points per parameter"},
+};
+
+void check_options_apply(const CLI::App& cmd) {
+    for (const OptionNeeds& rule : kOptionNeeds) {
+        const CLI::Option* opt = option_named(cmd, rule.option);
+        const CLI::Option* other = option_named(cmd, rule.other);
+        if (!opt || !other || opt->count() == 0) continue;
+        const std::string value = value_or_default(*other, rule.other_default);
+        if (value == rule.value) continue;
+        throw UserError(std::string("--") + rule.option + " = '" + analytics::shortened_text(opt->as<std::string>()) +
+                        "' is " + rule.what + ": it applies to --" + rule.other + " " + rule.value + " only (this " +
+                        "command runs with --" + rule.other + " " + value + ")");
+    }
+    for (const CLI::App* sub : cmd.get_subcommands()) check_options_apply(*sub);
+}
+}  // namespace
+
+void refuse_inapplicable_options(CLI::App& app) {
+    app.parse_complete_callback([&app] { check_options_apply(app); });
+}
+
 void check_argument_lengths(int argc, const char* const* argv) {
     for (int i = 1; i < argc; ++i) {
         const std::string_view arg(argv[i]);

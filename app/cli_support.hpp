@@ -25,6 +25,12 @@ CLI::Validator integer_in(long long lo, long long hi);  // a whole integer, lo <
 // option the integer rule (integer_in, never clamped). Call once every command is registered.
 void refuse_empty_values(CLI::App& app);
 
+// Refuses, once the command line is parsed and before any command runs, an option the rest of the command line makes
+// void, naming it and what it needs: --partition without --executor slurm, --yade with --engine kernel (both were
+// silently ignored: a user who meant a SLURM campaign got a local one). One rule per pair, for every command that
+// has both options. Call once every command is registered (it sets `app`'s parse-complete callback).
+void refuse_inapplicable_options(CLI::App& app);
+
 // The longest command-line argument demcal takes: a path (PATH_MAX) or a list of numbers.
 inline constexpr std::size_t kMaxArgumentChars = 4096;
 

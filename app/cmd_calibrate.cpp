@@ -244,7 +244,9 @@ void add_calibrate(CLI::App& app) {
     cmd->add_flag("--sequential", o->sequential, "slope first, then cohesion (the seed's order)");
     cmd->add_flag("--strict", o->strict, "stop on the tolerance only, not when a target is inside the simulated interval");
     cmd->add_option("--max-evaluations", o->max_evaluations, "failure lines at most (start included)")->capture_default_str();
-    cmd->add_option("--grid-points", o->grid_points, "points per parameter (grid method)")->capture_default_str();
+    cmd->add_option("--grid-points", o->grid_points, "points per parameter (grid method)")
+        ->check(integer_in(2, 1000))
+        ->capture_default_str();
     cmd->add_option("--output,-o", o->output, "calibrated material JSON (default CAMPAIGN/calibrated_material.json; calibrated_material_<method>.json for the baselines)");
     cmd->add_option("--params", o->study.params, "study: parameters to vary")->delimiter(',');
     cmd->add_option("--levels", o->study.levels, "study: values per parameter")->check(integer_in(3, calibration::kMaxLevels))->capture_default_str();

@@ -854,7 +854,8 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--max-time", o.max_time, "discharge time limit after the opening [s]")->capture_default_str();
     sub->add_option("--fill-time", o.fill_time, "filling time limit [s] (ends earlier once the grains are at rest)")
         ->capture_default_str();
-    sub->add_option("--dt", o.dt, "time step [s] (default: --dt-fraction x the Rayleigh time step)");
+    sub->add_option("--dt", o.dt, "time step [s] (default: --dt-fraction x the Rayleigh time step)")
+        ->check(positive_number());  // 0 stands for "not given" inside: `--dt 0` ran the default time step
     sub->add_option("--dt-fraction", o.dt_fraction, "time step as a fraction of the Rayleigh time step")
         ->capture_default_str();
     sub->add_option("--stiffness-scale", o.stiffness_scale,

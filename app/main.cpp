@@ -23,6 +23,7 @@ int run_command(int argc, char** argv) {
     demcal::add_calibration_commands(app);
     demcal::add_scale_command(app);
     demcal::refuse_empty_values(app);
+    demcal::refuse_inapplicable_options(app);
     try {
         demcal::check_argument_lengths(argc, argv);
         demcal::check_command_line_shape(app, argc, argv);

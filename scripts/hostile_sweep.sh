@@ -207,7 +207,7 @@ run_case scale/dir-readonly          2 "campaign" "$ro"   -- scale "$tiny" -s 5e
 run_case scale/base-deep             2 "nest"            -- scale "$work/deep.json" --dir camp --radii 1e-3,1.5e-3,2e-3
 run_case scale/base-folder           2 "folder.json"     -- scale "$work/folder.json" --dir camp --radii 1e-3,1.5e-3,2e-3
 
-run_case calibrate/grid-huge          2 "evaluations"     -- calibrate --start "$tiny" --target mu_b=1.3,tau_c=800 --method grid --grid-points 100000 -s 5e3,1e4,2e4 --campaign camp
+run_case calibrate/grid-huge          2 "evaluations"     -- calibrate --start "$tiny" --target mu_b=1.3,tau_c=800 --method grid --grid-points 1000 -s 5e3,1e4,2e4 --campaign camp
 
 # ---- demcal cutoff --------------------------------------------------------------------------------------------------
 run_case cutoff/bond-nan             2 "--bond-number"   -- cutoff --bond-number nan

@@ -738,3 +738,35 @@ TEST_CASE("probe 46: an option the command does not have is named, even where th
     CHECK_FALSE(fs::exists(dir / "vib"));
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 47: an option the rest of the command line makes void is refused, not ignored", "[cli]") {
+    // --partition without --executor slurm, --yade with --engine kernel and --grid-points without --method grid ran
+    // as if they were not given: a user who meant a SLURM campaign got a local one
+    const fs::path root = test::fresh_test_dir("hostile-probe47"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "camp").string();
+    refused({{{"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "--partition", "batch", "-c", camp},
+              {"--partition = 'batch' is a SLURM partition", "--executor slurm only", "--executor local"}},
+             {{"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "--yade", "/usr/bin/yade", "-c", camp},
+              {"--yade = '/usr/bin/yade'", "--engine yade only", "--engine kernel"}},
+             {{"vibration", "--theta", "30", "--frequency", "0", "--partition", "batch", "--campaign", camp},
+              {"--partition = 'batch'", "--executor slurm only"}},
+             {{"calibrate", "--target", "mu_b=0.5,tau_c=100", "--start", tiny, "--engine", "kernel", "--grid-points",
+               "5", "-c", camp},
+              {"--grid-points = '5'", "--method grid only", "--method surrogate"}},
+             // values that cannot be meant: no run ends within 1e-5 s, a grid of -1 points, a time step of 0 (which
+             // stood for "not given": the default ran)
+             {{"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "--timeout", "1e-5", "-c", camp},
+              {"--timeout", "1e-5"}},
+             {{"calibrate", "--target", "mu_b=0.5,tau_c=100", "--start", tiny, "--method", "grid", "--grid-points",
+               "-1", "-c", camp},
+              {"--grid-points", "-1"}},
+             {{"silo", "--theta", "30", "--dt", "0", "--check"}, {"--dt", "0 is not a positive number"}}},
+            dir);
+    CHECK_FALSE(fs::exists(camp));
+    // the rules leave what applies alone
+    CHECK(test::run_demcal({"silo", "--theta", "30", "--particles", "200", "--dt", "1e-6", "--check"},
+                           root / "dt.log") == 0);
+    fs::remove_all(root);
+}
