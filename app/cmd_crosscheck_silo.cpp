@@ -189,7 +189,7 @@ CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
     // refused early, named; YADE's Hertz-Mindlin has no JKR cohesion, so a cohesive material has no YADE twin
     for (const auto& [option, file] : {std::pair<std::string, std::string>{"--material", o.material},
                                        {"--yade-material", o.yade_material}})
-        if (!file.empty() && read_silo_material(file).cohesive())
+        if (!file.empty() && read_silo_material(file, option.substr(2)).cohesive())
             throw UserError(option + " = " + file + ": a cohesive material (surface_energy_J_m2 > 0): yade_scripts/silo.py "
                             "has no JKR cohesion to match the kernel's; cross-check cohesionless materials");
     if (!o.geometry.empty()) {
@@ -369,7 +369,7 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
     silo->add_option("--max-time", o->max_time, "discharge time limit [s]")->check(positive_number())->capture_default_str();
     silo->add_option("--campaign,-c", o->dir, "output directory (runs reused from it)")->capture_default_str();
     silo->add_option("--jobs,-j", o->jobs, "runs in parallel (0 = one per core)")->check(non_negative_number());
-    silo->add_option("--timeout", o->timeout_s, "per-run wall-clock limit [s]")->check(positive_number());
+    silo->add_option("--timeout", o->timeout_s, "per-run wall-clock limit [s], at least 1")->check(number_in(1, 1e9));
     silo->add_option("--executor", o->executor, "local (processes of this machine) or slurm (job arrays)")
         ->check(CLI::IsMember({"local", "slurm"}))
         ->capture_default_str();

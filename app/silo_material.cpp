@@ -82,8 +82,8 @@ ks::PairCoefficients pair(const json& root, const std::string& file, const std::
 
 }  // namespace
 
-ks::WheatMaterials read_silo_material(const std::string& file) {
-    const json root = read_json_file(file, "material");
+ks::WheatMaterials read_silo_material(const std::string& file, const std::string& what) {
+    const json root = read_json_file(file, what);
     object_with(root, file, "", {"name", "description", "grain", "wall", "grain_grain", "grain_wall"});
     ks::WheatMaterials m;
     m.wheat = solid(root, file, "grain", true);

@@ -11,8 +11,8 @@
 namespace demcal {
 
 /// Reads FILE into the silo's materials (the stiffness scale is left as it is). Throws UserError naming the file, the
-/// field and the value.
-kernel::silo::WheatMaterials read_silo_material(const std::string& file);
+/// field and the value; `what` names the input (the option without its dashes) where the file is unreadable.
+kernel::silo::WheatMaterials read_silo_material(const std::string& file, const std::string& what = "material");
 
 /// The materials as a material file spells them (G for each solid, unscaled; the stiffness scale is not part of it):
 /// read_silo_material reads it back to the same values.

@@ -229,7 +229,7 @@ run_case cutoff/json-readonly        2 "--json"  "$ro"   -- cutoff --bond-number
 run_case cutoff/json-no-folder       2 "--json"          -- cutoff --bond-number 10 --json /no/such/c.json
 meal="$here/examples/materials/silo_meal.json"
 run_case cutoff/silo-tol-tiny        2 "--tol"           -- cutoff --tol 1e-300 -- --material "$meal" --theta 30
-run_case cutoff/silo-dt-fraction     2 "--dt-fraction"   -- cutoff -- --material "$meal" --theta 30 --dt-fraction 1e-300
+run_case cutoff/silo-dt-fraction     2 "dt_fraction = "  -- cutoff -- --material "$meal" --theta 30 --dt-fraction 1e-300
 run_case cutoff/silo-particles-nan   2 "--particles"     -- cutoff -- --material "$meal" --theta 30 --particles nan
 run_case cutoff/silo-stiffness-sub   2 "--stiffness-scale" -- cutoff -- --material "$meal" --theta 30 --stiffness-scale 1e-320
 run_case cutoff/silo-out             2 "--out"           -- cutoff -- --material "$meal" --theta 30 --out o
@@ -305,8 +305,8 @@ run_case silo/vib-start-nan          2 "vibration-start" -- "${L[@]}" --vibratio
 run_case silo/vib-start-1e99         2 "vibration_start = 1e+99" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-start 1e99
 run_case silo/vib-start-no-vib       2 "vibration-start" -- "${L[@]}" --vibration-start 1
 run_case silo/dt-subnormal           2 "dt"              -- "${L[@]}" --dt 1e-320
-run_case silo/dt-fraction-tiny       2 "--dt-fraction"   -- "${L[@]}" --dt-fraction 1e-300
-run_case silo/dt-tiny                2 "--dt"            -- "${L[@]}" --dt 1e-300
+run_case silo/dt-fraction-tiny       2 "dt_fraction = "  -- "${L[@]}" --dt-fraction 1e-300
+run_case silo/dt-tiny                2 "dt = 1e-300"    -- "${L[@]}" --dt 1e-300
 run_case silo/vtk-every-tiny         2 "--vtk-every"     -- "${L[@]}" --vtk v --vtk-every 1e-300
 run_case silo/particles-huge         2 "particles"       -- "${L[@]}" --particles 99999999999999
 run_case silo/material-deep          2 "nest"            -- "${L[@]}" --material "$work/deep.json"

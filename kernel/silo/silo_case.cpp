@@ -303,8 +303,20 @@ void validate(const SiloCaseSettings& s) {
         reject_setting("dt", s.time_step,
                        "larger than the Rayleigh time step of the smallest wheat sphere (" + setting_text(rayleigh) +
                            " s at this stiffness); use a fraction of it, or --dt-fraction");
-    if (!(s.time_step_fraction > 0 && s.time_step_fraction <= 1))
-        reject_setting("dt_fraction", s.time_step_fraction, "must lie in (0, 1] (of the Rayleigh time step)");
+    // Below a thousandth of the Rayleigh step nothing is resolved better (at 0.25 a contact already spans tens of
+    // steps), and one record interval takes millions of steps: a stop (Ctrl-C, SIGTERM, --wall-limit), which waits
+    // for the end of one, did not come within minutes (--dt-fraction 1e-5).
+    const double rayleigh = smallest_sphere_rayleigh_step(s.materials);
+    if (s.time_step > 0 && s.time_step < kMinTimeStepFraction * rayleigh)
+        reject_setting("dt", s.time_step,
+                       "smaller than " + setting_text(kMinTimeStepFraction) + " of the Rayleigh time step of the "
+                       "smallest wheat sphere (" + setting_text(rayleigh) + " s at this stiffness): no more accurate, "
+                       "and a stop would wait minutes for the end of a record interval");
+    if (!(s.time_step_fraction >= kMinTimeStepFraction && s.time_step_fraction <= 1))
+        reject_setting("dt_fraction", s.time_step_fraction,
+                       "must lie in [" + setting_text(kMinTimeStepFraction) +
+                           ", 1] (of the Rayleigh time step; smaller is no more accurate, and a stop would wait "
+                           "minutes for the end of a record interval)");
     validate(s.vibration);
     if (s.contact_law != SiloContactLaw::edem && s.contact_law != SiloContactLaw::yade)
         reject_setting("contact_law", static_cast<double>(s.contact_law), "must be edem (0) or yade (1)");

@@ -71,6 +71,10 @@ const std::map<std::string, ClumpRotation>& silo_clump_rotations();
 std::string silo_clump_rotation_text(ClumpRotation scheme);  // its name in silo_clump_rotations()
 std::string silo_contact_law_text(SiloContactLaw law);  // its name in silo_contact_laws()
 
+// The smallest time step a silo run takes, as a fraction of the Rayleigh step (time_step and time_step_fraction):
+// smaller resolves nothing better, and a record interval would take millions of steps (a stop waits for its end).
+inline constexpr double kMinTimeStepFraction = 1e-3;
+
 struct SiloCaseSettings {
     SiloGeometry geometry;
     WheatMaterials materials;

@@ -146,9 +146,19 @@ TEST_CASE("silo: a time step that never lets the run end, or a snapshot every st
     fs::create_directories(dir);
     const std::string out = (dir / "o").string();
     refused({{{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt-fraction", "1e-300"},
-              {"--dt-fraction 1e-300", "time steps, more than 1e+09; the run would not end"}},
+              {"dt_fraction = 1e-300", "must lie in [0.001, 1]"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt", "1e-300"},
-              {"--dt 1e-300 s over --fill-time 2.1 s + --max-time 20 s"}},
+              {"dt = 1e-300", "smaller than 0.001 of the Rayleigh time step"}},
+             // the smallest fraction taken, over the default times: still too many steps for one run
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt-fraction", "1e-3"},
+              {"--dt-fraction 0.001", "time steps, more than 1e+09; the run would not end"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt", "1e-8"},
+              {"--dt 1e-08 s over --fill-time 2.1 s + --max-time 20 s"}},
+             // probe 47: --dt-fraction 1e-5 over a short run passed the count, and SIGTERM then waited minutes for
+             // the end of a 2 ms record interval
+             {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt-fraction", "1e-5", "--max-time",
+               "0.01", "--fill-time", "0.01"},
+              {"dt_fraction = 1e-05", "a stop would wait"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--vtk", (dir / "v").string(), "--vtk-every",
                "1e-300"},
               {"--vtk-every 1e-300 s", "snapshots, more than 100000"}}},
