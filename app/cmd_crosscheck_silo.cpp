@@ -196,7 +196,7 @@ CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
         const json geometry = analytics::read_json_input(o.geometry, "geometry");
         // yade_scripts/silo.py builds the conical silo only (its facet walls): a hopper would fail after the kernel's run
         if (geometry.is_object() && geometry.contains("shape") && geometry["shape"] != "conical")
-            throw UserError("--geometry = '" + o.geometry + "': shape = " + geometry["shape"].dump() +
+            throw UserError("--geometry = '" + o.geometry + "': shape = " + analytics::json_value_text(geometry["shape"]) +
                             ": yade_scripts/silo.py builds the conical silo only; cross-check a conical geometry");
     }
     if (!o.yade_material.empty()) in.yade_material = analytics::read_json_input(o.yade_material, "yade-material");

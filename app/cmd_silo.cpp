@@ -1,5 +1,6 @@
 // demcal silo: the seed's silo case (filling, opening, discharge) on the native DEM kernel.
 #include "analytics/discharge_models.hpp"
+#include "analytics/user_input.hpp"  // json_value_text
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
@@ -187,7 +188,7 @@ GeometryGiven read_geometry_file(const std::string& file) {
         if (key.rfind("_", 0) == 0) continue;  // keys starting with '_' are comments
         if (key == "shape") {
             if (!value.is_string() || (value != "conical" && value != "rectangular"))
-                throw UserError(file + ": shape = " + value.dump() + ": must be \"conical\" or \"rectangular\"");
+                throw UserError(file + ": shape = " + analytics::json_value_text(value) + ": must be \"conical\" or \"rectangular\"");
             g.rect = value == "rectangular";
             g.rect_source = file + ": shape";
             continue;
@@ -197,7 +198,7 @@ GeometryGiven read_geometry_file(const std::string& file) {
         if (!known)
             throw UserError(file + ": unknown key '" + key +
                             "' (known: shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m)");
-        if (!value.is_number()) throw UserError(file + ": " + key + " = " + value.dump() + ": must be a number");
+        if (!value.is_number()) throw UserError(file + ": " + key + " = " + analytics::json_value_text(value) + ": must be a number");
         g.values[key] = {value.get<double>(), file + ": " + key};
     }
     return g;

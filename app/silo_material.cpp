@@ -7,8 +7,10 @@
 #include <string>
 
 #include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"  // json_value_text
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "kernel/silo/silo_case.hpp"  // validate(WheatMaterials)
 
 namespace demcal {
 
@@ -34,7 +36,7 @@ const json& object_with(const json& j, const std::string& file, const std::strin
 double number(const json& j, const std::string& file, const std::string& field, const std::string& key) {
     if (!j.contains(key)) throw UserError(file + ": " + field + "." + key + " is missing");
     const json& v = j.at(key);
-    if (!v.is_number()) throw UserError(file + ": " + field + "." + key + " = " + v.dump().substr(0, 40) + ": must be a number");
+    if (!v.is_number()) throw UserError(file + ": " + field + "." + key + " = " + analytics::json_value_text(v) + ": must be a number");
     return v.get<double>();
 }
 
@@ -44,7 +46,7 @@ ks::Material solid(const json& root, const std::string& file, const std::string&
     if (grain) keys.insert({"shape", "aspect_ratio"});
     const json& j = object_with(root.at(field), file, field, keys);
     if (grain && j.contains("shape") && j.at("shape") != "wheat-clump")
-        throw UserError(file + ": " + field + ".shape = " + j.at("shape").dump().substr(0, 40) +
+        throw UserError(file + ": " + field + ".shape = " + analytics::json_value_text(j.at("shape")) +
                         ": the silo case has one grain shape, \"wheat-clump\" (the seed's 3-sphere grain)");
     ks::Material m{};
     m.poisson = number(j, file, field, "poisson");
@@ -91,6 +93,11 @@ ks::WheatMaterials read_silo_material(const std::string& file, const std::string
     m.steel = solid(root, file, "wall", false);
     m.wheat_wheat = pair(root, file, "grain_grain");
     m.wheat_steel = pair(root, file, "grain_wall");
+    try {
+        ks::validate(m);  // here, so that the message names the file
+    } catch (const std::invalid_argument& e) {
+        throw UserError(file + ": " + e.what());
+    }
     return m;
 }
 

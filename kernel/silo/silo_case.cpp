@@ -251,16 +251,17 @@ double planned_time_step(const SiloCaseSettings& s) {
     return s.time_step > 0 ? s.time_step : s.time_step_fraction * smallest_sphere_rayleigh_step(s.materials);
 }
 
-void validate(const SiloCaseSettings& s) {
-    // the materials first: the checks below derive masses and time steps from them
+void validate(const WheatMaterials& materials) {
+    // the fields by the names of the material file (app/silo_material.hpp: examples/materials/silo_wheat_table21.json)
     const auto solid = [](const Material& m, const std::string& name) {
         if (!(m.shear_modulus >= 1e3 && m.shear_modulus <= 1e12))
-            reject_setting(name + ".shear_modulus", m.shear_modulus, "must lie in [1e3, 1e12] Pa");
+            reject_setting(name + ".shear_modulus_Pa", m.shear_modulus, "must lie in [1e3, 1e12] Pa");
         if (!(m.poisson > -1 && m.poisson < 0.5)) reject_setting(name + ".poisson", m.poisson, "must lie in (-1, 0.5)");
-        if (!(m.density >= 10 && m.density <= 1e5)) reject_setting(name + ".density", m.density, "must lie in [10, 1e5] kg/m^3");
+        if (!(m.density >= 10 && m.density <= 1e5))
+            reject_setting(name + ".density_kg_m3", m.density, "must lie in [10, 1e5] kg/m^3");
     };
-    solid(s.materials.wheat, "grain");
-    solid(s.materials.steel, "wall");
+    solid(materials.wheat, "grain");
+    solid(materials.steel, "wall");
     const auto pair = [](const PairCoefficients& p, const std::string& name) {
         if (!(p.restitution > 0 && p.restitution <= 1))
             reject_setting(name + ".restitution", p.restitution, "must lie in (0, 1]");
@@ -269,14 +270,17 @@ void validate(const SiloCaseSettings& s) {
             reject_setting(name + ".rolling_friction", p.rolling_friction, "must lie in [0, 1]");
         // 100 J/m^2 gives the seed's grain a bond number 3 pi gamma R* / (m g) near 2000: far beyond any powder
         if (!(p.surface_energy >= 0 && p.surface_energy <= 100))
-            reject_setting(name + ".surface_energy", p.surface_energy, "must lie in [0, 100] J/m^2 (0: no cohesion)");
+            reject_setting(name + ".surface_energy_J_m2", p.surface_energy, "must lie in [0, 100] J/m^2 (0: no cohesion)");
     };
-    pair(s.materials.wheat_wheat, "grain_grain");
-    pair(s.materials.wheat_steel, "grain_wall");
-    if (!(s.materials.grain_aspect_ratio >= min_grain_aspect_ratio &&
-          s.materials.grain_aspect_ratio <= max_grain_aspect_ratio))
-        reject_setting("grain.aspect_ratio", s.materials.grain_aspect_ratio,
+    pair(materials.wheat_wheat, "grain_grain");
+    pair(materials.wheat_steel, "grain_wall");
+    if (!(materials.grain_aspect_ratio >= min_grain_aspect_ratio && materials.grain_aspect_ratio <= max_grain_aspect_ratio))
+        reject_setting("grain.aspect_ratio", materials.grain_aspect_ratio,
                        "must lie in [1, 2.6] (length / width of the 3-sphere grain; the seed's 1.833)");
+}
+
+void validate(const SiloCaseSettings& s) {
+    validate(s.materials);  // first: the checks below derive masses and time steps from them
     validate(s.geometry, grain_length(s.materials));
     if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
     // a bed is many grains: one grain has no bulk density, no flow pattern and no steady rate (`--particles 1` ran,

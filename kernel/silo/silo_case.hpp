@@ -147,6 +147,8 @@ struct SiloCaseSettings {
 
 // Throws std::invalid_argument naming the field and value (geometry, counts, times, fractions, the vibration).
 void validate(const SiloCaseSettings& s);
+// The materials alone (part of the above), their fields named as the material file names them (grain.density_kg_m3).
+void validate(const WheatMaterials& materials);
 
 // The silo's walls of steel material `steel`, the outlet plate last; the body reaches up to `wall_top`. The walls of
 // the vibrating `part` move on `bin_motion` (null: every wall still).

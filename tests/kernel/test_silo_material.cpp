@@ -111,7 +111,7 @@ TEST_CASE("demcal silo --material: bad files name the file, the field and the va
        "grain.shape"},
       {file(good_solid, R"({"restitution": "high", "friction": 0.3, "rolling_friction": 0.01})"), "must be a number"},
       {file(good_solid, R"({"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01,
-                             "surface_energy_J_m2": -0.5})"), "grain_grain.surface_energy = -0.5"},
+                             "surface_energy_J_m2": -0.5})"), "grain_grain.surface_energy_J_m2 = -0.5"},
       {file(good_solid, R"({"restitution": 0.5, "friction": 0.3, "rolling_friction": 0.01,
                              "surface_energy_J_m2": "sticky"})"), "surface_energy_J_m2 = \"sticky\": must be a number"},
       {file(R"({"aspect_ratio": 3, "shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430})", good_pair),

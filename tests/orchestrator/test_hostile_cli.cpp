@@ -780,3 +780,25 @@ TEST_CASE("probe 47: an option the rest of the command line makes void is refuse
                            root / "dt.log") == 0);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 47: a silo geometry or material names the file and its field, and shortens a long value", "[cli]") {
+    // a 100 kB shape string was echoed in full; a material's bad density was named grain.density, without its file
+    // and not by the key the file has (density_kg_m3)
+    const fs::path root = test::fresh_test_dir("hostile-probe47-silo"), dir = root / "work";
+    fs::create_directories(dir);
+    auto geometry = nlohmann::json::parse(test::read_file(test::source_path("examples/silo/seed_conical_30deg.json")));
+    geometry["shape"] = std::string(100000, 'x');
+    const fs::path geometry_file = root / "long_shape.json";
+    std::ofstream(geometry_file) << geometry.dump();
+    auto material =
+        nlohmann::json::parse(test::read_file(test::source_path("examples/materials/silo_wheat_table21.json")));
+    material["grain"]["density_kg_m3"] = 3;
+    const fs::path material_file = root / "light_grain.json";
+    std::ofstream(material_file) << material.dump();
+    refused({{{"silo", "--geometry", geometry_file.string(), "--check"},
+              {"long_shape.json: shape = \"xxxx", "(100002 characters)"}},
+             {{"silo", "--theta", "30", "--material", material_file.string(), "--check"},
+              {"light_grain.json: grain.density_kg_m3 = 3", "must lie in [10, 1e5]"}}},
+            dir);
+    fs::remove_all(root);
+}
