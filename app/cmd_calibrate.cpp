@@ -305,7 +305,7 @@ void add_calibrate(CLI::App& app) {
         if (!o->sensitivity_file.empty()) {
             try {
                 study = SensitivityStudy::from_json(read_json_file(o->sensitivity_file, "sensitivity"));
-            } catch (const nlohmann::json::exception& e) {  // a key missing or of the wrong type
+            } catch (const std::invalid_argument& e) {  // a field missing, of the wrong type or out of range
                 throw UserError("sensitivity = '" + o->sensitivity_file + "': " + e.what());
             }
             check_study_matches_start(study, start, o->sensitivity_file);

@@ -1,6 +1,7 @@
 #include "calibration/sensitivity_study.hpp"
 
 #include "analytics/number_text.hpp"
+#include "analytics/user_input.hpp"  // json_value_text
 #include "orchestrator/shear_params.hpp"
 
 #include <algorithm>
@@ -226,32 +227,109 @@ nlohmann::json SensitivityStudy::to_json() const {
     return j;
 }
 
+namespace {
+// The reader of a stored study (SensitivityStudy::from_json): every field's type and range, named by its path in the
+// file ("parameters[1].levels[3].se_mu_b"), the value shortened; a library type error named no field.
+struct StudyFieldReader {
+    [[noreturn]] static void refuse(const std::string& path, const nlohmann::json& v, const std::string& why) {
+        throw std::invalid_argument(path + " = " + analytics::json_value_text(v) + ": " + why);
+    }
+    static const nlohmann::json& at(const nlohmann::json& j, const std::string& key, const std::string& where) {
+        if (!j.is_object()) refuse(where.empty() ? "the file" : where, j, "must be a JSON object");
+        const auto it = j.find(key);
+        if (it == j.end()) throw std::invalid_argument((where.empty() ? "" : where + ".") + key + " is missing");
+        return *it;
+    }
+    static std::string path(const std::string& where, const std::string& key) {
+        return where.empty() ? key : where + "." + key;
+    }
+    static double number(const nlohmann::json& j, const std::string& key, const std::string& where, double lo,
+                         double hi, const char* range) {
+        const nlohmann::json& v = at(j, key, where);
+        if (!v.is_number()) refuse(path(where, key), v, "must be a number");
+        const double x = v.get<double>();
+        if (!(x >= lo && x <= hi)) refuse(path(where, key), v, std::string("must lie in ") + range);
+        return x;
+    }
+    static double optional_number(const nlohmann::json& j, const std::string& key, const std::string& where) {
+        return j.contains(key) ? number(j, key, where, 0, analytics::kLargestPlausibleNumber, "[0, 1e100]") : 0.0;
+    }
+    static int optional_count(const nlohmann::json& j, const std::string& key, const std::string& where) {
+        if (!j.contains(key)) return 0;
+        const nlohmann::json& v = j.at(key);
+        if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 1000000000LL)
+            refuse(path(where, key), v, "must be a whole number in [0, 1e9]");
+        return static_cast<int>(v.get<long long>());
+    }
+    static std::string text(const nlohmann::json& j, const std::string& key, const std::string& where) {
+        const nlohmann::json& v = at(j, key, where);
+        if (!v.is_string() || v.get<std::string>().size() > 200) refuse(path(where, key), v, "must be a short text");
+        return v.get<std::string>();
+    }
+    static const nlohmann::json& array(const nlohmann::json& j, const std::string& key, const std::string& where,
+                                       std::size_t min_size) {
+        const nlohmann::json& v = at(j, key, where);
+        if (!v.is_array() || v.size() < min_size)
+            refuse(path(where, key), v, "must be an array of at least " + std::to_string(min_size) + " entries");
+        return v;
+    }
+};
+}  // namespace
+
 SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
-    if (j.value("schema", "") != "demcal.sensitivity/1")
-        throw std::invalid_argument("sensitivity file: schema = " + j.value("schema", std::string("<missing>")) +
+    using R = StudyFieldReader;
+    if (!j.is_object() || !j.contains("schema") || j["schema"] != "demcal.sensitivity/1")
+        throw std::invalid_argument("schema = " +
+                                    (j.is_object() && j.contains("schema") ? analytics::json_value_text(j["schema"])
+                                                                           : std::string("<missing>")) +
                                     " is not demcal.sensitivity/1");
     SensitivityStudy s;
-    s.base_material = j.at("base_material");
-    s.options.levels = j.at("levels").get<int>();
-    s.options.relative_span = j.at("relative_span").get<double>();
-    s.options.line = line_kind_from_string(j.at("line").get<std::string>());
-    s.options.shape.criterion = analytics::shape_criterion_from_string(j.at("criterion").get<std::string>());
-    s.options.shape.alpha = j.at("alpha").get<double>();
-    s.evaluations = j.value("evaluations", 0);
-    s.simulations_run = j.value("simulations_run", 0);
-    s.simulations_reused = j.value("simulations_reused", 0);
-    s.cpu_s = j.value("cpu_s", 0.0);
-    for (const auto& pj : j.at("parameters")) {
+    s.base_material = R::at(j, "base_material", "");
+    if (!s.base_material.is_object()) R::refuse("base_material", s.base_material, "must be a JSON object");
+    s.options.levels = static_cast<int>(R::number(j, "levels", "", 3, kMaxLevels, "[3, 101]"));
+    if (!j.at("levels").is_number_integer()) R::refuse("levels", j.at("levels"), "must be a whole number");
+    s.options.relative_span = R::number(j, "relative_span", "", 1e-6, 0.999, "(0, 1)");
+    s.options.line = line_kind_from_string(R::text(j, "line", ""));
+    s.options.shape.criterion = analytics::shape_criterion_from_string(R::text(j, "criterion", ""));
+    s.options.shape.alpha = R::number(j, "alpha", "", 1e-6, 0.5, "[1e-6, 0.5]");
+    s.evaluations = R::optional_count(j, "evaluations", "");
+    s.simulations_run = R::optional_count(j, "simulations_run", "");
+    s.simulations_reused = R::optional_count(j, "simulations_reused", "");
+    s.cpu_s = R::optional_number(j, "cpu_s", "");
+    const nlohmann::json& parameters = R::array(j, "parameters", "", 1);
+    for (std::size_t i = 0; i < parameters.size(); ++i) {
+        const std::string where = "parameters[" + std::to_string(i) + "]";
+        const nlohmann::json& pj = parameters[i];
         ParameterSensitivity p;
-        p.name = pj.at("name").get<std::string>();
-        p.base_value = pj.at("base_value").get<double>();
+        p.name = R::text(pj, "name", where);
+        p.base_value = R::number(pj, "base_value", where, -analytics::kLargestPlausibleNumber,
+                                 analytics::kLargestPlausibleNumber, "[-1e100, 1e100]");
+        // the base material is the centre of every parameter's levels: an edited one no longer matches the runs
+        const auto base = s.base_material.find(p.name);
+        if (base == s.base_material.end() || !base->is_number() || base->get<double>() != p.base_value)
+            throw std::invalid_argument("base_material." + p.name + " = " +
+                                        (base == s.base_material.end() ? std::string("<missing>")
+                                                                       : analytics::json_value_text(*base)) +
+                                        ": differs from " + where + ".base_value = " +
+                                        analytics::number_text(p.base_value) + " (the value the study varied around)");
         s.options.params.push_back(p.name);
-        for (const auto& lj : pj.at("levels"))
-            p.levels.push_back({lj.at("value").get<double>(), lj.at("mu_b").get<double>(),
-                                lj.at("se_mu_b").get<double>(), lj.value("mu_b_half_width", 0.0),
-                                lj.at("tau_c").get<double>(), lj.at("se_tau_c").get<double>(),
-                                lj.value("tau_c_half_width", 0.0), lj.value("simulations_run", 0),
-                                lj.value("simulations_reused", 0), lj.value("cpu_s", 0.0)});
+        const nlohmann::json& levels = R::array(pj, "levels", where, 3);
+        for (std::size_t k = 0; k < levels.size(); ++k) {
+            const std::string lw = where + ".levels[" + std::to_string(k) + "]";
+            const nlohmann::json& lj = levels[k];
+            constexpr double big = analytics::kLargestPlausibleNumber;
+            p.levels.push_back({R::number(lj, "value", lw, -big, big, "[-1e100, 1e100]"),
+                                R::number(lj, "mu_b", lw, -big, big, "[-1e100, 1e100]"),
+                                R::number(lj, "se_mu_b", lw, 0, big, "[0, 1e100]"), R::optional_number(lj, "mu_b_half_width", lw),
+                                R::number(lj, "tau_c", lw, -big, big, "[-1e100, 1e100]"),
+                                R::number(lj, "se_tau_c", lw, 0, big, "[0, 1e100]"),
+                                R::optional_number(lj, "tau_c_half_width", lw), R::optional_count(lj, "simulations_run", lw),
+                                R::optional_count(lj, "simulations_reused", lw), R::optional_number(lj, "cpu_s", lw)});
+            if (k > 0 && !(p.levels[k].value > p.levels[k - 1].value))
+                R::refuse(lw + ".value", lj.at("value"),
+                          "not above the level before it (" + analytics::number_text(p.levels[k - 1].value) +
+                              "): a study's levels ascend");
+        }
         fit_responses(p, s.options.shape);
         s.parameters.push_back(std::move(p));
     }

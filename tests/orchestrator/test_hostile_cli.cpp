@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -799,6 +800,48 @@ TEST_CASE("probe 47: a silo geometry or material names the file and its field, a
               {"long_shape.json: shape = \"xxxx", "(100002 characters)"}},
              {{"silo", "--theta", "30", "--material", material_file.string(), "--check"},
               {"light_grain.json: grain.density_kg_m3 = 3", "must lie in [10, 1e5]"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 47: a stored sensitivity study with a damaged field is refused with the field's path", "[cli]") {
+    // a field of the wrong type ended in "[json.exception.type_error.302] type must be number, but is string", no
+    // field named; a varied parameter's base value could be anything (null, "nan") and the calibration ran
+    const fs::path root = test::fresh_test_dir("hostile-probe47-study"), dir = root / "work";
+    fs::create_directories(dir);
+    const auto study = nlohmann::json::parse(
+        test::read_file(test::source_path("examples/calibration/kernel-sand-bonded-far/sensitivity.json")));
+    const fs::path start = root / "base.json";
+    std::ofstream(start) << study["base_material"].dump();
+    const auto damaged = [&](const std::string& name, const std::function<void(nlohmann::json&)>& edit) {
+        nlohmann::json j = study;
+        edit(j);
+        std::ofstream(root / name) << j.dump();
+        return (root / name).string();
+    };
+    const std::vector<std::string> calibrate{"calibrate", "--target", "mu_b=0.5,tau_c=100", "--start", start.string(),
+                                             "--engine", "kernel", "-c", (dir / "cal").string(), "--sensitivity"};
+    const auto with = [&](const std::string& file) {
+        auto args = calibrate;
+        args.push_back(file);
+        return args;
+    };
+    refused({{with(damaged("se_text.json", [](nlohmann::json& j) { j["parameters"][0]["levels"][2]["se_mu_b"] = "0.01"; })),
+              {"parameters[0].levels[2].se_mu_b = \"0.01\": must be a number"}},
+             {with(damaged("span.json", [](nlohmann::json& j) { j["relative_span"] = 3; })),
+              {"relative_span = 3: must lie in (0, 1)"}},
+             {with(damaged("base_null.json",
+                           [](nlohmann::json& j) { j["base_material"][j["parameters"][0]["name"].get<std::string>()] = nullptr; })),
+              {"base_material.", "= null: differs from parameters[0].base_value"}},
+             {with(damaged("few_levels.json",
+                           [](nlohmann::json& j) {
+                               auto& levels = j["parameters"][1]["levels"];
+                               levels.erase(levels.begin() + 1, levels.end() - 1);
+                           })),
+              {"parameters[1].levels = ", "at least 3 entries"}},
+             {with(damaged("unordered.json",
+                           [](nlohmann::json& j) { std::swap(j["parameters"][0]["levels"][1], j["parameters"][0]["levels"][3]); })),
+              {"parameters[0].levels[2].value = ", "a study's levels ascend"}}},
             dir);
     fs::remove_all(root);
 }
