@@ -48,6 +48,9 @@ CLI::Validator number_check(const std::string& what, std::function<bool(double)>
             if (n.defect) return shown + " " + *n.defect;
             const double v = n.value;
             if (!ok(v)) return analytics::shortened_text(text) + " is not " + what;
+            // -0 is 0: one value, one run (`vibration --frequency 0,-0` planned the same still bin twice); takes
+            // effect where the check is a transform (refuse_empty_values)
+            if (v == 0.0 && std::signbit(v)) text = "0";
             return {};
         },
         what);
@@ -94,7 +97,8 @@ void refuse_empty_values(CLI::App& app) {
         if (opt->get_type_size_max() <= 0) continue;  // a flag takes no value
         opt->check(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); }, ""));
         const std::string type = opt->get_type_name();
-        if (type == "FLOAT") opt->check(any_number);
+        // (a type name carries the descriptions of the option's own checks after a ':': "FLOAT:between 0 and 90")
+        if (type == "FLOAT" || type.rfind("FLOAT:", 0) == 0) opt->transform(any_number);  // a transform: -0 becomes 0
         else if (type == "INT" || type == "UINT") opt->check(any_integer);
         if (opt->check_lname("partition")) opt->check(slurm_partition);  // every command's SLURM partition
     }

@@ -773,7 +773,10 @@ TEST_CASE("probe 47: an option the rest of the command line makes void is refuse
              {{"calibrate", "--target", "mu_b=0.5,tau_c=100", "--start", tiny, "--method", "grid", "--grid-points",
                "-1", "-c", camp},
               {"--grid-points", "-1"}},
-             {{"silo", "--theta", "30", "--dt", "0", "--check"}, {"--dt", "0 is not a positive number"}}},
+             {{"silo", "--theta", "30", "--dt", "0", "--check"}, {"--dt", "0 is not a positive number"}},
+             // -0 is 0: `--frequency 0,-0` planned two runs of the same still bin (folders f0 and f-0)
+             {{"vibration", "--theta", "30", "--frequency", "0,-0", "--campaign", camp},
+              {"the same run folder 'theta30_f0_seed1'"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     // the rules leave what applies alone
