@@ -42,7 +42,7 @@ int run(int argc, char** argv) {
     clock::time_point t0, t1;
     double c0 = 0, c1 = 0;
     long step0 = 0, step1 = 0, spheres = 0;
-    const SiloCaseResult r = resume_silo_case(copy.string(), {threads, 1e9, seconds}, [&](const SiloProgress& p) {
+    const SiloCaseResult r = resume_silo_case(copy.string(), {threads, 1e9, seconds, {}}, [&](const SiloProgress& p) {
         if (p.phase == "resumed") {
             t0 = clock::now();
             c0 = demcal::kernel::process_cpu_seconds();
