@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""Hostile-value probe of every value-taking option of every demcal command (issue 23): each option of a valid
+command line in turn gets "", subnormal, huge, negative, NaN, inf, 0, -0, hex, padded, list, 2^63, a 100 kB word,
+folders and devices. Each case runs under a 4 s limit, then SIGTERM (a command that does not stop within 20 s, or that
+leaves processes behind, is flagged NOSTOP). One line per case: exit code, flags (SIGNAL, NOSTOP, RC<n> for an exit
+other than 0/2, UNNAMED for a refusal not naming the option, LONG for > 4 kB of output, WROTE for files left by a
+refusal, RAN for a value accepted and run until the limit: review those by hand), the last message line.
+Usage: python3 scripts/probe/probe_options.py build/app/demcal . [COMMAND] > out.txt   (J=2 parallel; about 25 min)
+Not a test: a probe for a person to read; its findings become tests (tests/orchestrator/test_hostile_cli.cpp)."""
+import time, json, os, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
+demcal = os.path.abspath(sys.argv[1])
+repo = os.path.abspath(sys.argv[2])
+only = sys.argv[3] if len(sys.argv) > 3 else None
+ex = repo + "/examples"
+WORK = tempfile.mkdtemp(prefix="demcal-probe-")
+FIX = WORK + "/fixtures"
+os.makedirs(FIX)
+
+def make_fixtures(repo, work):
+    """The valid inputs the probes start from, written into `work`: a shear run's params.json (bench/shear's), three
+    materials of increasing radius (enlarge), the base material of a stored sensitivity study (calibrate)."""
+    import json, shutil
+    shutil.copy(repo + "/bench/shear/logs/params.json", work + "/params.json")
+    m = json.load(open(repo + "/examples/materials/sand-tiny.json"))
+    for k, (r, E, nu) in enumerate([(2e-3, 5e7, 0.3), (3e-3, 7e7, 0.25), (4e-3, 9e7, 0.21)], 1):
+        mm = dict(m)
+        mm.update(particle_radius=r, young_modulus=E, poisson_ratio=nu, name="m%d" % k, box_length=0.08,
+                  box_width=0.08, box_height=0.04)
+        json.dump(mm, open(work + "/E%d.json" % k, "w"))
+    study = json.load(open(repo + "/examples/calibration/kernel-sand-bonded-far/sensitivity.json"))
+    json.dump(study["base_material"], open(work + "/sens_base.json", "w"))
+make_fixtures(repo, FIX)
+base = {
+ "shear": ["shear", ex+"/materials/sand-tiny.json", "-s", "5000,8000,11000", "--engine", "kernel", "-c", "camp", "-r", "1"],
+ "shear-run": ["shear-run", "PARAMS", "result.json"],
+ "crosscheck shear": ["crosscheck", "shear", ex+"/materials/sand-tiny.json", "-s", "5000,8000,11000", "-r", "1", "-c", "cc"],
+ "crosscheck silo": ["crosscheck", "silo", "--particles", "20", "--theta", "30", "-c", "cs"],
+ "silo": ["silo", "--theta", "30", "--particles", "100", "--max-time", "0.01", "--fill-time", "0.01", "--no-plots", "--out", "o"],
+ "cutoff": ["cutoff", "--grains", "10"],
+ "vibration": ["vibration", "--theta", "30", "--frequency", "10", "--campaign", "v", "--repeats", "1", "--amplitude", "1e-4", "--", "--particles", "100", "--max-time", "0.01", "--fill-time", "0.01"],
+ "predict": ["predict", ex+"/diagnose/silo_105mm_wheat.json"],
+ "diagnose": ["diagnose", "--model", "beverloo", "--data", ex+"/diagnose/beverloo_hopper_angle.csv", "--no-plots"],
+ "sensitivity": ["sensitivity", ex+"/materials/sand-tiny.json", "--engine", "kernel", "-r", "1", "-c", "sc"],
+ "calibrate": ["calibrate", "--target", "mu_b=0.5,tau_c=100", "--start", ex+"/materials/sand-tiny.json", "--engine", "kernel", "-c", "cal"],
+ "enlarge": ["enlarge", FIX + "/E1.json", FIX + "/E2.json", FIX + "/E3.json", "--no-plot", "--allow-unconverged"],
+ "scale": ["scale", ex+"/materials/sand-tiny.json", "--radii", "1e-3,2e-3", "--engine", "kernel", "-c", "scl"],
+}
+vals = ["", "1e-320", "1e308", "-1", "nan", "inf", "0", "-0", "5abc", "0x10", " 5", "1,2", "9223372036854775808",
+        "x" * 100000, "/", "/dev/null", "nonexist/x.json", "1e-5", "3.5", "@", "-5e-3"]
+def options(cmd):
+    out = subprocess.run([demcal] + cmd.split() + ["--help"], capture_output=True, text=True).stdout
+    opts = []
+    for line in out.split("\n"):
+        m = re.match(r"\s+((?:-\w,)?--[\w-]+(?:,--[\w-]+)*)\s+(\S+)", line)
+        if not m: continue
+        names, typ = m.group(1), m.group(2)
+        if not re.match(r"(INT|FLOAT|TEXT)", typ): continue
+        longname = [n for n in names.split(",") if n.startswith("--")][0]
+        if longname == "--help": continue
+        opts.append(longname)
+    return opts
+def run(cmd, opt, val):
+    d = tempfile.mkdtemp(dir=WORK)
+    argv = list(base[cmd])
+    if "PARAMS" in argv:
+        shutil.copy(FIX + "/params.json", d + "/params.json"); argv[argv.index("PARAMS")] = "params.json"
+    before = set(os.listdir(d))
+    # replace an option already in the base line
+    if opt in argv:
+        i = argv.index(opt); argv[i + 1] = val
+    elif "--" in argv:
+        i = argv.index("--"); argv[i:i] = [opt, val]
+    else:
+        argv += [opt, val]
+    p = subprocess.Popen([demcal] + argv, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
+    try:
+        out, _ = p.communicate(timeout=4)
+        rc, err = p.returncode, out
+    except subprocess.TimeoutExpired:
+        p.terminate()
+        try:
+            out, _ = p.communicate(timeout=20)
+            rc, err = 124, ""
+        except subprocess.TimeoutExpired:
+            p.kill(); p.communicate(); rc, err = 125, "did not stop on SIGTERM within 20 s"
+        time.sleep(0.5)
+        left = []
+        for pid in os.listdir("/proc"):
+            if not pid.isdigit(): continue
+            try:
+                if os.readlink("/proc/%s/cwd" % pid).startswith(d): left.append(pid)
+            except OSError:
+                pass
+        if left:
+            err = "ORPHANS %s after SIGTERM: %s" % (left, open("/proc/%s/cmdline" % left[0]).read().replace("\0", " ")[:150])
+            for pid in left:
+                try: os.kill(int(pid), 9)
+                except OSError: pass
+    after = set(os.listdir(d))
+    new = sorted(after - before)
+    shutil.rmtree(d, ignore_errors=True)
+    return cmd, opt, val, rc, err, new
+jobs = []
+for cmd in base:
+    if only and cmd != only: continue
+    for opt in options(cmd):
+        for v in vals:
+            jobs.append((cmd, opt, v))
+print(len(jobs), "cases", file=sys.stderr)
+with cf.ThreadPoolExecutor(int(os.environ.get("J", "2"))) as pool:
+    for cmd, opt, val, rc, err, new in pool.map(lambda a: run(*a), jobs):
+        v = val if len(val) < 30 else val[:10] + "...(%d)" % len(val)
+        first = err.strip().split("\n")[0][:200] if err.strip() else ""
+        flags = []
+        if rc >= 128 or rc < 0: flags.append("SIGNAL")
+        if rc == 124: flags.append("RAN")
+        if rc == 125 or "ORPHANS" in err: flags.append("NOSTOP")
+        if rc == 2 and opt.lstrip("-") not in err and opt not in err: flags.append("UNNAMED")
+        if len(err) > 4000: flags.append("LONG")
+        if rc not in (0, 2, 124): flags.append("RC%d" % rc)
+        if rc != 0 and new and rc != 124: flags.append("WROTE:" + ",".join(new))
+        print("%-16s %-22s %-22r rc=%-3d %-16s %s" % (cmd, opt, v, rc, " ".join(flags), first), flush=True)
+shutil.rmtree(WORK, ignore_errors=True)
