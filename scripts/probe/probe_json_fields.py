@@ -6,27 +6,10 @@ flags (as scripts/probe/probe_options.py), the last output line.
 Usage: python3 scripts/probe/probe_json_fields.py build/app/demcal . [KIND] > out.txt   (J=2 parallel; about 15 min)
 Not a test: a probe for a person to read; its findings become tests (tests/orchestrator/test_hostile_cli.cpp)."""
 import copy, json, os, shutil, subprocess, sys, tempfile, time, concurrent.futures as cf
-demcal, repo = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
-only = sys.argv[3] if len(sys.argv) > 3 else None
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from probe_common import run_bounded, setup  # noqa: E402
+demcal, repo, only, WORK, FIX = setup(sys.argv)
 ex = repo + "/examples"
-WORK = tempfile.mkdtemp(prefix="demcal-probe-")
-FIX = WORK + "/fixtures"
-os.makedirs(FIX)
-
-def make_fixtures(repo, work):
-    """The valid inputs the probes start from, written into `work`: a shear run's params.json (bench/shear's), three
-    materials of increasing radius (enlarge), the base material of a stored sensitivity study (calibrate)."""
-    import json, shutil
-    shutil.copy(repo + "/bench/shear/logs/params.json", work + "/params.json")
-    m = json.load(open(repo + "/examples/materials/sand-tiny.json"))
-    for k, (r, E, nu) in enumerate([(2e-3, 5e7, 0.3), (3e-3, 7e7, 0.25), (4e-3, 9e7, 0.21)], 1):
-        mm = dict(m)
-        mm.update(particle_radius=r, young_modulus=E, poisson_ratio=nu, name="m%d" % k, box_length=0.08,
-                  box_width=0.08, box_height=0.04)
-        json.dump(mm, open(work + "/E%d.json" % k, "w"))
-    study = json.load(open(repo + "/examples/calibration/kernel-sand-bonded-far/sensitivity.json"))
-    json.dump(study["base_material"], open(work + "/sens_base.json", "w"))
-make_fixtures(repo, FIX)
 kinds = {  # name: (source file, argv with FILE for the mutated copy)
  "shear-material": (ex + "/materials/sand-tiny.json", ["shear", "FILE", "-s", "5000,8000,11000", "--engine", "kernel", "-c", "camp"]),
  "shear-run-params": (FIX + "/params.json", ["shear-run", "FILE", "result.json"]),
@@ -59,21 +42,7 @@ def run(kind, path, val):
         setp(j, path, val if val is DEL else copy.deepcopy(val))
     json.dump(j, open(d + "/in.json", "w"))
     argv = [a if a != "FILE" else "in.json" for a in argv]
-    before = set(os.listdir(d))
-    p = subprocess.Popen([demcal] + argv, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
-    try:
-        out, _ = p.communicate(timeout=4); rc = p.returncode
-    except subprocess.TimeoutExpired:
-        p.terminate()
-        try: out, _ = p.communicate(timeout=20); rc = 124
-        except subprocess.TimeoutExpired: p.kill(); out, _ = p.communicate(); rc = 125
-        time.sleep(0.3)
-        for pid in os.listdir("/proc"):
-            if pid.isdigit():
-                try:
-                    if os.readlink("/proc/%s/cwd" % pid).startswith(d): out = "ORPHAN " + out; os.kill(int(pid), 9)
-                except OSError: pass
-    new = sorted(set(os.listdir(d)) - before)
+    rc, out, new = run_bounded([demcal] + argv, d)
     shutil.rmtree(d, ignore_errors=True)
     return kind, path, val, rc, out, new
 jobs = []
@@ -94,7 +63,7 @@ with cf.ThreadPoolExecutor(int(os.environ.get("J", "2"))) as pool:
         flags = []
         if rc >= 128 or rc < 0: flags.append("SIGNAL")
         if rc == 124: flags.append("RAN")
-        if rc == 125 or out.startswith("ORPHAN"): flags.append("NOSTOP")
+        if rc == 125 or out.startswith("ORPHANS"): flags.append("NOSTOP")
         if rc == 2 and path[-1] not in out and "bogus" not in out: flags.append("UNNAMED")
         if len(out) > 4000: flags.append("LONG")
         if rc not in (0, 2, 124): flags.append("RC%d" % rc)

@@ -8,28 +8,10 @@ refusal, RAN for a value accepted and run until the limit: review those by hand)
 Usage: python3 scripts/probe/probe_options.py build/app/demcal . [COMMAND] > out.txt   (J=2 parallel; about 25 min)
 Not a test: a probe for a person to read; its findings become tests (tests/orchestrator/test_hostile_cli.cpp)."""
 import time, json, os, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
-demcal = os.path.abspath(sys.argv[1])
-repo = os.path.abspath(sys.argv[2])
-only = sys.argv[3] if len(sys.argv) > 3 else None
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from probe_common import run_bounded, setup  # noqa: E402
+demcal, repo, only, WORK, FIX = setup(sys.argv)
 ex = repo + "/examples"
-WORK = tempfile.mkdtemp(prefix="demcal-probe-")
-FIX = WORK + "/fixtures"
-os.makedirs(FIX)
-
-def make_fixtures(repo, work):
-    """The valid inputs the probes start from, written into `work`: a shear run's params.json (bench/shear's), three
-    materials of increasing radius (enlarge), the base material of a stored sensitivity study (calibrate)."""
-    import json, shutil
-    shutil.copy(repo + "/bench/shear/logs/params.json", work + "/params.json")
-    m = json.load(open(repo + "/examples/materials/sand-tiny.json"))
-    for k, (r, E, nu) in enumerate([(2e-3, 5e7, 0.3), (3e-3, 7e7, 0.25), (4e-3, 9e7, 0.21)], 1):
-        mm = dict(m)
-        mm.update(particle_radius=r, young_modulus=E, poisson_ratio=nu, name="m%d" % k, box_length=0.08,
-                  box_width=0.08, box_height=0.04)
-        json.dump(mm, open(work + "/E%d.json" % k, "w"))
-    study = json.load(open(repo + "/examples/calibration/kernel-sand-bonded-far/sensitivity.json"))
-    json.dump(study["base_material"], open(work + "/sens_base.json", "w"))
-make_fixtures(repo, FIX)
 base = {
  "shear": ["shear", ex+"/materials/sand-tiny.json", "-s", "5000,8000,11000", "--engine", "kernel", "-c", "camp", "-r", "1"],
  "shear-run": ["shear-run", "PARAMS", "result.json"],
@@ -64,7 +46,6 @@ def run(cmd, opt, val):
     argv = list(base[cmd])
     if "PARAMS" in argv:
         shutil.copy(FIX + "/params.json", d + "/params.json"); argv[argv.index("PARAMS")] = "params.json"
-    before = set(os.listdir(d))
     # replace an option already in the base line
     if opt in argv:
         i = argv.index(opt); argv[i + 1] = val
@@ -72,32 +53,9 @@ def run(cmd, opt, val):
         i = argv.index("--"); argv[i:i] = [opt, val]
     else:
         argv += [opt, val]
-    p = subprocess.Popen([demcal] + argv, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
-    try:
-        out, _ = p.communicate(timeout=4)
-        rc, err = p.returncode, out
-    except subprocess.TimeoutExpired:
-        p.terminate()
-        try:
-            out, _ = p.communicate(timeout=20)
-            rc, err = 124, ""
-        except subprocess.TimeoutExpired:
-            p.kill(); p.communicate(); rc, err = 125, "did not stop on SIGTERM within 20 s"
-        time.sleep(0.5)
-        left = []
-        for pid in os.listdir("/proc"):
-            if not pid.isdigit(): continue
-            try:
-                if os.readlink("/proc/%s/cwd" % pid).startswith(d): left.append(pid)
-            except OSError:
-                pass
-        if left:
-            err = "ORPHANS %s after SIGTERM: %s" % (left, open("/proc/%s/cmdline" % left[0]).read().replace("\0", " ")[:150])
-            for pid in left:
-                try: os.kill(int(pid), 9)
-                except OSError: pass
-    after = set(os.listdir(d))
-    new = sorted(after - before)
+    rc, err, new = run_bounded([demcal] + argv, d)
+    if rc == 124 and not err.startswith("ORPHANS"):
+        err = ""
     shutil.rmtree(d, ignore_errors=True)
     return cmd, opt, val, rc, err, new
 jobs = []
@@ -114,7 +72,7 @@ with cf.ThreadPoolExecutor(int(os.environ.get("J", "2"))) as pool:
         flags = []
         if rc >= 128 or rc < 0: flags.append("SIGNAL")
         if rc == 124: flags.append("RAN")
-        if rc == 125 or "ORPHANS" in err: flags.append("NOSTOP")
+        if rc == 125 or err.startswith("ORPHANS"): flags.append("NOSTOP")
         if rc == 2 and opt.lstrip("-") not in err and opt not in err: flags.append("UNNAMED")
         if len(err) > 4000: flags.append("LONG")
         if rc not in (0, 2, 124): flags.append("RC%d" % rc)
