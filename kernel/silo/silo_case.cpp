@@ -303,14 +303,14 @@ void validate(const SiloCaseSettings& s) {
         reject_setting("stiffness_scale", s.materials.stiffness_scale, "must lie in (0, 100]");
     if (s.time_step < 0 || !std::isfinite(s.time_step)) reject_setting("dt", s.time_step, "must be >= 0 s (0: automatic)");
     // beyond the Rayleigh step the explicit integration of the stiffest contact is no longer resolved
-    if (const double rayleigh = smallest_sphere_rayleigh_step(s.materials); s.time_step > rayleigh)
+    const double rayleigh = smallest_sphere_rayleigh_step(s.materials);
+    if (s.time_step > rayleigh)
         reject_setting("dt", s.time_step,
                        "larger than the Rayleigh time step of the smallest wheat sphere (" + setting_text(rayleigh) +
                            " s at this stiffness); use a fraction of it, or --dt-fraction");
     // Below a thousandth of the Rayleigh step nothing is resolved better (at 0.25 a contact already spans tens of
     // steps), and one record interval takes millions of steps: a stop (Ctrl-C, SIGTERM, --wall-limit), which waits
     // for the end of one, did not come within minutes (--dt-fraction 1e-5).
-    const double rayleigh = smallest_sphere_rayleigh_step(s.materials);
     if (s.time_step > 0 && s.time_step < kMinTimeStepFraction * rayleigh)
         reject_setting("dt", s.time_step,
                        "smaller than " + setting_text(kMinTimeStepFraction) + " of the Rayleigh time step of the "
