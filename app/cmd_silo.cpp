@@ -96,8 +96,8 @@ constexpr const char* kRunFiles[] = {kCheckpointName,       "summary.json",     
                                      "discharge.png.gp",    "discharge.png.gp.log"};
 
 // SIGTERM (a batch system's time limit or scancel, kill) and SIGINT (Ctrl-C) during a checkpointed run: the run ends
-// its record interval, writes its checkpoint and exits 75, as at --wall-limit. The handler only records the signal
-// (async-signal-safe); the run asks for it between record intervals. SA_RESETHAND: a second signal takes the default
+// the step it is in, writes its checkpoint and exits 75, as at --wall-limit. The handler only records the signal
+// (async-signal-safe); the run asks for it after every step. SA_RESETHAND: a second signal takes the default
 // action and ends the process at once. A signal ignored at the start (SIGINT of a job started with `&` by a script)
 // stays ignored.
 volatile std::sig_atomic_t g_stop_signal = 0;
@@ -215,9 +215,15 @@ GeometryGiven geometry_options(const SiloCli& o, CLI::App& sub) {
     return g;
 }
 
+// The kernel's name of each geometry quantity (in its refusals, ks::SettingRejected::field) and the file key that
+// gives it: a refusal then names the quantity as the user gave it ("geo.json: D_m = -1", "--diameter = -1").
+constexpr std::pair<const char*, const char*> kGeometryFieldKeys[] = {
+    {"theta", "theta_deg"},     {"outlet", "outlet_m"}, {"a (outlet width)", "outlet_m"}, {"diameter", "D_m"},
+    {"body_height", "body_height_m"}, {"b (depth)", "b_m"}, {"c (width)", "c_m"}};
+
 // The command line over the --geometry file over the defaults; a quantity that does not belong to the shape is
-// refused wherever it was given.
-ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub) {
+// refused wherever it was given. `sources`: where each quantity given came from, by the kernel's field name.
+ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub, std::map<std::string, std::string>& sources) {
     GeometryGiven given = o.geometry_file.empty() ? GeometryGiven{} : read_geometry_file(o.geometry_file);
     GeometryGiven cli = geometry_options(o, sub);
     given.merge_slot_width();
@@ -228,6 +234,8 @@ ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub) {
         given.rect_source = cli.rect_source;
     }
     for (auto& [key, v] : cli.values) given.values.insert_or_assign(key, v);
+    for (const auto& [field, key] : kGeometryFieldKeys)
+        if (const auto it = given.values.find(key); it != given.values.end()) sources[field] = it->second.source;
     const bool rect = given.rect.value_or(false);
     const auto value = [&](const char* key) -> std::optional<double> {
         const auto it = given.values.find(key);
@@ -355,7 +363,8 @@ void check_run_size(const ks::SiloCaseSettings& s) {
 ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     check_session_options(o, sub);
     ks::SiloCaseSettings s;
-    s.geometry = geometry_from(o, sub);
+    std::map<std::string, std::string> geometry_sources;
+    s.geometry = geometry_from(o, sub, geometry_sources);
     if (sub.count("--particles") && sub.count("--fill-mass"))
         throw UserError("--particles and --fill-mass both set the amount of grain; give one");
     // 0 is the setting's "not given": given on the command line it must be a real amount, not the default's signal
@@ -388,6 +397,11 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.vtk_interval = o.vtk_every;
     try {
         ks::validate(s);
+    } catch (const ks::SettingRejected& e) {
+        const auto source = geometry_sources.find(e.field);
+        const std::string message = e.what();
+        if (source == geometry_sources.end() || message.rfind(e.field, 0) != 0) throw UserError(message);
+        throw UserError(source->second + message.substr(e.field.size()));
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
@@ -929,8 +943,8 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_flag("--no-checkpoint", o.no_checkpoint, "write no checkpoint");
     sub->add_flag("--check", o.check_only, "check the settings and exit (0: valid, 2: refused); nothing is written");
     sub->add_option("--wall-limit", o.wall_limit,
-                    "stop after this many wall-clock seconds of this session (0: none), at the end of a record "
-                    "interval, with a checkpoint written; exit status 75: not finished, continue with --resume "
+                    "stop after this many wall-clock seconds of this session (0: none), after the step it is in, "
+                    "with a checkpoint written; exit status 75: not finished, continue with --resume "
                     "(a batch system's time limit); SIGTERM or Ctrl-C does the same at any time")
         ->capture_default_str();
     sub->add_option("--resume", o.resume,

@@ -168,6 +168,11 @@ void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
 void open_silo_campaign(const fs::path& dir, const json& settings, const std::string& command,
                         const std::vector<std::string>& may_change) {
     const fs::path settings_file = dir / "campaign.json";
+    try {
+        orchestrator::check_campaign_folder(dir, "campaign.json");
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
     if (fs::exists(settings_file)) {
         json stored = read_json_file(settings_file.string(), "campaign settings"), now = settings;
         for (const std::string& key : may_change) {

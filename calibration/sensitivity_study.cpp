@@ -266,6 +266,16 @@ struct StudyFieldReader {
         if (!v.is_string() || v.get<std::string>().size() > 200) refuse(path(where, key), v, "must be a short text");
         return v.get<std::string>();
     }
+    // A key the writer (SensitivityStudy::to_json) never writes is an edit or another file's field: refused by name.
+    static void only_known_keys(const nlohmann::json& j, std::initializer_list<const char*> known,
+                                const std::string& where) {
+        if (!j.is_object()) return;  // at() refuses it with its path
+        for (const auto& [key, value] : j.items()) {
+            if (std::none_of(known.begin(), known.end(), [&key](const char* k) { return key == k; }))
+                refuse(path(where, analytics::shortened_text(key)), value,
+                       "unknown key (not written by a sensitivity study)");
+        }
+    }
     static const nlohmann::json& array(const nlohmann::json& j, const std::string& key, const std::string& where,
                                        std::size_t min_size) {
         const nlohmann::json& v = at(j, key, where);
@@ -283,6 +293,10 @@ SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
                                     (j.is_object() && j.contains("schema") ? analytics::json_value_text(j["schema"])
                                                                            : std::string("<missing>")) +
                                     " is not demcal.sensitivity/1");
+    R::only_known_keys(j,
+                       {"schema", "base_material", "levels", "relative_span", "line", "criterion", "alpha",
+                        "evaluations", "simulations_run", "simulations_reused", "cpu_s", "parameters"},
+                       "");
     SensitivityStudy s;
     s.base_material = R::at(j, "base_material", "");
     if (!s.base_material.is_object()) R::refuse("base_material", s.base_material, "must be a JSON object");
@@ -300,8 +314,14 @@ SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
     for (std::size_t i = 0; i < parameters.size(); ++i) {
         const std::string where = "parameters[" + std::to_string(i) + "]";
         const nlohmann::json& pj = parameters[i];
+        R::only_known_keys(pj, {"name", "base_value", "levels", "mu_b", "tau_c"}, where);
         ParameterSensitivity p;
         p.name = R::text(pj, "name", where);
+        const auto known = orchestrator::micromechanical_param_names();
+        if (std::find(known.begin(), known.end(), p.name) == known.end())
+            R::refuse(where + ".name", pj.at("name"), "not a micromechanical parameter of the shear box");
+        if (std::find(s.options.params.begin(), s.options.params.end(), p.name) != s.options.params.end())
+            R::refuse(where + ".name", pj.at("name"), "named by an earlier parameter too");
         p.base_value = R::number(pj, "base_value", where, -analytics::kLargestPlausibleNumber,
                                  analytics::kLargestPlausibleNumber, "[-1e100, 1e100]");
         // the base material is the centre of every parameter's levels: an edited one no longer matches the runs
@@ -314,9 +334,17 @@ SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
                                         analytics::number_text(p.base_value) + " (the value the study varied around)");
         s.options.params.push_back(p.name);
         const nlohmann::json& levels = R::array(pj, "levels", where, 3);
+        if (levels.size() != static_cast<std::size_t>(s.options.levels))
+            throw std::invalid_argument(where + ".levels has " + std::to_string(levels.size()) +
+                                        " entries, the study's levels = " + std::to_string(s.options.levels) +
+                                        ": every parameter is run at the same number of levels");
         for (std::size_t k = 0; k < levels.size(); ++k) {
             const std::string lw = where + ".levels[" + std::to_string(k) + "]";
             const nlohmann::json& lj = levels[k];
+            R::only_known_keys(lj,
+                               {"value", "mu_b", "se_mu_b", "mu_b_half_width", "tau_c", "se_tau_c",
+                                "tau_c_half_width", "simulations_run", "simulations_reused", "cpu_s"},
+                               lw);
             constexpr double big = analytics::kLargestPlausibleNumber;
             p.levels.push_back({R::number(lj, "value", lw, -big, big, "[-1e100, 1e100]"),
                                 R::number(lj, "mu_b", lw, -big, big, "[-1e100, 1e100]"),

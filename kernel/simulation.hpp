@@ -167,6 +167,15 @@ class BasicSimulation {
   // ---------------------------------------------------------------- run
   /// Advances n steps of the time step (velocity Verlet; forces at half-step velocities, as LAMMPS/LIGGGHTS).
   void step(long n = 1);
+  /// The same, asking `should_stop` after every step but the last: at a yes it returns the steps done (fewer than n)
+  /// with the state between two steps of the loop: velocities at the half step, the next step's first half kick still
+  /// owed (velocity Verlet fuses it with the last step's second one). Only save_state() and step() are meant then: a
+  /// later step() (in this object or one that loaded the state) pays the fused kick first, so that a run stopped and
+  /// continued takes exactly the uninterrupted run's steps, bit for bit. A stop within a long stretch (a silo's record
+  /// interval of millions of steps at 10^6 grains) therefore need not wait for its end.
+  long step(long n, const std::function<bool()>& should_stop);
+  /// Whether a stopped step(n, should_stop) left the velocities at the half step (see there).
+  bool between_steps() const { return half_kick_owed_; }
   double time() const { return time_; }           ///< simulated time [s]
   long steps_done() const { return steps_; }      ///< steps taken so far
 
@@ -231,8 +240,9 @@ class BasicSimulation {
   std::size_t memory_bytes() const;
 
  private:
-  // 3: contact histories of any size, walls move; 4: the skin spent by growth (3 is still read)
-  static constexpr const char* kStateFormat = "demcal-kernel-state/4";
+  // 3: contact histories of any size, walls move; 4: the skin spent by growth; 5: stopped between two steps (the
+  // half kick owed). 3 and 4 are still read.
+  static constexpr const char* kStateFormat = "demcal-kernel-state/5";
   void prepare();
   void compute_forces(bool rebuild, double dt_history);
   bool kick_drift(double kick);
@@ -350,6 +360,7 @@ class BasicSimulation {
   // taken with the forces before the change, is taken again with the new ones (see refresh_forces).
   bool rekick_on_refresh_ = false;
   bool import_spring_step_pending_ = false;  // restart_as_imported_leapfrog: the refresh advances the springs
+  bool half_kick_owed_ = false;  // step(n, should_stop) stopped inside its loop: the next step's kick is fused
   bool import_full_kick_pending_ = false;    // restart_as_imported_leapfrog: the next step's first kick is whole
 };
 

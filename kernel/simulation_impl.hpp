@@ -878,21 +878,34 @@ void BasicSimulation<Law>::refresh_forces() {
 
 template <class Law>
 void BasicSimulation<Law>::step(long nsteps) {
+  step(nsteps, {});
+}
+
+template <class Law>
+long BasicSimulation<Law>::step(long nsteps, const std::function<bool()>& should_stop) {
   prepare();
   if (!forces_valid_) refresh_forces();
-  if (import_full_kick_pending_ && nsteps > 0) {  // the on-step velocities taken as half-step ones: a whole first kick
+  if (nsteps <= 0) return 0;
+  if (import_full_kick_pending_) {  // the on-step velocities taken as half-step ones: a whole first kick
     kick(1.0);
     import_full_kick_pending_ = false;
   }
-  // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass
+  // velocity Verlet; the second half kick of a step and the first of the next are fused into one pass (also across
+  // a stop: an owed half kick is paid with the first kick here)
   for (long s = 0; s < nsteps; ++s) {
-    const bool moved = kick_drift(s == 0 ? 1.0 : 2.0);
+    const bool moved = kick_drift(s == 0 && !half_kick_owed_ ? 1.0 : 2.0);
+    half_kick_owed_ = false;
     if (walls_move_) move_walls();
     compute_forces(moved || (walls_move_ && walls_left_reach()), dt_);
     time_ += dt_;
     ++steps_;
+    if (should_stop && s + 1 < nsteps && should_stop()) {
+      half_kick_owed_ = true;
+      return s + 1;
+    }
   }
-  if (nsteps > 0) kick();
+  kick();
+  return nsteps;
 }
 
 template <class Law>
@@ -1305,6 +1318,7 @@ void BasicSimulation<Law>::save_state(std::ostream& os) const {
   nl_.save(w);
   w.value(gravity_); w.value(dt_); w.value(time_); w.value(skin_); w.value(steps_);
   w.value(reorder_every_); w.value(std::uint64_t(builds_since_reorder_)); w.value(forces_valid_);
+  w.value(half_kick_owed_);
   w.checksum();
   if (!w.ok()) throw std::runtime_error("save_state: the stream failed while writing");
 }
@@ -1317,7 +1331,7 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   if (tag == "demcal-kernel-state/1" || tag == "demcal-kernel-state/2")
     r.fail("format tag", "written by an older demcal (" + tag + "; this one reads " + kStateFormat +
                              "): finish that run with the demcal that started it, or start it again");
-  if (tag != kStateFormat && tag != "demcal-kernel-state/3")
+  if (tag != kStateFormat && tag != "demcal-kernel-state/3" && tag != "demcal-kernel-state/4")
     r.fail("format tag", "'" + tag.substr(0, 40) + "' is not a demcal kernel state (" + kStateFormat + ")");
   std::vector<double> saved;
   r.array(saved, "configuration");
@@ -1352,6 +1366,8 @@ void BasicSimulation<Law>::load_state(std::istream& is, const std::string& sourc
   r.value(steps_, "step count"); r.value(reorder_every_, "reorder period");
   builds_since_reorder_ = std::size_t(r.value<std::uint64_t>("builds since the last reorder"));
   r.value(forces_valid_, "force state");
+  half_kick_owed_ = false;
+  if (tag == kStateFormat) r.value(half_kick_owed_, "half kick owed");
   r.checksum();  // nothing read is used before the whole state is known to be the one written
   for (std::size_t k = 0; k < walls_.size(); ++k) {
     walls_[k].enabled = enabled[k] != 0;

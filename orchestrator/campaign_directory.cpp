@@ -5,14 +5,40 @@
 #include "orchestrator/slurm_executor.hpp"
 
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace demcal::orchestrator {
 
 namespace fs = std::filesystem;
 
+void check_campaign_folder(const fs::path& dir, const std::string& marker) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec) || fs::exists(dir / marker, ec)) return;
+    std::vector<std::string> others;
+    std::size_t count = 0;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name == ".lock") continue;  // (ours: a campaign that died before its first write)
+        if (others.size() < 3) others.push_back(analytics::shortened_text(name, 40));
+        ++count;
+    }
+    if (ec)
+        throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +
+                                    "': cannot list the folder: " + ec.message());
+    if (count == 0) return;
+    std::string listed;
+    for (const auto& name : others) listed += (listed.empty() ? "" : ", ") + name;
+    if (count > others.size()) listed += ", ... " + std::to_string(count) + " in all";
+    throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) + "': a folder of other "
+                                "files (" + listed + ") and no campaign in it (no " + marker + "): give a new or "
+                                "empty folder, or a campaign's folder to continue it");
+}
+
 CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& finished)
     : dir_(fs::absolute(dir).lexically_normal()) {
     std::error_code ec;
+    check_campaign_folder(dir_, "campaign.sqlite");
     // a store this demcal refuses is refused before anything is written: the lock file, the folder, the store
     if (fs::exists(dir_ / "campaign.sqlite", ec)) CampaignStore(dir_ / "campaign.sqlite", StoreAccess::read_only);
     CampaignStore::check_store_path(dir_ / "campaign.sqlite");

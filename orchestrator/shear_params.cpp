@@ -203,8 +203,13 @@ void check_work(const nlohmann::json& m, std::optional<double> normal_stress, co
 constexpr double kLooseSolidFraction = 0.5;
 constexpr double kGravity = 9.81;
 
+// The least normal stress a box holds: its grains' weight over its area (density x 0.5 x g x box_height).
+double self_weight_stress(const nlohmann::json& p) {
+    return p.at("density").get<double>() * kLooseSolidFraction * kGravity * p.at("box_height").get<double>();
+}
+
 void check_stress_above_self_weight(const nlohmann::json& p, double normal_stress, const std::string& where) {
-    const double weight = p.at("density").get<double>() * kLooseSolidFraction * kGravity * p.at("box_height").get<double>();
+    const double weight = self_weight_stress(p);
     if (normal_stress < weight)
         throw std::invalid_argument(where + ": normal_stress = " + analytics::number_text(normal_stress) +
                                     " Pa is below the weight of the box's grains (about " +
@@ -303,6 +308,10 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
         out[s.name] = s.integer ? nlohmann::json(static_cast<long>(*s.default_value)) : nlohmann::json(*s.default_value);
     }
     check_geometry(out, where);
+    // No run holds less than the grains' weight (check_stress_above_self_weight): a modulus the overlap rule refuses
+    // there refuses every run of the material, so it is refused here, where commands without a stress read it
+    // (enlarge took E = 0.5 Pa and fitted laws through it).
+    check_overlap(out, self_weight_stress(out), where + " (at the box's own weight, the least stress it holds)");
     check_work(out, std::nullopt, where);
     return out;
 }

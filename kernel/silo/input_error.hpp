@@ -1,10 +1,18 @@
-// Bad silo settings: one message shape for every check, "field = value: why", thrown as std::invalid_argument.
+// Bad silo settings: one message shape for every check, "field = value: why", thrown as SettingRejected (a
+// std::invalid_argument that keeps the field's name, so that a front end can name it as its user gave it).
 #pragma once
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace demcal::kernel::silo {
+
+struct SettingRejected : std::invalid_argument {
+    SettingRejected(std::string field_name, const std::string& message)
+        : std::invalid_argument(message), field(std::move(field_name)) {}
+    std::string field;  // as the message's start names it: "field = value: why"
+};
 
 // A value as the user would type it (shortest default stream form).
 inline std::string setting_text(double value) {
@@ -14,7 +22,7 @@ inline std::string setting_text(double value) {
 }
 
 [[noreturn]] inline void reject_setting(const std::string& field, double value, const std::string& why) {
-    throw std::invalid_argument(field + " = " + setting_text(value) + ": " + why);
+    throw SettingRejected(field, field + " = " + setting_text(value) + ": " + why);
 }
 
 }  // namespace demcal::kernel::silo

@@ -309,18 +309,18 @@ void validate(const SiloCaseSettings& s) {
                        "larger than the Rayleigh time step of the smallest wheat sphere (" + setting_text(rayleigh) +
                            " s at this stiffness); use a fraction of it, or --dt-fraction");
     // Below a thousandth of the Rayleigh step nothing is resolved better (at 0.25 a contact already spans tens of
-    // steps), and one record interval takes millions of steps: a stop (Ctrl-C, SIGTERM, --wall-limit), which waits
-    // for the end of one, did not come within minutes (--dt-fraction 1e-5).
+    // steps), and the run would take up to a thousand times the steps (--dt-fraction 1e-5 passed the step count; a
+    // stop then waited for the end of a record interval of millions of steps, before stops came within one step)
     if (s.time_step > 0 && s.time_step < kMinTimeStepFraction * rayleigh)
         reject_setting("dt", s.time_step,
                        "smaller than " + setting_text(kMinTimeStepFraction) + " of the Rayleigh time step of the "
                        "smallest wheat sphere (" + setting_text(rayleigh) + " s at this stiffness): no more accurate, "
-                       "and a stop would wait minutes for the end of a record interval");
+                       "and the run would take up to a thousand times the steps");
     if (!(s.time_step_fraction >= kMinTimeStepFraction && s.time_step_fraction <= 1))
         reject_setting("dt_fraction", s.time_step_fraction,
                        "must lie in [" + setting_text(kMinTimeStepFraction) +
-                           ", 1] (of the Rayleigh time step; smaller is no more accurate, and a stop would wait "
-                           "minutes for the end of a record interval)");
+                           ", 1] (of the Rayleigh time step; smaller is no more accurate, and the run would take up "
+                           "to a thousand times the steps)");
     validate(s.vibration);
     if (s.contact_law != SiloContactLaw::edem && s.contact_law != SiloContactLaw::yade)
         reject_setting("contact_law", static_cast<double>(s.contact_law), "must be edem (0) or yade (1)");
@@ -425,8 +425,11 @@ namespace {
 // (no cohesion), is read too. Version 4: each section (tag and settings; the case's state; the kernel's state) closed
 // by a checksum, the kernel's state in its format 3 (contact histories of any size, moving walls); the settings
 // include the bin's vibration (version 3 had none). Versions 1 to 3 are refused with a message that says so.
+// Version 13: the steps left of the record interval a session stopped within (its kernel state owes a half kick);
+// versions 4 to 12 stopped only at the end of an interval (0 left).
 constexpr const char* kCheckpointTagPrefix = "demcal-silo-checkpoint/";
-constexpr int kCheckpointVersion = 12;
+constexpr int kCheckpointVersion = 13;
+constexpr int kCheckpointVersionWithoutIntervalStop = 12;  // interval_steps_left_: 0
 constexpr int kCheckpointVersionWithoutFillCpu = 11;       // fill_cpu_s: unknown past the filling
 constexpr int kCheckpointVersionWithoutWallFacets = 10;    // discharge_wall_facets: 0 (exact walls)
 constexpr int kCheckpointVersionWithoutRotationChoice = 9;  // discharge_clump_rotation: richardson
@@ -619,6 +622,7 @@ public:
                 r_.section->save(w);
                 outlet_->save(w);
             }
+            w.value(interval_steps_left_);
             w.checksum();
             sim_.save_state(os);
             os.flush();
@@ -668,8 +672,16 @@ public:
             // a version 6 run resumed in its discharge measures the outlet from here on (result(): its frames)
             if (version > kCheckpointVersionWithoutVibratingPart) outlet_->load(r);
         }
+        interval_steps_left_ = 0;
+        if (version > kCheckpointVersionWithoutIntervalStop) r.value(interval_steps_left_, "steps left of the interval");
+        if (interval_steps_left_ < 0 || interval_steps_left_ >= chunk())
+            r.fail("steps left of the interval", std::to_string(interval_steps_left_) + " is not within the record "
+                   "interval's " + std::to_string(chunk()) + " steps");
         r.checksum();
         sim_.load_state(is, source);
+        if (sim_.between_steps() != (interval_steps_left_ > 0))
+            throw std::runtime_error(source + ": its kernel state " + (sim_.between_steps() ? "was" : "was not") +
+                                     " stopped between two steps, its record interval says otherwise: damaged");
         ++r_.sessions;
         ++r_.cpu_sessions;
         last_checkpoint_wall_ = wall();
@@ -686,7 +698,7 @@ private:
     }
     double wall() const { return wall_before_ + session_wall(); }
     double cpu() const { return cpu_before_ + process_cpu_seconds() - cpu_start_; }
-    // Whether this session ends here (at the end of a record interval), and why: its wall limit, or the caller's
+    // Whether this session ends here (asked after every step), and why: its wall limit, or the caller's
     // stop request. The run is then suspended with a checkpoint.
     bool session_must_end() {
         if (s_.wall_limit > 0 && session_wall() >= s_.wall_limit) {
@@ -701,6 +713,17 @@ private:
     }
     long progress_every() const { return std::max(1L, std::lround(s_.progress_interval / r_.time_step)); }
     long chunk() const { return std::max(1L, std::lround(s_.record_interval / r_.time_step)); }
+    // One record interval of steps, or what a stopped session left of it. The session's end (session_must_end) is
+    // asked after every step, not only at the interval's end: an interval is millions of steps for a large bed (a
+    // SIGTERM then waited minutes, past a batch system's grace). False: the session ends within the interval, the
+    // steps left kept for the checkpoint; the next session takes them first, and the run goes on bit for bit.
+    bool advance_record_interval() {
+        const long todo = interval_steps_left_ > 0 ? interval_steps_left_ : chunk();
+        const bool may_end = s_.wall_limit > 0 || (s_.stop_request && !s_.checkpoint_file.empty());
+        const long done = may_end ? sim_.step(todo, [this] { return session_must_end(); }) : (sim_.step(todo), todo);
+        interval_steps_left_ = todo - done;
+        return interval_steps_left_ == 0;
+    }
     bool is_below_outlet(const BodyState& b) const { return b.position.z() < -s_.removal_depth; }
 
     static void sync_file(const std::string& file) {
@@ -787,7 +810,7 @@ private:
         const double rest_energy = this->rest_energy();
         auto below = [this](const BodyState& b) { return is_below_outlet(b); };
         while (true) {
-            sim_.step(chunk());
+            if (!advance_record_interval()) return false;
             lost_ += long(sim_.remove_bodies_if(below).count);  // grains through a gap in the closed silo: none expected
             ke_ = sim_.num_bodies() ? sim_.kinetic_energy() / double(sim_.num_bodies()) : 0;
             maybe_vtk();
@@ -879,7 +902,7 @@ private:
         const double stall_time = 0.5;  // no grain discharged for this long with grains left: the flow has stopped
         auto below = [this](const BodyState& b) { return is_below_outlet(b); };
         while (true) {
-            sim_.step(chunk());
+            if (!advance_record_interval()) return false;
             const RemovalResult rem = sim_.remove_bodies_if(below);
             mass_out_ += rem.mass;
             grains_out_ += long(rem.count);
@@ -997,6 +1020,7 @@ private:
     double ke_ = 0;
     double t_open_ = 0;
     long next_frame_ = 0;
+    long interval_steps_left_ = 0;  // of the record interval a session stopped within (advance_record_interval)
     double mass_out_ = 0;
     long grains_out_ = 0;
     double last_out_time_ = 0;

@@ -72,7 +72,7 @@ std::string silo_clump_rotation_text(ClumpRotation scheme);  // its name in silo
 std::string silo_contact_law_text(SiloContactLaw law);  // its name in silo_contact_laws()
 
 // The smallest time step a silo run takes, as a fraction of the Rayleigh step (time_step and time_step_fraction):
-// smaller resolves nothing better, and a record interval would take millions of steps (a stop waits for its end).
+// smaller resolves nothing better, and the run would take up to a thousand times the steps.
 inline constexpr double kMinTimeStepFraction = 1e-3;
 
 struct SiloCaseSettings {
@@ -123,11 +123,11 @@ struct SiloCaseSettings {
     // crash, a kill or the end of a session. Empty: no checkpoints. 0 s: after every record interval (tests).
     std::string checkpoint_file;
     double checkpoint_interval = 900;  // [s] wall clock
-    // Wall-clock limit of this session [s] (0: none): once it is reached, at the end of a record interval, the run
+    // Wall-clock limit of this session [s] (0: none): once it is reached (asked after every step), the run
     // writes its checkpoint and returns suspended, to be resumed later (a batch system's time limit, a machine lent
     // for a few hours). Needs a checkpoint file. Not stored: each session sets its own.
     double wall_limit = 0;
-    // Asked at the end of every record interval, as the wall limit: a non-empty answer (why, e.g. "SIGTERM received")
+    // Asked after every step, as the wall limit: a non-empty answer (why, e.g. "SIGTERM received")
     // suspends the run the same way (checkpoint written, result marked suspended). The caller's way to stop a run
     // cleanly from outside (demcal silo: SIGTERM and SIGINT). Only with a checkpoint file. Not stored.
     std::function<std::string()> stop_request;

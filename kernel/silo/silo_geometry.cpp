@@ -134,6 +134,20 @@ void validate(const SiloGeometry& g, double particle_size, double min_outlet_par
                     " particle sizes (" + setting_text(min_outlet_particles * particle_size) + " m)");
     }
     const double size = g.shape == SiloShape::conical ? g.diameter : g.width;
+    // A bed is a few grains deep at most once the silo is this wide: the largest run (5,000,000 grains) could not
+    // fill it (a diameter of 1e19 m was refused only by the stiffness check, for a fall of 1e10 m/s).
+    constexpr double kMaxParticleSizesAcross = 1000;
+    const char* size_name = g.shape == SiloShape::conical ? "diameter" : "c (width)";
+    if (size > kMaxParticleSizesAcross * particle_size)
+        reject_setting(size_name, size,
+                       "more than " + setting_text(kMaxParticleSizesAcross) + " particle sizes across (" +
+                           setting_text(kMaxParticleSizesAcross * particle_size) + " m for d_p = " +
+                           setting_text(particle_size) + " m): no run can fill it");
+    if (g.shape == SiloShape::rectangular && g.depth > kMaxParticleSizesAcross * particle_size)
+        reject_setting("b (depth)", g.depth,
+                       "more than " + setting_text(kMaxParticleSizesAcross) + " particle sizes (" +
+                           setting_text(kMaxParticleSizesAcross * particle_size) + " m for d_p = " +
+                           setting_text(particle_size) + " m): no run can fill it");
     if (g.hopper_height() > 20 * size)
         reject_setting("theta", g.half_angle_deg,
             "the hopper would be " + setting_text(g.hopper_height()) + " m tall (more than 20 silo sizes)");

@@ -10,6 +10,7 @@
 // 5-10 cm bed is about 3 % of the radius. Both cases together ran in about 95 s on one thread (Release, machine
 // shared with other jobs).
 #include "kernel/silo/silo_case.hpp"
+#include "silo_resume_check.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -255,6 +256,53 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
         CHECK_THROWS_WITH(read_checkpoint_settings((dir / "missing.bin").string()),
                           Catch::Matchers::Contains("missing.bin"));
     }
+    std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("silo case: a stop within a record interval ends the session after its step, and the run resumes bit for bit",
+          "[silo][checkpoint]") {
+    // A stop (SIGTERM, Ctrl-C, the wall limit) used to wait for the end of the 2 ms record interval: millions of steps
+    // for a large bed. Now it comes after the step it is asked at; the checkpoint keeps the steps left of the interval
+    // and a kernel state that owes the next step's half kick.
+    SiloCaseSettings s = small_rectangular_case();
+    const SiloCaseResult whole = run_silo_case(s);
+    const long interval_steps = std::lround(s.record_interval / whole.time_step);
+    REQUIRE(interval_steps > 20);
+    const auto dir = std::filesystem::temp_directory_path() / ("demcal-test-midstop-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    s.checkpoint_file = (dir / "checkpoint.bin").string();
+    s.checkpoint_interval = 1e6;  // only the stops write checkpoints
+    // first session: asked to stop at its 1000th question, while filling
+    long asked = 0;
+    s.stop_request = [&asked] { return ++asked == 1000 ? std::string("test stop") : std::string(); };
+    const SiloCaseResult first = run_silo_case(s);
+    CHECK(first.suspended);
+    CHECK(first.stop_reason == "test stop");
+    CHECK(first.steps % interval_steps != 0);  // within an interval
+    CHECK(first.steps < whole.fill_steps);
+    // second session: asked to stop a few steps after the discharge began (progress reports mark it)
+    bool discharging = false;
+    long asked_in_discharge = 0;
+    const SiloCaseResult second = resume_silo_case(
+        s.checkpoint_file,
+        {.threads = 2, .checkpoint_interval = 1e6, .wall_limit = 0,
+         .stop_request = [&] { return discharging && ++asked_in_discharge == 7 ? std::string("stop 2") : std::string(); }},
+        [&](const SiloProgress& p) { discharging = discharging || p.phase == "filled"; });
+    CHECK(second.suspended);
+    CHECK(second.stop_reason == "stop 2");
+    CHECK(second.steps > whole.fill_steps);
+    CHECK(second.steps % interval_steps != 0);
+    // third session: to the end, the uninterrupted run's result to the last bit
+    const SiloCaseResult resumed =
+        resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 1e6, .wall_limit = 0, .stop_request = {}});
+    CHECK_FALSE(resumed.suspended);
+    CHECK(resumed.sessions == 3);
+    CHECK(resumed.steps == whole.steps);
+    CHECK(resumed.fill_steps == whole.fill_steps);
+    CHECK(resumed.fill_kinetic_energy == whole.fill_kinetic_energy);
+    CHECK(demcal::test::same_discharge(resumed, whole));
+    CHECK(resumed.fit.rate == whole.fit.rate);
+    CHECK(resumed.flow.ratio == whole.flow.ratio);
     std::filesystem::remove_all(dir);
 }
 

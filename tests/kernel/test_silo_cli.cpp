@@ -79,8 +79,8 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
     for (const Case& c : {Case{"--theta 95", "theta = 95"}, Case{"--theta 0", "theta = 0"},
                           Case{"--theta 30 --outlet 0.01", "outlet = 0.01"},
                           Case{"--theta 30 --diameter 0.02", "diameter = 0.02"},
-                          Case{"--theta 30 --rect --c 0.02", "c (width) = 0.02"},
-                          Case{"--theta 30 --rect --b 0.01", "b (depth) = 0.01"},
+                          Case{"--theta 30 --rect --c 0.02", "--c = 0.02: the silo width c"},
+                          Case{"--theta 30 --rect --b 0.01", "--b = 0.01: the slot spans the depth b"},
                           Case{"--theta 30 --particles 0", "particles = 0"},
                           Case{"--theta 30 --stiffness-scale -1", "stiffness_scale = -1"},
                           Case{"--theta 30 --stop-fraction 2", "stop_fraction = 2"},
@@ -89,7 +89,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"", "theta: missing"},
                           // a value that once meant "not given" is a value like any other
                           Case{"--theta 30 --outlet -1", "outlet = -1"},
-                          Case{"--theta 30 --rect --outlet -1", "a (outlet width) = -1"},
+                          Case{"--theta 30 --rect --outlet -1", "--outlet = -1: must be positive"},
                           Case{"--theta 30 --seed -1", "seed = -1"},
                           Case{"--theta 30 --a 0.02", "--a = 0.02: applies to a rectangular hopper"},
                           Case{"--theta 30 --checkpoint-every nan", "--checkpoint-every: 'nan' is not a number"},
@@ -137,20 +137,20 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
         CHECK_THAT(r.err, Catch::Matchers::Contains(c.expect));
         CHECK_FALSE(fs::exists(out));
     }
-    // a geometry file: the same rules as the options, the key named
+    // a geometry file: the same rules as the options, the file and its key named (as an option is by its name)
     struct GeometryCase {
         std::string json, options, expect;
     };
     for (const GeometryCase& c :
          {GeometryCase{R"({"shape": "conical", "theta_deg": 30, "outlet_mm": 35})", "", "unknown key 'outlet_mm'"},
-          GeometryCase{R"({"theta_deg": -1})", "", "theta = -1"},
+          GeometryCase{R"({"theta_deg": -1})", "", "g.json: theta_deg = -1: the hopper half angle"},
           GeometryCase{R"({"theta_deg": 30, "a_m": 0.02})", "", "a_m = 0.02: applies to a rectangular hopper"},
           GeometryCase{R"({"shape": "rectangular", "theta_deg": 30, "D_m": 0.2})", "", "D_m = 0.2: the diameter"},
           GeometryCase{R"({"shape": "rectangular", "theta_deg": 30, "outlet_m": 0.03, "a_m": 0.02})", "",
                        "both set the outlet (slot) width"},
           GeometryCase{R"({"theta_deg": "30"})", "", R"(theta_deg = "30": must be a number)"},
           // --rect over a conical file drops its D_m (the command line's shape wins); the rest stands
-          GeometryCase{R"({"theta_deg": 30, "D_m": 0.105})", "--rect --c 0.02", "c (width) = 0.02"}}) {
+          GeometryCase{R"({"theta_deg": 30, "D_m": 0.105})", "--rect --c 0.02", "--c = 0.02: the silo width c"}}) {
         INFO(c.json + " " + c.options);
         std::ofstream(dir / "g.json") << c.json;
         const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' " + c.options + " --out '" +

@@ -159,7 +159,7 @@ TEST_CASE("silo: a time step that never lets the run end, or a snapshot every st
              // the end of a 2 ms record interval
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--dt-fraction", "1e-5", "--max-time",
                "0.01", "--fill-time", "0.01"},
-              {"dt_fraction = 1e-05", "a stop would wait"}},
+              {"dt_fraction = 1e-05", "a thousand times the steps"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--vtk", (dir / "v").string(), "--vtk-every",
                "1e-300"},
               {"--vtk-every 1e-300 s", "snapshots, more than 100000"}}},
@@ -418,7 +418,7 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
               {"--checkpoint-every 5", "--no-checkpoint"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--threads", "2147483647"}, {"--threads"}},
              {{"silo", "--theta", "30", "--particles", "200", "--out", out, "--body-height", "1e5"},
-              {"body_height = 100000", "20 silo sizes"}},
+              {"--body-height = 100000", "20 silo sizes"}},
              {{"predict", (dir / "wide_k.json").string()}, {"beverloo_k=7", "effective outlet would be empty"}},
              // a shear campaign that cannot give a failure line ran and ended "no failure line" with exit 0
              {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,5e3,5e3",
@@ -842,7 +842,102 @@ TEST_CASE("probe 47: a stored sensitivity study with a damaged field is refused 
               {"parameters[1].levels = ", "at least 3 entries"}},
              {with(damaged("unordered.json",
                            [](nlohmann::json& j) { std::swap(j["parameters"][0]["levels"][1], j["parameters"][0]["levels"][3]); })),
-              {"parameters[0].levels[2].value = ", "a study's levels ascend"}}},
+              {"parameters[0].levels[2].value = ", "a study's levels ascend"}},
+             // stop 49: the writer's keys only, as many levels as the study says, each parameter a real one, once
+             {with(damaged("unknown_top.json", [](nlohmann::json& j) { j["level"] = 5; })),
+              {"level = 5: unknown key"}},
+             {with(damaged("unknown_level.json", [](nlohmann::json& j) { j["parameters"][1]["levels"][0]["mu"] = 0.4; })),
+              {"parameters[1].levels[0].mu = 0.4: unknown key"}},
+             {with(damaged("count.json",
+                           [](nlohmann::json& j) {
+                               auto& levels = j["parameters"][0]["levels"];
+                               levels.erase(levels.begin() + 1);
+                           })),
+              {"parameters[0].levels has ", "the study's levels = "}},
+             {with(damaged("name.json",
+                           [](nlohmann::json& j) {
+                               j["parameters"][0]["name"] = "box_height";
+                               j["base_material"]["box_height"] = j["parameters"][0]["base_value"];
+                           })),
+              {"parameters[0].name = \"box_height\": not a micromechanical parameter"}},
+             {with(damaged("twice.json", [](nlohmann::json& j) { j["parameters"][1]["name"] = j["parameters"][0]["name"]; j["parameters"][1]["base_value"] = j["parameters"][0]["base_value"]; })),
+              {"parameters[1].name = ", "named by an earlier parameter too"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 49: a campaign folder of other files is refused, an empty one or a campaign's is taken", "[cli]") {
+    // `--campaign /` (as root) or a project folder got runs/, a store, campaign.json and reports among its files
+    const fs::path root = test::fresh_test_dir("hostile-probe49-folder"), dir = root / "work";
+    const fs::path foreign = dir / "project";
+    fs::create_directories(foreign / "data");
+    std::ofstream(foreign / "notes.txt") << "mine";
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::vector<std::string> shear{"shear", tiny, "-s", "5000,8000,11000", "--engine", "kernel", "-r", "1",
+                                         "-c", foreign.string()};
+    refused({{shear, {"campaign = '", "project': a folder of other files (", "notes.txt", "no campaign.sqlite"}},
+             {{"sensitivity", tiny, "--engine", "kernel", "-r", "1", "-c", foreign.string()},
+              {"project': a folder of other files", "no campaign.sqlite"}},
+             {{"crosscheck", "silo", "--particles", "20", "--theta", "30", "-c", foreign.string()},
+              {"project': a folder of other files", "no campaign.sqlite"}},
+             {{"vibration", "--theta", "30", "--frequency", "10", "--amplitude", "1e-4", "--campaign", foreign.string(),
+               "--repeats", "1", "--", "--particles", "100", "--max-time", "0.01", "--fill-time", "0.01"},
+              {"project': a folder of other files", "no campaign.json"}}},
+            dir);
+    // an empty folder is a new campaign; the folder of a campaign continues it (a demcal lock file alone is ours)
+    const fs::path empty = dir / "empty";
+    fs::create_directories(empty);
+    std::ofstream(empty / ".lock");
+    auto args = shear;
+    args.back() = empty.string();
+    CHECK(test::run_demcal(args, root / "first.log") == 0);
+    CHECK(fs::exists(empty / "campaign.sqlite"));
+    CHECK(test::run_demcal(args, root / "again.log") == 0);
+    CHECK_THAT(test::read_file(root / "again.log"), Contains("reused"));
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 49: a silo geometry refusal names the quantity as it was given, a file's key or an option", "[cli]") {
+    // "diameter = -1" named neither the file nor its key D_m; a diameter of 1.8e19 m was refused by the stiffness
+    // check (a fall of 1.8e10 m/s), not as a silo no run can fill
+    const fs::path root = test::fresh_test_dir("hostile-probe49-geometry"), dir = root / "work";
+    fs::create_directories(dir);
+    const auto geometry = [&](const std::string& name, const nlohmann::json& j) {
+        std::ofstream(root / name) << j.dump();
+        return (root / name).string();
+    };
+    refused({{{"silo", "--geometry", geometry("neg.json", {{"theta_deg", 30}, {"D_m", -1}}), "--check"},
+              {"neg.json: D_m = -1: the silo diameter D must be larger than the outlet"}},
+             {{"silo", "--geometry", geometry("huge.json", {{"theta_deg", 30}, {"D_m", 1.8e19}}), "--check"},
+              {"huge.json: D_m = 1.8e+19: more than 1000 particle sizes across"}},
+             {{"silo", "--geometry", geometry("slot.json", {{"shape", "rectangular"}, {"theta_deg", 30}, {"a_m", 0}}),
+               "--check"},
+              {"slot.json: a_m = 0: must be positive"}},
+             {{"silo", "--theta", "0.5", "--check"}, {"--theta = 0.5: the hopper would be"}},
+             {{"silo", "--theta", "30", "--diameter", "20", "--check"},
+              {"--diameter = 20: more than 1000 particle sizes across"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 49: a Young modulus no box can hold, even at its own weight, is refused where a material is read", "[cli]") {
+    // enlarge has no normal stress to check a modulus against: E = 0.5 Pa was fitted into a law
+    const fs::path root = test::fresh_test_dir("hostile-probe49-modulus"), dir = root / "work";
+    fs::create_directories(dir);
+    const auto tiny = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
+    std::vector<std::string> enlarge{"enlarge", "--no-plot", "-o", (dir / "laws.json").string()};
+    for (int k = 0; k < 3; ++k) {
+        nlohmann::json m = tiny;
+        m["particle_radius"] = tiny["particle_radius"].get<double>() * (1 + 0.1 * k);
+        if (k == 1) m["young_modulus"] = 0.5;
+        const fs::path file = root / ("E" + std::to_string(k) + ".json");
+        std::ofstream(file) << m.dump();
+        enlarge.push_back(file.string());
+    }
+    refused({{enlarge, {"E1.json (at the box's own weight", "young_modulus = 0.5 Pa", "so young_modulus >= "}},
+             {{"shear", root.string() + "/E1.json", "-s", "5000,8000,11000", "--engine", "kernel", "-c",
+               (dir / "c").string()},
+              {"young_modulus = 0.5 Pa"}}},
             dir);
     fs::remove_all(root);
 }
