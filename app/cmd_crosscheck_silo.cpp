@@ -148,7 +148,16 @@ void check_kernel_run(const SiloCrosscheckOptions& o, double theta) {
     try {
         silo_case_settings(settings, "demcal crosscheck silo");
     } catch (const std::exception& e) {
-        throw UserError("theta = " + g(theta) + ": the kernel run refuses its settings: " + e.what());
+        // demcal silo names a refused setting by its option; the options this command passes under another name
+        // are named as the user typed them here
+        constexpr std::pair<const char*, const char*> kRenamed[] = {{"--discharge-wall-facets", "--wall-facets"},
+                                                                    {"--contact-law", "--kernel-law"},
+                                                                    {"--discharge-rotation", "--kernel-rotation"}};
+        std::string message = e.what();
+        for (const auto& [silo_option, own_option] : kRenamed)
+            if (message.rfind(std::string(silo_option) + " = ", 0) == 0)
+                message = own_option + message.substr(std::string(silo_option).size());
+        throw UserError("theta = " + g(theta) + ": the kernel run refuses its settings: " + message);
     }
 }
 

@@ -221,6 +221,30 @@ constexpr std::pair<const char*, const char*> kGeometryFieldKeys[] = {
     {"theta", "theta_deg"},     {"outlet", "outlet_m"}, {"a (outlet width)", "outlet_m"}, {"diameter", "D_m"},
     {"body_height", "body_height_m"}, {"b (depth)", "b_m"}, {"c (width)", "c_m"}};
 
+// The kernel's name of each setting an option sets (ks::SettingRejected::field): a refusal of a setting given on the
+// command line names the option typed ("--max-time = -1: must be > 0 s"), one of a setting not given keeps the
+// kernel's name (a default, or a resumed run's stored value).
+constexpr std::pair<const char*, const char*> kSettingOptions[] = {
+    {"particles", "--particles"},
+    {"fill_mass", "--fill-mass"},
+    {"threads", "--threads"},
+    {"max_time", "--max-time"},
+    {"fill_time", "--fill-time"},
+    {"dt", "--dt"},
+    {"dt_fraction", "--dt-fraction"},
+    {"stiffness_scale", "--stiffness-scale"},
+    {"stop_fraction", "--stop-fraction"},
+    {"skin", "--skin"},
+    {"vtk_every", "--vtk-every"},
+    {"vibration_frequency", "--vibration-frequency"},
+    {"vibration_amplitude", "--vibration-amplitude"},
+    {"vibration_direction", "--vibration-direction"},
+    {"vibration_part", "--vibration-part"},
+    {"vibration_start", "--vibration-start"},
+    {"discharge_wall_facets", "--discharge-wall-facets"},
+    {"checkpoint_interval", "--checkpoint-every"},
+    {"wall_limit", "--wall-limit"}};
+
 // The command line over the --geometry file over the defaults; a quantity that does not belong to the shape is
 // refused wherever it was given. `sources`: where each quantity given came from, by the kernel's field name.
 ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub, std::map<std::string, std::string>& sources) {
@@ -395,12 +419,15 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.discharge_wall_facets = o.discharge_wall_facets;
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
+    std::map<std::string, std::string>& sources = geometry_sources;  // and the options', by the kernel's field name
+    for (const auto& [field, option] : kSettingOptions)
+        if (sub.count(option)) sources[field] = option;
     try {
         ks::validate(s);
     } catch (const ks::SettingRejected& e) {
-        const auto source = geometry_sources.find(e.field);
+        const auto source = sources.find(e.field);
         const std::string message = e.what();
-        if (source == geometry_sources.end() || message.rfind(e.field, 0) != 0) throw UserError(message);
+        if (source == sources.end() || message.rfind(e.field, 0) != 0) throw UserError(message);
         throw UserError(source->second + message.substr(e.field.size()));
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());

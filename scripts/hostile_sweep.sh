@@ -159,7 +159,7 @@ run_case crosscheck-silo/kernel-law-unknown 2 "--kernel-law" -- "${S[@]}" --thet
 run_case crosscheck-silo/kernel-law-rolling 2 "rolling_friction" -- "${S[@]}" --theta 30 --kernel-law yade
 run_case crosscheck-silo/kernel-rotation-unknown 2 "--kernel-rotation" -- "${S[@]}" --theta 30 --kernel-rotation omelyan
 run_case crosscheck-silo/kernel-rotation-empty 2 "--kernel-rotation" -- "${S[@]}" --theta 30 --kernel-rotation ""
-run_case crosscheck-silo/wall-facets-few 2 "discharge_wall_facets" -- "${S[@]}" --theta 30 --wall-facets 5
+run_case crosscheck-silo/wall-facets-few 2 "--wall-facets = 5" -- "${S[@]}" --theta 30 --wall-facets 5
 run_case crosscheck-silo/wall-facets-huge 2 "--wall-facets" -- "${S[@]}" --theta 30 --wall-facets 3000
 run_case crosscheck-silo/yade-start-value 2 "--kernel-start-as-yade-import" -- "${S[@]}" --theta 30 --kernel-start-as-yade-import=maybe
 run_case crosscheck-silo/theta-subnormal 2 "theta"       -- "${S[@]}" --theta 1e-320
@@ -229,7 +229,7 @@ run_case cutoff/json-readonly        2 "--json"  "$ro"   -- cutoff --bond-number
 run_case cutoff/json-no-folder       2 "--json"          -- cutoff --bond-number 10 --json /no/such/c.json
 meal="$here/examples/materials/silo_meal.json"
 run_case cutoff/silo-tol-tiny        2 "--tol"           -- cutoff --tol 1e-300 -- --material "$meal" --theta 30
-run_case cutoff/silo-dt-fraction     2 "dt_fraction = "  -- cutoff -- --material "$meal" --theta 30 --dt-fraction 1e-300
+run_case cutoff/silo-dt-fraction     2 "--dt-fraction = "  -- cutoff -- --material "$meal" --theta 30 --dt-fraction 1e-300
 run_case cutoff/silo-particles-nan   2 "--particles"     -- cutoff -- --material "$meal" --theta 30 --particles nan
 run_case cutoff/silo-stiffness-sub   2 "--stiffness-scale" -- cutoff -- --material "$meal" --theta 30 --stiffness-scale 1e-320
 run_case cutoff/silo-out             2 "--out"           -- cutoff -- --material "$meal" --theta 30 --out o
@@ -278,7 +278,7 @@ run_case silo/contact-law-rolling     2 "grain_grain.rolling_friction = 0.01" --
 run_case silo/contact-law-resume      2 "--contact-law"   -- silo --resume somewhere --contact-law yade
 run_case silo/rotation-unknown        2 "--discharge-rotation" -- "${L[@]}" --discharge-rotation "$hugestr"
 run_case silo/rotation-resume         2 "--discharge-rotation" -- silo --resume somewhere --discharge-rotation yade
-run_case silo/wall-facets-few         2 "discharge_wall_facets = 5" -- "${L[@]}" --discharge-wall-facets 5
+run_case silo/wall-facets-few         2 "--discharge-wall-facets = 5" -- "${L[@]}" --discharge-wall-facets 5
 run_case silo/wall-facets-huge        2 "--discharge-wall-facets" -- "${L[@]}" --discharge-wall-facets 99999999999999
 run_case silo/wall-facets-text        2 "--discharge-wall-facets" -- "${L[@]}" --discharge-wall-facets many
 run_case silo/wall-facets-resume      2 "--discharge-wall-facets" -- silo --resume somewhere --discharge-wall-facets 72
@@ -295,17 +295,17 @@ run_case silo/resume-readonly        2 "resume"  "$ro"   -- silo --resume "$ro"
 run_case silo/vib-frequency-nan      2 "vibration-frequency" -- "${L[@]}" --vibration-frequency nan --vibration-amplitude 1e-4
 run_case silo/vib-frequency-subnormal 2 "vibration-frequency" -- "${L[@]}" --vibration-frequency 1e-320 --vibration-amplitude 1e-4
 run_case silo/vib-frequency-1e308    2 "vibration-frequency" -- "${L[@]}" --vibration-frequency 1e308 --vibration-amplitude 1e-4
-run_case silo/vib-frequency-negative 2 "vibration_frequency = -5" -- "${L[@]}" --vibration-frequency -5 --vibration-amplitude 1e-4
+run_case silo/vib-frequency-negative 2 "--vibration-frequency = -5" -- "${L[@]}" --vibration-frequency -5 --vibration-amplitude 1e-4
 run_case silo/vib-amplitude-huge     2 "vibration-amplitude" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude "$huge"
 run_case silo/vib-amplitude-alone    2 "vibration-amplitude" -- "${L[@]}" --vibration-amplitude 1e-4
 run_case silo/vib-direction-bad      2 "vibration-direction" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-direction "$hugestr"
 run_case silo/vib-part-bad           2 "vibration-part" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-part "$hugestr"
 run_case silo/vib-part-no-vib        2 "vibration-part" -- "${L[@]}" --vibration-part hopper
 run_case silo/vib-start-nan          2 "vibration-start" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-start nan
-run_case silo/vib-start-1e99         2 "vibration_start = 1e+99" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-start 1e99
+run_case silo/vib-start-1e99         2 "--vibration-start = 1e+99" -- "${L[@]}" --vibration-frequency 50 --vibration-amplitude 1e-4 --vibration-start 1e99
 run_case silo/vib-start-no-vib       2 "vibration-start" -- "${L[@]}" --vibration-start 1
 run_case silo/dt-subnormal           2 "dt"              -- "${L[@]}" --dt 1e-320
-run_case silo/dt-fraction-tiny       2 "dt_fraction = "  -- "${L[@]}" --dt-fraction 1e-300
+run_case silo/dt-fraction-tiny       2 "--dt-fraction = "  -- "${L[@]}" --dt-fraction 1e-300
 run_case silo/dt-tiny                2 "dt = 1e-300"    -- "${L[@]}" --dt 1e-300
 run_case silo/vtk-every-tiny         2 "--vtk-every"     -- "${L[@]}" --vtk v --vtk-every 1e-300
 run_case silo/particles-huge         2 "particles"       -- "${L[@]}" --particles 99999999999999
@@ -332,7 +332,7 @@ run_case predict/density-1e308       2 "rho_b_kg_m3"     -- predict "$work/geome
 run_case predict/geometry-deep       2 "nest"            -- predict "$work/deep.json"
 run_case predict/json-folder         2 "folder.json"     -- predict "$G" --json "$work/folder.json"
 run_case silo/fill-mass-0            2 "--fill-mass = 0" -- silo --theta 30 --fill-mass 0 --check
-run_case silo/fill-mass-below-grain  2 "fill_mass"       -- silo --theta 30 --fill-mass 1e-9 --check
+run_case silo/fill-mass-below-grain  2 "--fill-mass = "       -- silo --theta 30 --fill-mass 1e-9 --check
 run_case silo/seed-2^64              2 "--seed"          -- silo --theta 30 --seed 18446744073709551616 --check
 mkdir -p "$work/zero_store" "$work/foreign_store"
 : > "$work/zero_store/campaign.sqlite"

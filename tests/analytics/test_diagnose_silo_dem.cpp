@@ -152,7 +152,7 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
          "--report = '" + (dir / "m.csv/sub/r.md").string() + "': " + (dir / "m.csv").string() + " is a file, so the folder cannot be created"},
         {"--model silo-dem" + data + campaign + " -- " + kTinySilo, "--material"},
         {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --theta 30", "--theta"},
-        {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --stop-fraction 7", "stop_fraction"},
+        {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --stop-fraction 7", "--stop-fraction = 7"},
         {"--model silo-dem --data '" + (dir / "few.csv").string() + "'" + campaign + material + " -- " + kTinySilo,
          "at least 3 conditions"},
         {"--model silo-dem" + data + campaign + " --material '" + (dir / "m.csv").string() + "' -- " + kTinySilo,

@@ -75,7 +75,7 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
       {"-- --theta 95", "theta"},
       {"--bracket 0,5000 -- --theta 30", "bracket"},
       {"--bracket 0,900 -- --theta 30 --stiffness-scale 1e-3", "vibration_frequency"},
-      {"--bracket 0,400 -- --theta 30 --stiffness-scale 1e-6", "stiffness_scale = 1e-06"}};
+      {"--bracket 0,400 -- --theta 30 --stiffness-scale 1e-6", "--stiffness-scale = 1e-06"}};
   for (const auto& [args, expect] : cases) {
     INFO(args);
     // --json first: after -- every word is a silo option

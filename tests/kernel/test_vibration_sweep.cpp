@@ -124,7 +124,7 @@ TEST_CASE("demcal vibration: bad input exits 2 naming it before anything is writ
       {"--theta 45 --frequency 100" + campaign + " -- " + kTiny, "--amplitude"},
       {"--theta 45 --frequency 0,100 --amplitude 1e-4" + campaign + " -- " + kTiny + " --seed 3", "--seed"},
       {"--theta 45 --frequency 0,100 --amplitude 1e-4" + campaign + " -- " + kTiny + " --stop-fraction 7",
-       "stop_fraction"},
+       "--stop-fraction = 7"},
       {"--theta 95 --frequency 0" + campaign + " -- " + kTiny, "--theta"},
       {"--theta 45 --frequency 0,-5 --amplitude 1e-4" + campaign, "--frequency"},
       {"--theta 45 --frequency 100 --amplitude 1e-4 --direction y" + campaign, "--direction"},
