@@ -123,6 +123,14 @@ std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::st
                                         [b](double x, double y) { return std::fabs(x - b) < std::fabs(y - b); });
         if (std::fabs(*nearest - b) < 0.25 * (hi - lo) / (options.levels - 1)) *nearest = b;
     }
+    // Rounded to 6 significant digits, levels closer than that are one material: --span 1e-7 ran nine identical
+    // lines and failed only at the end ("needs at least 3 distinct levels")
+    for (std::size_t k = 1; k < values.size(); ++k)
+        if (!(values[k] > values[k - 1]))
+            throw std::invalid_argument("range of " + name + " = " + number_text(lo, 12) + ":" + number_text(hi, 12) + ": its " +
+                                        std::to_string(options.levels) + " levels are not distinct at 6 significant "
+                                        "digits (" + number_text(values[k - 1]) + ", " + number_text(values[k]) +
+                                        "): widen it (--span, --range) or give fewer --levels");
     return values;
 }
 

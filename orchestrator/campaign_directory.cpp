@@ -15,12 +15,12 @@ namespace fs = std::filesystem;
 void check_campaign_folder(const fs::path& dir, const std::string& marker) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec) || fs::exists(dir / marker, ec)) return;
-    std::vector<std::string> others;
+    std::vector<std::string> folders;
     std::size_t count = 0;
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-        const std::string name = it->path().filename().string();
-        if (name == ".lock") continue;  // (ours: a campaign that died before its first write)
-        if (others.size() < 3) others.push_back(analytics::shortened_text(name, 40));
+        std::error_code type_ec;
+        if (!it->is_directory(type_ec)) continue;  // a file: a console log, a batch system's output (sbatch -o DIR/..)
+        if (folders.size() < 3) folders.push_back(analytics::shortened_text(it->path().filename().string(), 40));
         ++count;
     }
     if (ec)
@@ -28,11 +28,11 @@ void check_campaign_folder(const fs::path& dir, const std::string& marker) {
                                     "': cannot list the folder: " + ec.message());
     if (count == 0) return;
     std::string listed;
-    for (const auto& name : others) listed += (listed.empty() ? "" : ", ") + name;
-    if (count > others.size()) listed += ", ... " + std::to_string(count) + " in all";
-    throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) + "': a folder of other "
-                                "files (" + listed + ") and no campaign in it (no " + marker + "): give a new or "
-                                "empty folder, or a campaign's folder to continue it");
+    for (const auto& name : folders) listed += (listed.empty() ? "" : ", ") + name + "/";
+    if (count > folders.size()) listed += ", ... " + std::to_string(count) + " in all";
+    throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) + "': holds other "
+                                "folders (" + listed + ") and no campaign (no " + marker + "): give a new folder, "
+                                "one with files only (a console log), or a campaign's folder to continue it");
 }
 
 CampaignDirectory::CampaignDirectory(const fs::path& dir, const FinishedResult& finished)

@@ -13,11 +13,12 @@
 
 namespace demcal::orchestrator {
 
-// A campaign folder is new, empty, or already a campaign's: one that holds `marker` (the store, campaign.sqlite; a
-// silo campaign's campaign.json). A folder of other files (a home or project folder given by mistake, "/") would get
-// a store, runs/ and reports among its files, and the same names overwritten: std::invalid_argument naming the
-// folder and a few of its entries, before anything is written. A folder that does not exist, or is not a folder, is
-// left to the caller.
+// A campaign folder is new, holds files only, or is already a campaign's: one that holds `marker` (the store,
+// campaign.sqlite; a silo campaign's campaign.json). A folder with folders of its own (a home or project folder given
+// by mistake, "/") would get a store, runs/ and reports among its files, the same names overwritten:
+// std::invalid_argument naming the folder and a few of its folders, before anything is written. Files alone are
+// taken: a console log or a batch system's output file (sbatch -o DIR/...) exists before demcal starts. A folder
+// that does not exist, or is not a folder, is left to the caller.
 void check_campaign_folder(const std::filesystem::path& dir, const std::string& marker);
 
 // The result a run left in its folder if it finished (written atomically as its last act), else nothing.

@@ -866,7 +866,8 @@ TEST_CASE("probe 47: a stored sensitivity study with a damaged field is refused 
     fs::remove_all(root);
 }
 
-TEST_CASE("probe 49: a campaign folder of other files is refused, an empty one or a campaign's is taken", "[cli]") {
+TEST_CASE("probe 49: a campaign folder with folders of its own is refused, one of files only or a campaign's is taken",
+          "[cli]") {
     // `--campaign /` (as root) or a project folder got runs/, a store, campaign.json and reports among its files
     const fs::path root = test::fresh_test_dir("hostile-probe49-folder"), dir = root / "work";
     const fs::path foreign = dir / "project";
@@ -875,19 +876,20 @@ TEST_CASE("probe 49: a campaign folder of other files is refused, an empty one o
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
     const std::vector<std::string> shear{"shear", tiny, "-s", "5000,8000,11000", "--engine", "kernel", "-r", "1",
                                          "-c", foreign.string()};
-    refused({{shear, {"campaign = '", "project': a folder of other files (", "notes.txt", "no campaign.sqlite"}},
+    refused({{shear, {"campaign = '", "project': holds other folders (data/)", "no campaign.sqlite"}},
              {{"sensitivity", tiny, "--engine", "kernel", "-r", "1", "-c", foreign.string()},
-              {"project': a folder of other files", "no campaign.sqlite"}},
+              {"project': holds other folders (data/)", "no campaign.sqlite"}},
              {{"crosscheck", "silo", "--particles", "20", "--theta", "30", "-c", foreign.string()},
-              {"project': a folder of other files", "no campaign.sqlite"}},
+              {"project': holds other folders (data/)", "no campaign.sqlite"}},
              {{"vibration", "--theta", "30", "--frequency", "10", "--amplitude", "1e-4", "--campaign", foreign.string(),
                "--repeats", "1", "--", "--particles", "100", "--max-time", "0.01", "--fill-time", "0.01"},
-              {"project': a folder of other files", "no campaign.json"}}},
+              {"project': holds other folders (data/)", "no campaign.json"}}},
             dir);
-    // an empty folder is a new campaign; the folder of a campaign continues it (a demcal lock file alone is ours)
+    // a folder of files only is a new campaign (a console log, sbatch -o DIR/slurm.out made before demcal starts);
+    // the folder of a campaign continues it
     const fs::path empty = dir / "empty";
     fs::create_directories(empty);
-    std::ofstream(empty / ".lock");
+    std::ofstream(empty / "slurm-17.out") << "console";
     auto args = shear;
     args.back() = empty.string();
     CHECK(test::run_demcal(args, root / "first.log") == 0);
@@ -938,6 +940,22 @@ TEST_CASE("probe 49: a Young modulus no box can hold, even at its own weight, is
              {{"shear", root.string() + "/E1.json", "-s", "5000,8000,11000", "--engine", "kernel", "-c",
                (dir / "c").string()},
               {"young_modulus = 0.5 Pa"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 49: levels that round to one value are refused before any run", "[cli]") {
+    // --span 1e-7: nine levels rounded to 6 significant digits were one material, run (reused) nine times, and the
+    // study failed only at its end ("needs at least 3 distinct levels")
+    const fs::path root = test::fresh_test_dir("hostile-probe49-levels"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    refused({{{"sensitivity", tiny, "--engine", "kernel", "-r", "1", "-c", (dir / "s").string(), "--span", "1e-7",
+               "--levels", "9", "--params", "friction_coefficient"},
+              {"range of friction_coefficient = ", "levels are not distinct at 6 significant digits"}},
+             {{"sensitivity", tiny, "--engine", "kernel", "-r", "1", "-c", (dir / "s").string(), "--range",
+               "friction_coefficient=0.5:0.5000001", "--params", "friction_coefficient"},
+              {"range of friction_coefficient = 0.5:0.5000001", "not distinct"}}},
             dir);
     fs::remove_all(root);
 }
