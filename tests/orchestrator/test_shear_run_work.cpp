@@ -105,8 +105,11 @@ TEST_CASE("shear-run refuses a travel shorter than a particle fraction and a mod
     const fs::path dir = test::fresh_test_dir("work-physics");
     // a "peak" after 3 micrometres of a 4 mm grain sample was reported with exit 0
     shear_run_refuses(dir, "shear_displacement", 1e-12, {"'shear_displacement' = 1e-12", "particle length"});
-    // the run failed with exit 3 (a sphere escaped) instead of a refusal
-    shear_run_refuses(dir, "young_modulus", 1e-3, {"young_modulus = 0.001 Pa", "normal_stress = 5000 Pa", "overlap"});
+    // the run failed with exit 3 (a sphere escaped) instead of a refusal: 1e5 Pa holds the box's own weight (about
+    // 260 Pa) but not the run's 5 kPa; 1e-3 Pa not even the weight, so no run of that material can hold
+    shear_run_refuses(dir, "young_modulus", 1e5, {"young_modulus = 100000 Pa", "normal_stress = 5000 Pa", "overlap"});
+    shear_run_refuses(dir, "young_modulus", 1e-3,
+                      {"(at the box's own weight, the least stress it holds): young_modulus = 0.001 Pa", "overlap"});
     fs::remove_all(dir);
 }
 

@@ -25,6 +25,10 @@ StoredJob shell_job(const fs::path& root, const std::string& name, const std::st
                       60);
 }
 
+// The commands open their campaign folder (its store) before they make their jobs' folders; a folder of folders
+// without a store is refused (check_campaign_folder).
+void open_store_first(const fs::path& root) { CampaignDirectory made(root, stored_job_result); }
+
 std::map<std::string, std::string> run_all(CampaignDirectory& d, const std::vector<StoredJob>& jobs,
                                            StoredJobsOutcome& out) {
     std::map<std::string, std::string> events;
@@ -40,6 +44,7 @@ std::map<std::string, std::string> run_all(CampaignDirectory& d, const std::vect
 TEST_CASE("stored jobs: reuse, failure for good on exit 2, retry of other failures, outputs checked", "[store]") {
     const fs::path root = fs::temp_directory_path() / ("demcal-test-stored-jobs-" + std::to_string(::getpid()));
     fs::remove_all(root);
+    open_store_first(root);
     std::vector<StoredJob> jobs = {shell_job(root, "good", "echo '{\"x\": 1}' > result.json && touch other.out"),
                                    shell_job(root, "refused", "exit 2"),
                                    shell_job(root, "flaky", "if [ -e ../flaky.ok ]; then echo '{}' > result.json; "
@@ -101,6 +106,7 @@ TEST_CASE("stored jobs: a result file nested 100000 deep or with a repeated key 
     // rerun, never the orchestrator; the JSON reader's depth limit is what keeps the parse and the store's dump bounded
     const fs::path root = fs::temp_directory_path() / ("demcal-test-stored-deep-" + std::to_string(::getpid()));
     fs::remove_all(root);
+    open_store_first(root);
     const std::string deep = "python3 -c \"print('[' * 100000 + ']' * 100000)\" > result.json";
     std::vector<StoredJob> jobs = {shell_job(root, "deep", deep),
                                    shell_job(root, "twice", "echo '{\"x\": 1, \"x\": 2}' > result.json")};
@@ -125,6 +131,7 @@ TEST_CASE("stored jobs: a done job whose result file is no longer the result the
     // flipped, another run's result copied in) must not be reported as this run's
     const fs::path root = fs::temp_directory_path() / ("demcal-test-stored-changed-" + std::to_string(::getpid()));
     fs::remove_all(root);
+    open_store_first(root);
     std::vector<StoredJob> jobs = {shell_job(root, "counted", "echo '{\"rate\": 0.25}' > result.json"),
                                    shell_job(root, "kept", "echo '{\"rate\": 0.5}' > result.json")};
     {
