@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -47,8 +48,8 @@ void check_discharge_switch_keeps_rate(kernel::silo::SiloCaseSettings s, Switch 
 }
 
 // `s` runs whole, then again killed at its 5th checkpoint (while filling, with checkpoints after every record
-// interval) and, resumed on another thread count, killed once the discharge passed `second_kill_after` s; the third
-// session finishes. Returns the checkpoint's stored settings for the caller's own checks.
+// interval) and, resumed on another thread count, stopped within a record interval once the discharge passed
+// `second_kill_after` s; the third session finishes. Returns the checkpoint's stored settings for the caller's own checks.
 inline kernel::silo::SiloCaseSettings check_resumes_bit_for_bit(kernel::silo::SiloCaseSettings s, const std::string& tag,
                                                                 double second_kill_after) {
     using namespace kernel::silo;
@@ -68,12 +69,18 @@ inline kernel::silo::SiloCaseSettings check_resumes_bit_for_bit(kernel::silo::Si
                     SimulatedCrash);
     CHECK_FALSE(opened);
     const SiloCaseSettings stored = read_checkpoint_settings(s.checkpoint_file);
-    CHECK_THROWS_AS(resume_silo_case(s.checkpoint_file, {.threads = 2, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}},
-                                     [&](const SiloProgress& p) {
-                                         if (p.phase == "checkpoint" && p.discharge_time > second_kill_after)
-                                             throw SimulatedCrash{};
-                                     }),
-                    SimulatedCrash);
+    // the second session is stopped (as by SIGTERM) 7 steps after the discharge passed `second_kill_after`: within a
+    // record interval, its kernel state between two steps
+    bool past = false;
+    long asked_after = 0;
+    const SiloCaseResult second = resume_silo_case(
+        s.checkpoint_file,
+        {.threads = 2, .checkpoint_interval = 0, .wall_limit = 0,
+         .stop_request = [&] { return past && ++asked_after == 7 ? std::string("test stop") : std::string(); }},
+        [&](const SiloProgress& p) { past = past || p.discharge_time > second_kill_after; });
+    CHECK(second.suspended);
+    CHECK(second.stop_reason == "test stop");
+    CHECK(second.steps % std::lround(s.record_interval / whole.time_step) != 0);
     const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}});
     CHECK(resumed.sessions == 3);
     CHECK(resumed.fill_steps == whole.fill_steps);
