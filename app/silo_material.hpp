@@ -1,5 +1,6 @@
 // The silo's material file (demcal silo --material FILE.json): the grain, the wall and the two pair sets of the seed's
-// Table 2.1, every field required, E or G for each solid, unknown keys refused. The seed's wheat is
+// Table 2.1, every physical field required (grain.shape, the one "wheat-clump", may be left out), E or G for each
+// solid, unknown keys refused. The seed's wheat is
 // examples/materials/silo_wheat_table21.json (equal to the built-in default).
 #pragma once
 #include <nlohmann/json.hpp>
