@@ -387,8 +387,8 @@ void check_run_size(const ks::SiloCaseSettings& s) {
 ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     check_session_options(o, sub);
     ks::SiloCaseSettings s;
-    std::map<std::string, std::string> geometry_sources;
-    s.geometry = geometry_from(o, sub, geometry_sources);
+    std::map<std::string, std::string> sources;  // where each setting given came from, by the kernel's field name
+    s.geometry = geometry_from(o, sub, sources);
     if (sub.count("--particles") && sub.count("--fill-mass"))
         throw UserError("--particles and --fill-mass both set the amount of grain; give one");
     // 0 is the setting's "not given": given on the command line it must be a real amount, not the default's signal
@@ -419,16 +419,13 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     s.discharge_wall_facets = o.discharge_wall_facets;
     s.vtk_dir = o.vtk;
     s.vtk_interval = o.vtk_every;
-    std::map<std::string, std::string>& sources = geometry_sources;  // and the options', by the kernel's field name
     for (const auto& [field, option] : kSettingOptions)
         if (sub.count(option)) sources[field] = option;
     try {
         ks::validate(s);
     } catch (const ks::SettingRejected& e) {
         const auto source = sources.find(e.field);
-        const std::string message = e.what();
-        if (source == sources.end() || message.rfind(e.field, 0) != 0) throw UserError(message);
-        throw UserError(source->second + message.substr(e.field.size()));
+        throw UserError(source == sources.end() ? std::string(e.what()) : source->second + e.after_field);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }

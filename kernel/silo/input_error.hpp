@@ -9,9 +9,12 @@
 namespace demcal::kernel::silo {
 
 struct SettingRejected : std::invalid_argument {
-    SettingRejected(std::string field_name, const std::string& message)
-        : std::invalid_argument(message), field(std::move(field_name)) {}
-    std::string field;  // as the message's start names it: "field = value: why"
+    SettingRejected(std::string field_name, std::string value_and_why)
+        : std::invalid_argument(field_name + value_and_why),
+          field(std::move(field_name)),
+          after_field(std::move(value_and_why)) {}
+    std::string field;        // as the message's start names it
+    std::string after_field;  // the rest: " = value: why"
 };
 
 // A value as the user would type it (shortest default stream form).
@@ -22,7 +25,7 @@ inline std::string setting_text(double value) {
 }
 
 [[noreturn]] inline void reject_setting(const std::string& field, double value, const std::string& why) {
-    throw SettingRejected(field, field + " = " + setting_text(value) + ": " + why);
+    throw SettingRejected(field, " = " + setting_text(value) + ": " + why);
 }
 
 }  // namespace demcal::kernel::silo
