@@ -1,6 +1,6 @@
 // demcal shear-run PARAMS RESULT: one shear box on the kernel engine, as a campaign runs it (the orchestrator starts it
 // as a subprocess, so timeouts, kill -9, retries and SLURM hold exactly as for YADE). It speaks the YADE script's
-// protocol: params.json in, result.json (schema demcal.shear_result/2, sealed with its SHA-256 as
+// protocol: params.json in, result.json (schema demcal.shear_result/3, sealed with its SHA-256 as
 // orchestrator/run_identity.hpp says) written atomically, exit 2 with
 // `DEMCAL_FAILURE params: ...` for bad parameters, exit 3 with `DEMCAL_FAILURE <cause>: ...` for a run that failed.
 #include "app/cli_support.hpp"
@@ -69,8 +69,9 @@ ShearBoxParams to_kernel_params(const nlohmann::json& j) {
     return p;
 }
 
-nlohmann::json to_json(const ShearBoxResult& r, const std::string& params_sha256) {
+nlohmann::json to_json(const ShearBoxResult& r, const nlohmann::json& params_as_read) {
     return {{"schema", orchestrator::kShearResultSchema},
+            {"params", params_as_read},
             {"curve",
              {{"displacement", r.displacement},
               {"shear_stress", r.shear_stress},
@@ -100,16 +101,15 @@ nlohmann::json to_json(const ShearBoxResult& r, const std::string& params_sha256
             {"steps", r.steps},
             {"timestep", r.timestep},
             {"wall_time_s", r.wall_time_s},
-            {"engine", kernel::cases::kShearBoxEngine},
-            {"params_sha256", params_sha256}};
+            {"engine", kernel::cases::kShearBoxEngine}};
 }
 
 void run(const std::string& params_path, const std::string& result_path, int threads) {
     ShearBoxParams params;
-    std::string params_sha256;
+    nlohmann::json params_as_read;  // recorded in the result: whose result it is (orchestrator::params_digest)
     try {
         const nlohmann::json raw = analytics::read_json_input(params_path, "params");
-        params_sha256 = orchestrator::params_digest(raw);
+        params_as_read = raw;
         params = to_kernel_params(checked_run_params(raw, params_path));
         kernel::cases::validate(params);
     } catch (const kernel::cases::ShearBoxFailure& e) {
@@ -132,7 +132,7 @@ void run(const std::string& params_path, const std::string& result_path, int thr
     }
     try {
         orchestrator::write_text_file_atomically(result_path,
-                                                 orchestrator::sealed_result_text(to_json(result, params_sha256).dump(1) + "\n"));
+                                                 orchestrator::sealed_result_text(to_json(result, params_as_read).dump(1) + "\n"));
     } catch (const std::exception& e) {
         fail(3, "output", e.what());
     }

@@ -74,7 +74,7 @@ nlohmann::json read_result_json(const std::filesystem::path& file, const std::st
     ResultFile r = read_result_file(file, what);
     if (!r.sealed && r.json.is_object() && r.json.contains("schema")) {
         const nlohmann::json& schema = r.json["schema"];
-        if (schema == kShearResultSchema || schema == kSiloSummarySchema)
+        if (schema == kShearResultSchema || schema == kShearResultSchema2 || schema == kSiloSummarySchema)
             throw DamagedResult(what + ": schema " + schema.get<std::string>() +
                                 " without its SHA-256 seal: damaged or not a demcal result");
     }

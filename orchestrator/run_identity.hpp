@@ -15,18 +15,22 @@ std::string sha256_hex(const std::string& bytes);
 // double counts as the integer (30000.0 and 30000 are one run).
 std::string run_identity(const std::string& template_text, const nlohmann::json& params);
 
-// SHA-256 of the parameters' canonical form alone. A result that carries it ("params_sha256": demcal shear-run writes
-// it; YADE's template does not) tells which run it belongs to: a result copied from another run's folder, even of the
-// same normal stress and another seed, is not taken for this run's.
+// SHA-256 of the parameters' canonical form alone. It tells which run a result belongs to: a result of schema
+// demcal.shear_result/3 carries the params.json object its run read ("params", both engines), a /2 result of the
+// kernel engine carried this digest ("params_sha256"); a result copied from another run's folder, even of the same
+// normal stress and another seed, is then not taken for this run's.
 std::string params_digest(const nlohmann::json& params);
 
-// result.json of a shear run (schema demcal.shear_result/2) is sealed with the SHA-256 of its own text, so that a
+// result.json of a shear run (schema demcal.shear_result/3; /2 had the same seal) is sealed with the SHA-256 of its own text, so that a
 // file damaged after its atomic write (a flipped byte, a truncated copy) is found when the orchestrator reads it. The
 // rule, the same for every writer (yade_scripts/shear_box.py's write_result_atomically, demcal shear-run): BODY is the
 // result's JSON object as the writer serialises it, with its final newline; the file is
 //     {"sha256": "<64 lowercase hex digits of SHA-256(BODY)>", <BODY without its opening brace>
 // which is JSON again (one more key). A reader takes BODY back as "{" + everything after the seal and compares.
-inline constexpr const char* kShearResultSchema = "demcal.shear_result/2";
+inline constexpr const char* kShearResultSchema = "demcal.shear_result/3";
+// The earlier sealed schema, still read: the same fields without "params" (YADE's template recorded nothing of its
+// run but its normal stress; the kernel engine recorded "params_sha256").
+inline constexpr const char* kShearResultSchema2 = "demcal.shear_result/2";
 
 // A result file whose seal is missing (where its schema needs one) or does not match its text.
 struct DamagedResult : std::runtime_error {
@@ -53,7 +57,7 @@ struct ResultFile {
 };
 ResultFile read_result_file(const std::filesystem::path& file, const std::string& what);
 
-// read_result_file for any result: an object whose schema is one that is always sealed (kShearResultSchema,
+// read_result_file for any result: an object whose schema is one that is always sealed (kShearResultSchema and /2,
 // kSiloSummarySchema) but carries no seal is damaged (a flipped byte in the seal itself); an unsealed file of
 // another schema, or of none (older writers, YADE's silo script), is taken as it is.
 // Throws DamagedResult, or analytics::InputError when the text breaks the reader's rules.

@@ -259,6 +259,22 @@ nlohmann::json read_shear_result(const fs::path& file, const nlohmann::json* run
     return result;
 }
 
+namespace {
+// ", seed = 2 where this run has 1": the first field in which a result's recorded params differ from the run's
+std::string differing_param(const nlohmann::json& recorded, const nlohmann::json& own) {
+    for (const auto& [key, value] : own.items()) {
+        if (!recorded.contains(key))
+            return ": " + key + " is missing";
+        if (params_digest(recorded[key]) != params_digest(value))
+            return ": " + key + " = " + analytics::json_value_text(recorded[key]) + " where this run has " +
+                   analytics::json_value_text(value);
+    }
+    for (const auto& [key, value] : recorded.items())
+        if (!own.contains(key)) return ": " + key + " = " + analytics::json_value_text(value) + " is not this run's";
+    return "";
+}
+}  // namespace
+
 void check_shear_result_values(const nlohmann::json& result, const std::string& what,
                                const nlohmann::json* run_params) {
     // the stresses a box can hold: a simulator (or a file planted in a run folder) that reports a negative peak or
@@ -285,8 +301,21 @@ void check_shear_result_values(const nlohmann::json& result, const std::string& 
                                         " Pa is outside [0, " + analytics::number_text(limit) +
                                         "] (not a shear box's result)");
     }
-    // the run's own result, not another run's copied into its folder: by its parameters' digest where the writer
-    // gave one (the kernel engine), else by its normal stress (YADE's template records no more of its run)
+    // the run's own result, not another run's copied into its folder: by the parameters it records (schema /3, both
+    // engines), by their digest (a /2 result of the kernel engine), else by its normal stress (YADE's /2 template
+    // recorded no more of its run)
+    if (result.value("schema", std::string()) == kShearResultSchema) {
+        if (!result.contains("params") || !result["params"].is_object())
+            throw std::invalid_argument(what + ": params = " +
+                                        (result.contains("params") ? analytics::json_value_text(result["params"])
+                                                                   : std::string("<missing>")) +
+                                        " is not the object of the run's params.json (schema " + kShearResultSchema +
+                                        " records it)");
+        if (run_params && params_digest(result["params"]) != params_digest(*run_params))
+            throw std::invalid_argument(what + ": the result of a run with other parameters (its params are not this "
+                                        "run's" + differing_param(result["params"], *run_params) +
+                                        "): another run's result in this run's folder");
+    }
     if (result.contains("params_sha256")) {
         const auto& digest = result["params_sha256"];
         if (!digest.is_string() || digest.get<std::string>().size() != 64 ||

@@ -10,7 +10,8 @@ Sequence (the thesis' modified Jenike cell, seed section 2.2.1):
   4. the upper frame (four walls, its flange and the lid) is driven along x at shear_velocity up to
      shear_displacement while the lid keeps the normal stress; shear stress vs displacement is sampled.
 
-Output: result.json (schema demcal.shear_result/2, sealed with its SHA-256), written atomically. Failures: exit 3 and one line
+Output: result.json (schema demcal.shear_result/3, sealed with its SHA-256, with the params.json object it ran), written
+atomically. Failures: exit 3 and one line
 `DEMCAL_FAILURE <cause>: <details>` on stderr; bad params: exit 2 with `DEMCAL_FAILURE params: ...`.
 Every parameter is documented in PARAM_SPECS below and in yade_scripts/README.md.
 """
@@ -26,7 +27,7 @@ from yade import pack, utils
 
 WALL_CLOCK_START = time.time()
 
-SCHEMA = "demcal.shear_result/2"
+SCHEMA = "demcal.shear_result/3"
 
 # name: (unit, kind, lower bound, lower bound inclusive, upper bound, upper bound inclusive, meaning)
 PARAM_SPECS = {
@@ -96,6 +97,8 @@ def fail(exit_code, cause, details):
 
 
 def read_params(path):
+    """(the checked parameters, the params.json object as read: the result records it, so that the orchestrator knows
+    the result for its run's and not another run's copied into the folder)."""
     try:
         with open(path) as f:
             raw = json.load(f)
@@ -133,7 +136,7 @@ def read_params(path):
     for key in PARAM_SPECS:
         if key not in params:
             fail(2, "params", "%s=<missing> required field [%s] (%s)" % (key, PARAM_SPECS[key][0], PARAM_SPECS[key][6]))
-    return params
+    return params, raw
 
 
 def check_geometry(p):
@@ -197,7 +200,7 @@ def write_result_atomically(path, result):
 def main():
     params_path = sys.argv[1] if len(sys.argv) > 1 else "params.json"
     result_path = sys.argv[2] if len(sys.argv) > 2 else "result.json"
-    p = read_params(params_path)
+    p, params_as_read = read_params(params_path)
     check_geometry(p)
 
     L, W, H = p["box_length"], p["box_width"], p["box_height"]
@@ -572,6 +575,7 @@ def main():
 
     result = {
         "schema": SCHEMA,
+        "params": params_as_read,
         "curve": {"displacement": displacement, "shear_stress": shear_stress, "normal_stress": normal_stress,
                   "lid_height": lid_height},
         "peak_shear_stress": shear_stress[peak_index],

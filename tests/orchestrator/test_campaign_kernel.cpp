@@ -47,7 +47,7 @@ TEST_CASE("a kernel-engine campaign fits a failure line, stores its runs beside 
         const std::string yade_identity = orchestrator::run_identity(
             test::read_file(test::source_path("yade_scripts/shear_box.py")), r.params);
         CHECK(r.hash != yade_identity);
-        CHECK(r.result.at("params_sha256") == orchestrator::params_digest(r.params));  // the run it belongs to
+        CHECK(orchestrator::params_digest(r.result.at("params")) == orchestrator::params_digest(r.params));  // its run
         hashes.insert(r.hash);
     }
     CHECK(hashes.size() == 3);
@@ -131,7 +131,7 @@ TEST_CASE("resume does not take another replicate's result, copied into an inter
     for (const auto& r : test::stored_runs(dir)) {
         if (r.hash != b->hash) continue;
         CHECK(r.state == RunState::done);
-        CHECK(r.result.at("params_sha256") == orchestrator::params_digest(b->params));
+        CHECK(orchestrator::params_digest(r.result.at("params")) == orchestrator::params_digest(b->params));
         CHECK(r.result.at("peak_shear_stress") != a->result.at("peak_shear_stress"));
     }
     // the rerun computes the run's own result again (the kernel is deterministic; only the wall time differs)
@@ -145,8 +145,9 @@ TEST_CASE("resume does not take another replicate's result, copied into an inter
 
 TEST_CASE("a result whose parameters' digest is not the run's, or is no digest, is refused", "[kernel_engine]") {
     const nlohmann::json params{{"normal_stress", 5e3}, {"seed", 1}, {"density", 2650}};
-    nlohmann::json result{{"peak_shear_stress", 3e3}, {"normal_stress_target", 5e3}};
-    CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", &params));  // YADE's: no digest
+    nlohmann::json result{{"schema", orchestrator::kShearResultSchema2}, {"peak_shear_stress", 3e3},
+                          {"normal_stress_target", 5e3}};
+    CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", &params));  // YADE's /2: no digest
     result["params_sha256"] = orchestrator::params_digest(params);
     CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", &params));
     nlohmann::json other_seed = params;
@@ -156,4 +157,31 @@ TEST_CASE("a result whose parameters' digest is not the run's, or is no digest, 
     result["params_sha256"] = "ABC";
     CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &params),
                       Catch::Contains("params_sha256 = \"ABC\" is not 64 lowercase hex digits"));
+}
+
+TEST_CASE("a result of schema 3 is its run's only when it records the run's parameters", "[kernel_engine]") {
+    // both engines write the params.json object they ran; another run's result (same stress, other seed) is refused
+    const nlohmann::json params{{"normal_stress", 5e3}, {"seed", 1}, {"density", 2650}};
+    nlohmann::json result{{"schema", orchestrator::kShearResultSchema}, {"peak_shear_stress", 3e3},
+                          {"normal_stress_target", 5e3}};
+    CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &params),
+                      Catch::Contains("params = <missing> is not the object of the run's params.json"));
+    result["params"] = "x";
+    CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &params),
+                      Catch::Contains("params = \"x\" is not the object"));
+    // written as read: 2650.0 from a computed level and 2650 from a file are one value
+    result["params"] = {{"normal_stress", 5000}, {"seed", 1}, {"density", 2650.0}};
+    CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", &params));
+    CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", nullptr));
+    result["params"]["seed"] = 2;
+    CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &params),
+                      Catch::Contains("seed = 2 where this run has 1") && Catch::Contains("another run's result"));
+    result["params"]["seed"] = 1;
+    result["params"].erase("density");
+    CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &params),
+                      Catch::Contains("density is missing"));
+    result["params"]["density"] = 2650;
+    result["params"]["damping"] = 0.2;
+    CHECK_THROWS_WITH(orchestrator::check_shear_result_values(result, "r", &params),
+                      Catch::Contains("damping = 0.2 is not this run's"));
 }

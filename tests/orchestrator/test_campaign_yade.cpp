@@ -47,6 +47,9 @@ TEST_CASE("a tiny YADE shear campaign gives positive peaks and a failure line, a
         // The run directory repeats by hand: the generated script and its parameters are there.
         CHECK(fs::exists(r.run_dir / "shear_box.py"));
         CHECK(nlohmann::json::parse(test::read_file(r.run_dir / "params.json")) == r.params);
+        // the result records the parameters it ran (schema /3): the orchestrator knows it for this run's
+        CHECK(r.result.at("schema") == orchestrator::kShearResultSchema);
+        CHECK(orchestrator::params_digest(r.result.at("params")) == orchestrator::params_digest(r.params));
         // YADE's own /tmp/yade-XXXXXX of this run is gone (run_clean.py): a campaign leaves nothing in /tmp
         const std::string out = test::read_file(r.run_dir / "stdout.log");
         const std::string mark = "run_clean: removed YADE's temporary directory ";

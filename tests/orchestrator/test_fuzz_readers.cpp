@@ -85,8 +85,9 @@ TEST_CASE("fuzz: a damaged campaign store is refused or read, never crashes", "[
 }
 
 TEST_CASE("fuzz: a damaged shear result is refused or read whole, never taken for another result", "[fuzz][input]") {
-    // a sealed result as demcal shear-run and shear_box.py write it (schema demcal.shear_result/2)
+    // a sealed result as demcal shear-run and shear_box.py write it (schema demcal.shear_result/3)
     nlohmann::json result = {{"schema", orchestrator::kShearResultSchema},
+                             {"params", {{"normal_stress", 5e3}, {"seed", 3}}},
                              {"curve", {{"displacement", {0.0, 1e-4, 2e-4}}, {"shear_stress", {0.0, 2100.5, 3300.25}}}},
                              {"peak_shear_stress", 3300.25},
                              {"residual_shear_stress", 2950.0},
