@@ -41,6 +41,14 @@ inline std::string shortened_text(std::string_view text, std::size_t max_chars =
     return shown + "... (" + std::to_string(text.size()) + " characters)";
 }
 
+// A control character (a newline, a tab, an escape) in a path: no batch script line, plot command or log line can
+// carry it, so an output path holding one is refused (analytics::shortened_text shows it escaped).
+inline bool has_control_character(std::string_view text) {
+    for (char c : text)
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return true;
+    return false;
+}
+
 // Beyond this magnitude no input of demcal is a measurement or a setting, only a typo (1e308 for 1e3).
 inline constexpr double kLargestPlausibleNumber = 1e100;
 

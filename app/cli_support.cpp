@@ -203,6 +203,10 @@ constexpr std::size_t kDerivedNameChars = 40;
 enum class PathKind { file, folder };
 void check_name_lengths(const std::string& path, const std::string& named, PathKind kind) {
     namespace fs = std::filesystem;
+    // (here, where every output path is first looked at: a name demcal cannot pass on is as unusable as a long one)
+    if (analytics::has_control_character(path))
+        throw UserError(named + ": the path holds a control character (a newline, a tab): no batch script, plot or "
+                        "log line can name it; give a path without one");
     const fs::path p(path);
     for (const fs::path& part : p) {
         const bool own_name = kind == PathKind::file && part == p.filename();

@@ -1,5 +1,6 @@
 #include "app/gnuplot.hpp"
 
+#include "analytics/number_text.hpp"
 #include "app/commands.hpp"  // UserError
 
 #include <fcntl.h>
@@ -25,16 +26,10 @@ std::string single_quoted(const std::string& text) {
     return s + "'";
 }
 
-bool has_control_character(const std::string& text) {
-    for (char c : text)
-        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return true;
-    return false;
-}
-
 }  // namespace
 
 std::string gnuplot_quote(const std::filesystem::path& p) {
-    if (has_control_character(p.string()))
+    if (analytics::has_control_character(p.string()))
         throw UserError("the plot path '" + p.string().substr(0, 200) +
                         "' holds a control character (a newline, a tab): gnuplot cannot be given it");
     return single_quoted(p.string());

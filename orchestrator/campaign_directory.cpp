@@ -13,6 +13,11 @@ namespace demcal::orchestrator {
 namespace fs = std::filesystem;
 
 void check_campaign_folder(const fs::path& dir, const std::string& marker) {
+    if (analytics::has_control_character(dir.string()))
+        throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +
+                                    "': the path holds a control character (a newline, a tab): no batch script, plot "
+                                    "or log line can name it; give a path without one (a campaign resumes where it "
+                                    "is moved)");
     std::error_code ec;
     if (!fs::is_directory(dir, ec) || fs::exists(dir / marker, ec)) return;
     std::vector<std::string> folders;

@@ -18,7 +18,8 @@ namespace demcal::orchestrator {
 // by mistake, "/") would get a store, runs/ and reports among its files, the same names overwritten:
 // std::invalid_argument naming the folder and a few of its folders, before anything is written. Files alone are
 // taken: a console log or a batch system's output file (sbatch -o DIR/...) exists before demcal starts. A folder
-// that does not exist, or is not a folder, is left to the caller.
+// that does not exist, or is not a folder, is left to the caller. A path holding a control character (a newline) is
+// refused whatever the folder holds: SLURM's task list, the plots and the logs name runs by it.
 void check_campaign_folder(const std::filesystem::path& dir, const std::string& marker);
 
 // The result a run left in its folder if it finished (written atomically as its last act), else nothing.

@@ -959,3 +959,25 @@ TEST_CASE("probe 49: levels that round to one value are refused before any run",
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 50: an output path holding a control character is refused before any work", "[cli]") {
+    // `-c $'ca\nmp'` ran its campaign and then could not plot it (a warning, exit 0); under SLURM the task list,
+    // one script path per line, would have split the path in two
+    const fs::path root = test::fresh_test_dir("hostile-probe50-control"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string newline = (dir / "ca\nmp").string(), tab = (dir / "out\tx.json").string();
+    refused({{{"shear", tiny, "-s", "5000,8000,11000", "--engine", "kernel", "-r", "1", "-c", newline},
+              {"ca\\nmp': the path holds a control character"}},
+             {{"sensitivity", tiny, "--engine", "kernel", "-r", "1", "-c", newline},
+              {"ca\\nmp': the path holds a control character"}},
+             {{"vibration", "--theta", "30", "--frequency", "10", "--amplitude", "1e-4", "--campaign", newline,
+               "--repeats", "1", "--", "--particles", "100", "--max-time", "0.01", "--fill-time", "0.01"},
+              {"--campaign = '", "ca\\nmp': the path holds a control character"}},
+             {{"silo", "--particles", "20", "--theta", "30", "--out", newline},
+              {"--out = '", "the path holds a control character"}},
+             {{"predict", test::source_path("examples/silo/seed_conical_30deg.json").string(), "--json", tab},
+              {"--json = '", "out\\tx.json': the path holds a control character"}}},
+            dir);
+    fs::remove_all(root);
+}
