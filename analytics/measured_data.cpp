@@ -122,6 +122,21 @@ void strip_byte_order_mark(std::string& first_line, const std::string& source) {
 }
 }  // namespace
 
+namespace {
+/// A header read as one column that holds ';' or a tab: a spreadsheet set to decimal commas saves "CSV" so, and every
+/// row would be refused for its field count without saying why.
+void check_separator(const std::vector<std::string>& header, const std::string& source, int line_no) {
+    if (header.size() != 1) return;
+    for (const char separator : {';', '\t'})
+        if (header.front().find(separator) != std::string::npos)
+            throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": the header " +
+                                        quote(header.front()) + " is one column: fields are separated by "
+                                        "commas here, this file separates them by " +
+                                        (separator == ';' ? "';'" : "tabs") +
+                                        " (save it as CSV with ',' between fields and '.' in numbers)");
+}
+}  // namespace
+
 MeasuredData parse_csv(std::istream& in, const std::string& source) {
     MeasuredData data;
     data.source = source;
@@ -135,6 +150,7 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
         if (t.empty() || t[0] == '#') continue;  // blank lines and comments hold no data
         auto fields = split_csv_line(line, source, line_no);
         if (!have_header) {
+            check_separator(fields, source, line_no);
             for (auto& name : fields) {
                 if (name.empty())
                     throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": empty column name");
@@ -150,7 +166,11 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
         if (fields.size() != data.columns.size())
             throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": " +
                                         std::to_string(fields.size()) + " fields, the header has " +
-                                        std::to_string(data.columns.size()));
+                                        std::to_string(data.columns.size()) +
+                                        (fields.size() > data.columns.size()
+                                             ? " (a decimal comma, 0,105, or an unquoted comma in a text splits a "
+                                               "field: numbers are written 0.105)"
+                                             : ""));
         data.lines.push_back(line_no);
         for (std::size_t c = 0; c < fields.size(); ++c) data.columns[c].text.push_back(fields[c]);
     }

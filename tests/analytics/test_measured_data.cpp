@@ -51,6 +51,17 @@ TEST_CASE("a spreadsheet's UTF-8 byte-order mark and CRLF line ends are read, UT
     CHECK_THROWS_WITH(load(std::string("\xFF\xFEg\0e\0o\0", 8) + "\n"), Catch::Contains("UTF-16"));
 }
 
+TEST_CASE("a file separated by semicolons or tabs is named as such, not by its rows' field counts", "[measured]") {
+    // a spreadsheet set to decimal commas saves "CSV" as geometry;D_m;...: every row then had "7 fields, the header
+    // has 1"
+    CHECK_THROWS_WITH(load("geometry;D_m;outlet_m\nconical;0,105;0,035\n"),
+                      Catch::Contains("line 1: the header 'geometry;D_m;outlet_m' is one column") &&
+                          Catch::Contains("this file separates them by ';'"));
+    CHECK_THROWS_WITH(load("geometry\tD_m\toutlet_m\nconical\t0.105\t0.035\n"),
+                      Catch::Contains("the header 'geometry\\tD_m\\toutlet_m' is one column") &&
+                          Catch::Contains("separates them by tabs"));
+}
+
 TEST_CASE("bad discharge files name the line and the column", "[measured]") {
     const std::string good = "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n";
     auto fails_with = [&](const std::string& body, const std::string& expected) {
@@ -68,6 +79,8 @@ TEST_CASE("bad discharge files name the line and the column", "[measured]") {
     fails_with("conical,0.105,,,0.035,30,0.0055,780,0.171,anna,1 2\n", "line 3, column moisture_pct: '1 2'");
     fails_with("hexagonal,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column geometry: 'hexagonal'");
     fails_with("conical,0.105,,,0.035,30,0.0055,780\n", "line 3: 8 fields, the header has 11");
+    fails_with("conical,0,105,,,0.035,30,0.0055,780,0.171,anna,12.5\n",
+               "line 3: 12 fields, the header has 11 (a decimal comma, 0,105,");
     CHECK_THROWS_WITH(load("geometry,outlet_m,theta_deg,d_p_m,W_kg_s\nconical,0.035,30,0.0055,0.17\n"),
                       Catch::Contains("missing column rho_b_kg_m3"));
     CHECK_THROWS_WITH(load("sigma_Pa,tau_Pa\n1000,800\n2000,-5\n", MeasuredKind::shear),
