@@ -238,7 +238,10 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
     if (spec.base_seed < 0) throw std::invalid_argument("seed = " + std::to_string(spec.base_seed) + " must be >= 0");
     // every run's own fields in their ranges (each stress, the last replicate's seed), before anything is written
     const nlohmann::json material = validate_material(spec.material);
-    for (double s : spec.normal_stresses) make_run_params(material, s, spec.base_seed + spec.replicates - 1);
+    // (named by the option that gave the stress: every campaign command takes its stresses from --normal-stress)
+    for (double s : spec.normal_stresses)
+        make_run_params(material, s, spec.base_seed + spec.replicates - 1,
+                        "the run at --normal-stress " + analytics::number_text(s));
     const ShearCampaignSpec s = resolved(spec);
     if (s.engine == ShearEngine::yade && !fs::is_regular_file(s.template_path))
         throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");

@@ -981,3 +981,19 @@ TEST_CASE("probe 50: an output path holding a control character is refused befor
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 50: a campaign's run refused for its normal stress names the option that gave it", "[cli]") {
+    // "run: normal_stress = 1 Pa is below ..." named a field of params.json the user never wrote
+    const fs::path root = test::fresh_test_dir("hostile-probe50-stress"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "camp").string();
+    refused({{{"shear", tiny, "--engine", "kernel", "-s", "5e3,1", "-c", camp},
+              {"the run at --normal-stress 1: normal_stress = 1 Pa is below the weight of the box's grains"}},
+             {{"crosscheck", "shear", tiny, "-s", "5e3,8e3,3.5", "-c", camp},
+              {"the run at --normal-stress 3.5: normal_stress = 3.5 Pa is below"}},
+             {{"shear", tiny, "--engine", "kernel", "-s", "5e3,9e18", "-c", camp},
+              {"the run at --normal-stress 9e+18: field 'normal_stress'", "is outside"}}},
+            dir);
+    fs::remove_all(root);
+}
