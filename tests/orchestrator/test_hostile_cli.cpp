@@ -258,7 +258,7 @@ TEST_CASE("levels and replicates have their own caps, named, below the total --m
              {{"crosscheck", "shear", tiny, "-s", "5e3,5e3", "-r", "3", "--campaign", camp},
               {"normal-stress: a failure line needs at least 2 distinct normal stresses, got 1"}},
              {{"crosscheck", "shear", tiny, "-s", "5e3,1e4", "-r", "1", "--campaign", camp},
-              {"replicates = 1 at 2 normal stresses: a failure line needs at least 3 points"}},
+              {"replicates = 1 at 2 distinct normal-stress values: a failure line needs at least 3 points"}},
              // 2e9 evaluations overflowed scale's int count of failure lines, which then passed --max-runs
              {{"scale", tiny, "--radii", "1e-3,1.5e-3,2e-3", "-s", "5e3,1e4,2e4", "--max-evaluations", "2000000000",
                "--dir", camp},
@@ -426,7 +426,7 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
               {"at least 2 distinct normal stresses, got 1"}},
              {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4",
                "--engine", "kernel", "--campaign", camp},
-              {"replicates = 1 at 2 normal stresses", "at least 3 points"}}},
+              {"replicates = 1 at 2 distinct normal-stress values", "at least 3 points"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);
