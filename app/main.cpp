@@ -1,3 +1,4 @@
+#include "analytics/number_text.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 
@@ -9,10 +10,22 @@
 
 namespace {
 
+// Every message names values a user typed; one holding a newline or an escape sequence ('new\nline' as a path) split
+// the message over lines and could move the terminal's cursor. The whole message is escaped here, once, as
+// analytics::shortened_text escapes a value (and bounded: a message is one line a person reads).
+constexpr std::size_t kMaxMessageChars = 4000;
+std::string one_line(std::string_view message) { return demcal::analytics::shortened_text(message, kMaxMessageChars); }
+
 int run_command(int argc, char** argv) {
     CLI::App app{"demcal: DEM calibration, YADE campaigns, discharge models and a native DEM kernel"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "demcal 0.1");
+    app.failure_message([](const CLI::App* a, const CLI::Error& e) {  // CLI11's own text, its message on one line
+        std::string text = CLI::FailureMessage::simple(a, e);
+        const std::string what = e.what();
+        if (text.compare(0, what.size(), what) == 0) text = one_line(what) + text.substr(what.size());
+        return text;
+    });
     demcal::add_shear_commands(app);
     demcal::add_shear_run_command(app);
     demcal::add_crosscheck_command(app);
@@ -34,19 +47,19 @@ int run_command(int argc, char** argv) {
         // --help and --version exit 0; a malformed command line is bad input like any other: exit 2
         return app.exit(e) == 0 ? 0 : 2;
     } catch (const demcal::UserError& e) {
-        std::cerr << "demcal: error: " << e.what() << "\n";
+        std::cerr << "demcal: error: " << one_line(e.what()) << "\n";
         return 2;
     } catch (const std::filesystem::filesystem_error& e) {
         // a path the user gave that the file system will not take (a file where a folder belongs, a link loop, a
         // read-only folder): the path and the reason, not the library's text
-        std::cerr << "demcal: error: '" << e.path1().string() << "': " << e.code().message()
+        std::cerr << "demcal: error: '" << one_line(e.path1().string()) << "': " << e.code().message()
                   << " (a file where a folder belongs, a link loop or a read-only folder in the path?)\n";
         return 2;
     } catch (const std::invalid_argument& e) {  // the libraries' word for bad input
-        std::cerr << "demcal: error: " << e.what() << "\n";
+        std::cerr << "demcal: error: " << one_line(e.what()) << "\n";
         return 2;
     } catch (const std::exception& e) {
-        std::cerr << "demcal: failed: " << e.what() << "\n";
+        std::cerr << "demcal: failed: " << one_line(e.what()) << "\n";
         return 1;
     }
     return 0;

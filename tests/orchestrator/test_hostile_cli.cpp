@@ -997,3 +997,28 @@ TEST_CASE("probe 50: a campaign's run refused for its normal stress names the op
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 50: a value holding a newline or an escape leaves the message on one line, the value escaped",
+          "[cli]") {
+    // "demcal: error: template = 'new" and "line' ..." on two lines; an ESC could move the terminal's cursor
+    const fs::path root = test::fresh_test_dir("hostile-probe50-oneline"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string value = "new\nline\x1b[2J";
+    const std::vector<std::vector<std::string>> commands{
+        {"shear", tiny, "-s", "5e3,8e3,11e3", "--template", value, "-c", (dir / "c").string()},  // demcal's own
+        {"shear", tiny, "-s", "5e3,8e3,11e3", "--engine", value, "-c", (dir / "c").string()},    // CLI11's
+        {"calibrate", "--target", value, "--start", tiny},                  // a list item
+        {"diagnose", "--model", value, "--data", "x.csv"}};
+    for (const auto& args : commands) {
+        INFO(args[0] + " " + args[2]);
+        CHECK(test::run_demcal(args, root / "oneline.log") == 2);
+        const std::string log = test::read_file(root / "oneline.log");
+        INFO(log);
+        CHECK_THAT(log, Contains("new\\nline\\x1b[2J"));
+        CHECK(log.find('\x1b') == std::string::npos);
+        const auto first_line = log.substr(0, log.find('\n'));
+        CHECK_THAT(first_line, Contains("line\\x1b"));  // the whole value on the message's own line
+    }
+    fs::remove_all(root);
+}
