@@ -16,9 +16,16 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& w
     // O_CLOEXEC: children must not inherit the lock, or a resume right after kill -9 of the holder finds the folder
     // "in use" until the last orphan has died
     fd_ = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0)
+    if (fd_ < 0) {
+        const int why = errno;
+        // a folder the user may not write (a campaign copied read-only from a cluster): bad input, named as such
+        if (why == EACCES || why == EROFS || why == EPERM)
+            throw std::invalid_argument(what + " " + folder.string() + " is not writable (" + std::strerror(why) +
+                                        "): running or resuming a campaign writes into its folder (demcal status "
+                                        "reads one as it is)");
         throw std::runtime_error(what + " " + folder.string() + ": cannot open its lock " + file_.string() + " (" +
-                                 std::strerror(errno) + ")");
+                                 std::strerror(why) + ")");
+    }
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
         ::close(fd_);
         fd_ = -1;

@@ -10,7 +10,8 @@ namespace demcal::orchestrator {
 class FolderLock {
 public:
     // Takes the lock of an existing `folder`; throws std::runtime_error naming `what` and the folder when another
-    // process holds it, or when the lock file cannot be made (the reason given).
+    // process holds it, or when the lock file cannot be made (the reason given); std::invalid_argument (bad input)
+    // when the folder is not the user's to write (permission denied, a read-only file system).
     FolderLock(const std::filesystem::path& folder, const std::string& what);
     ~FolderLock();
     FolderLock(const FolderLock&) = delete;

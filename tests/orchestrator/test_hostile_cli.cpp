@@ -1022,3 +1022,33 @@ TEST_CASE("probe 50: a value holding a newline or an escape leaves the message o
     }
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 50: resuming a campaign in a folder the user may not write is refused as bad input, status reads it",
+          "[cli]") {
+    // a campaign copied read-only from a cluster: "failed: cannot open its lock (Permission denied)", exit 1
+    const fs::path root = test::fresh_test_dir("hostile-probe50-readonly"), camp = root / "camp";
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "5e3,8e3,11e3", "--engine", "kernel", "-c", camp.string()},
+                             root / "first.log") == 0);
+    fs::remove(camp / ".lock");
+    // as root, permissions do not hold: the commands then run as nobody, for whom the folder is read-only
+    const bool root_user = ::geteuid() == 0;
+    const std::string as_user = root_user ? "runuser -u nobody -- " : "";
+    if (!root_user) fs::permissions(camp, fs::perms::owner_write, fs::perm_options::remove);
+    auto run = [&](const std::string& command, const fs::path& log) {
+        const std::string cmd = as_user + "'" + DEMCAL_BINARY + "' " + command + " '" + camp.string() + "' > '" +
+                                log.string() + "' 2>&1";
+        const int status = std::system(cmd.c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    };
+    const auto before = listing(root);
+    CHECK(run("resume", root / "resume.log") == 2);
+    CHECK_THAT(test::read_file(root / "resume.log"), Contains("camp is not writable (Permission denied)"));
+    CHECK(run("status", root / "status.log") == 0);
+    CHECK_THAT(test::read_file(root / "status.log"), Contains("3 done"));
+    fs::permissions(camp, fs::perms::owner_write, fs::perm_options::add);
+    fs::remove(root / "resume.log");
+    fs::remove(root / "status.log");
+    CHECK(listing(root) == before);
+    fs::remove_all(root);
+}
