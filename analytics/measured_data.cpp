@@ -150,6 +150,10 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
         if (t.empty() || t[0] == '#') continue;  // blank lines and comments hold no data
         auto fields = split_csv_line(line, source, line_no);
         if (!have_header) {
+            if (t[0] == '{' || t[0] == '[')
+                throw std::invalid_argument(source + ": line " + std::to_string(line_no) + " starts with '" +
+                                            std::string(1, t[0]) + "': a JSON file, not a table (CSV: a header line "
+                                            "of column names, then one line per measurement)");
             check_separator(fields, source, line_no);
             for (auto& name : fields) {
                 if (name.empty())
@@ -167,7 +171,7 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
             throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": " +
                                         std::to_string(fields.size()) + " fields, the header has " +
                                         std::to_string(data.columns.size()) +
-                                        (fields.size() > data.columns.size()
+                                        (fields.size() > data.columns.size() && data.columns.size() > 1
                                              ? " (a decimal comma, 0,105, or an unquoted comma in a text splits a "
                                                "field: numbers are written 0.105)"
                                              : ""));

@@ -86,6 +86,9 @@ ks::PairCoefficients pair(const json& root, const std::string& file, const std::
 
 ks::WheatMaterials read_silo_material(const std::string& file, const std::string& what) {
     const json root = read_json_file(file, what);
+    if (root.is_object() && !root.contains("grain") && (root.contains("young_modulus") || root.contains("density")))
+        throw UserError(file + ": a shear box's material (density, young_modulus, ...: demcal shear, sensitivity, "
+                        "calibrate), not a silo material (grain, wall, grain_grain, grain_wall)");
     object_with(root, file, "", {"name", "description", "grain", "wall", "grain_grain", "grain_wall"});
     ks::WheatMaterials m;
     m.wheat = solid(root, file, "grain", true);

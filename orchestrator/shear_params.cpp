@@ -294,6 +294,10 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
             continue;
         }
         const ParamSpec* s = find_shear_param(key);
+        if (!s && (material.contains("grain") || material.contains("grain_grain")))  // the other kind of material
+            throw std::invalid_argument(where + ": a silo material (grain, wall, grain_grain, grain_wall: demcal silo "
+                                        "--material), not a shear box's (density, young_modulus, poisson_ratio, "
+                                        "friction_coefficient, ...)");
         if (!s) throw std::invalid_argument(where + ": unknown field '" + analytics::shortened_text(key) + "' = " + format_value(value));
         if (s->per_run)
             throw std::invalid_argument(where + ": field '" + key + "' = " + format_value(value) +

@@ -60,6 +60,9 @@ TEST_CASE("a file separated by semicolons or tabs is named as such, not by its r
     CHECK_THROWS_WITH(load("geometry\tD_m\toutlet_m\nconical\t0.105\t0.035\n"),
                       Catch::Contains("the header 'geometry\\tD_m\\toutlet_m' is one column") &&
                           Catch::Contains("separates them by tabs"));
+    // a material or geometry given where the table belongs
+    CHECK_THROWS_WITH(load("{\n  \"density\": 2650,\n  \"young_modulus\": 1e8\n}\n"),
+                      Catch::Contains("line 1 starts with '{': a JSON file, not a table"));
 }
 
 TEST_CASE("bad discharge files name the line and the column", "[measured]") {

@@ -1052,3 +1052,18 @@ TEST_CASE("probe 50: resuming a campaign in a folder the user may not write is r
     CHECK(listing(root) == before);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 50: a material of the other kind, or a JSON file given as a table, is named for what it is", "[cli]") {
+    // "unknown field 'grain'", "unknown key 'bond_normal_strength'", "line 2: 2 fields, the header has 1"
+    const fs::path root = test::fresh_test_dir("hostile-probe50-kind"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string wheat = test::source_path("examples/materials/silo_wheat_table21.json").string();
+    refused({{{"shear", wheat, "-s", "5e3,8e3,11e3", "--engine", "kernel", "-c", (dir / "c").string()},
+              {"silo_wheat_table21.json: a silo material", "not a shear box's"}},
+             {{"silo", "--material", tiny, "--theta", "30", "--particles", "100", "--out", (dir / "o").string()},
+              {"sand-tiny.json: a shear box's material", "not a silo material"}},
+             {{"diagnose", "--model", "beverloo", "--data", tiny}, {"starts with '{': a JSON file, not a table"}}},
+            dir);
+    fs::remove_all(root);
+}
