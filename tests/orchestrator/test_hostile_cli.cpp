@@ -229,7 +229,7 @@ TEST_CASE("crosscheck silo: repeated angles, too many angles and settings the ke
               {"theta = 30: the kernel run refuses its settings", "--max-time 1e+99 s", "the run would not end"}},
              // a shear material given as the silo's
              {{"crosscheck", "silo", "--theta", "30", "--material", shear_material, "--campaign", camp},
-              {"unknown key 'bond_normal_strength'"}}},
+              {"sand-tiny.json: a shear box's material", "not a silo material"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);
