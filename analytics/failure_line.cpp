@@ -34,8 +34,8 @@ void check_failure_line_design(std::span<const double> normal_stresses, int repl
     if (static_cast<double>(distinct.size()) * replicates < 3)
         throw std::invalid_argument("replicates = " + std::to_string(replicates) + " at " +
                                     std::to_string(distinct.size()) +
-                                    " distinct normal-stress values: a failure line needs at least 3 points (a line through 2 "
-                                    "leaves nothing to estimate its uncertainty)");
+                                    " distinct normal-stress values: a failure line needs at least 3 points (a line "
+                                    "through 2 leaves nothing to estimate its uncertainty)");
 }
 
 FailureLine fit_failure_line(std::span<const double> sigma, std::span<const double> tau, double confidence) {

@@ -21,8 +21,9 @@ std::string run_identity(const std::string& template_text, const nlohmann::json&
 // normal stress and another seed, is then not taken for this run's.
 std::string params_digest(const nlohmann::json& params);
 
-// result.json of a shear run (schema demcal.shear_result/3; /2 had the same seal) is sealed with the SHA-256 of its own text, so that a
-// file damaged after its atomic write (a flipped byte, a truncated copy) is found when the orchestrator reads it. The
+// result.json of a shear run (schema demcal.shear_result/3; /2 had the same seal) is sealed with the SHA-256 of its
+// own text, so that a file damaged after its atomic write (a flipped byte, a truncated copy) is found when the
+// orchestrator reads it. The
 // rule, the same for every writer (yade_scripts/shear_box.py's write_result_atomically, demcal shear-run): BODY is the
 // result's JSON object as the writer serialises it, with its final newline; the file is
 //     {"sha256": "<64 lowercase hex digits of SHA-256(BODY)>", <BODY without its opening brace>

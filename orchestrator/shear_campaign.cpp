@@ -263,17 +263,18 @@ nlohmann::json read_shear_result(const fs::path& file, const nlohmann::json* run
 }
 
 namespace {
-// ", seed = 2 where this run has 1": the first field in which a result's recorded params differ from the run's
+// ": seed = 2 where this run has 1": the first field in which a result's recorded params differ from the run's
 std::string differing_param(const nlohmann::json& recorded, const nlohmann::json& own) {
     for (const auto& [key, value] : own.items()) {
-        if (!recorded.contains(key))
-            return ": " + key + " is missing";
+        if (!recorded.contains(key)) return ": " + analytics::shortened_text(key) + " is missing";
         if (params_digest(recorded[key]) != params_digest(value))
-            return ": " + key + " = " + analytics::json_value_text(recorded[key]) + " where this run has " +
-                   analytics::json_value_text(value);
+            return ": " + analytics::shortened_text(key) + " = " + analytics::json_value_text(recorded[key]) +
+                   " where this run has " + analytics::json_value_text(value);
     }
     for (const auto& [key, value] : recorded.items())
-        if (!own.contains(key)) return ": " + key + " = " + analytics::json_value_text(value) + " is not this run's";
+        if (!own.contains(key))
+            return ": " + analytics::shortened_text(key) + " = " + analytics::json_value_text(value) +
+                   " is not this run's";
     return "";
 }
 }  // namespace

@@ -11,8 +11,8 @@ Sequence (the thesis' modified Jenike cell, seed section 2.2.1):
      shear_displacement while the lid keeps the normal stress; shear stress vs displacement is sampled.
 
 Output: result.json (schema demcal.shear_result/3, sealed with its SHA-256, with the params.json object it ran), written
-atomically. Failures: exit 3 and one line
-`DEMCAL_FAILURE <cause>: <details>` on stderr; bad params: exit 2 with `DEMCAL_FAILURE params: ...`.
+atomically. Failures: exit 3 and one line `DEMCAL_FAILURE <cause>: <details>` on stderr; bad params: exit 2 with
+`DEMCAL_FAILURE params: ...`.
 Every parameter is documented in PARAM_SPECS below and in yade_scripts/README.md.
 """
 import hashlib
