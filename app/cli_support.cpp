@@ -5,6 +5,7 @@
 #include "app/commands.hpp"
 #include "orchestrator/slurm_executor.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -17,6 +18,7 @@
 #include <limits>
 #include <map>
 #include <string_view>
+#include <thread>
 
 #include <climits>
 #include <unistd.h>
@@ -134,6 +136,31 @@ constexpr OptionNeeds kOptionNeeds[] = {
     {"grid-points", "method", "grid", "surrogate", "the grid's points per parameter"},
 };
 
+// A local pool of --jobs runs takes that many cores and the memory of as many simulations (YADE: about 250 MB each):
+// `-j 1000` on a laptop is a typo that takes the machine down, not a plan. Four per core leaves room to oversubscribe
+// on purpose; a batch system takes any number (--executor slurm).
+constexpr unsigned kMaxLocalJobsPerCore = 4;
+
+void check_local_jobs(const CLI::App& cmd) {
+    const CLI::Option* jobs = option_named(cmd, "jobs");
+    if (!jobs || jobs->count() == 0) return;
+    const CLI::Option* executor = option_named(cmd, "executor");
+    if (executor && value_or_default(*executor, "local") != "local") return;
+    double asked = 0;
+    try {
+        asked = jobs->as<double>();  // (an integer already: the option's own check ran during the parse)
+    } catch (const CLI::Error&) {
+        return;
+    }
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    if (asked <= double(kMaxLocalJobsPerCore) * cores) return;
+    throw UserError("--jobs = " + analytics::shortened_text(jobs->as<std::string>()) + ": the local pool would run " +
+                    "that many simulations at once on this machine's " + std::to_string(cores) + " cores; at most " +
+                    std::to_string(kMaxLocalJobsPerCore) + " per core (" +
+                    std::to_string(kMaxLocalJobsPerCore * cores) + "), 0 for one per core" +
+                    (executor ? "; --executor slurm spreads more over a cluster" : ""));
+}
+
 void check_options_apply(const CLI::App& cmd) {
     for (const OptionNeeds& rule : kOptionNeeds) {
         const CLI::Option* opt = option_named(cmd, rule.option);
@@ -145,6 +172,7 @@ void check_options_apply(const CLI::App& cmd) {
                         "' is " + rule.what + ": it applies to --" + rule.other + " " + rule.value + " only (this " +
                         "command runs with --" + rule.other + " " + value + ")");
     }
+    check_local_jobs(cmd);
     for (const CLI::App* sub : cmd.get_subcommands()) check_options_apply(*sub);
 }
 }  // namespace

@@ -22,6 +22,7 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -1065,5 +1066,25 @@ TEST_CASE("probe 50: a material of the other kind, or a JSON file given as a tab
               {"sand-tiny.json: a shear box's material", "not a silo material"}},
              {{"diagnose", "--model", "beverloo", "--data", tiny}, {"starts with '{': a JSON file, not a table"}}},
             dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("probe 50: a local pool far beyond the machine's cores is refused, any count on SLURM is taken", "[cli]") {
+    // `-j 1000` started as many simulations at once (YADE about 250 MB each) on a 2-core machine
+    const fs::path root = test::fresh_test_dir("hostile-probe50-jobs"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string too_many = std::to_string(4 * std::max(1u, std::thread::hardware_concurrency()) + 1);
+    refused({{{"shear", tiny, "-s", "5e3,8e3,11e3", "--engine", "kernel", "-j", too_many, "-c", (dir / "c").string()},
+              {"--jobs = " + too_many + ": the local pool would run", "at most 4 per core", "--executor slurm"}},
+             {{"vibration", "--theta", "30", "--frequency", "10", "--amplitude", "1e-4", "--jobs", too_many,
+               "--campaign", (dir / "v").string(), "--", "--particles", "100"},
+              {"--jobs = " + too_many + ": the local pool"}}},
+            dir);
+    // on SLURM the count is the array's, whatever this machine has: the command goes on to its next check
+    CHECK(test::run_demcal({"shear", tiny, "-s", "5e3,8e3,11e3", "--engine", "kernel", "-j", too_many, "--executor",
+                            "slurm", "--max-runs", "1", "-c", (dir / "c").string()},
+                           root / "slurm.log") == 2);
+    CHECK_THAT(test::read_file(root / "slurm.log"), !Contains("local pool") && Contains("max-runs"));
     fs::remove_all(root);
 }
