@@ -124,7 +124,8 @@ class ShearBoxRun {
 
   void set_up_materials() {
     // particles cohesive-frictional; side walls smooth, floor and lid rough (the script's reasons)
-    const Material m{.young = p_.young_modulus, .poisson = p_.poisson_ratio, .density = p_.density};
+    const Material m{.young = p_.young_modulus, .poisson = p_.poisson_ratio, .density = p_.density,
+                      .name = "shear box: particles and walls"};
     particle_mat_ = sim_.add_material(m);
     smooth_mat_ = sim_.add_material(m);
     rough_mat_ = sim_.add_material(m);
