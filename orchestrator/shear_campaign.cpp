@@ -308,7 +308,7 @@ void check_shear_result_values(const nlohmann::json& result, const std::string& 
     // the run's own result, not another run's copied into its folder: by the parameters it records (schema /3, both
     // engines), by their digest (a /2 result of the kernel engine), else by its normal stress (YADE's /2 template
     // recorded no more of its run)
-    if (result.value("schema", std::string()) == kShearResultSchema) {
+    if (result.contains("schema") && result["schema"] == kShearResultSchema) {  // (any type: a stored row may hold any)
         if (!result.contains("params") || !result["params"].is_object())
             throw std::invalid_argument(what + ": params = " +
                                         (result.contains("params") ? analytics::json_value_text(result["params"])
