@@ -70,8 +70,10 @@ LeastSquaresFit fit_least_squares(std::size_t n, const ResidualFunction& residua
     int info = 0;
     const int status = gsl_multifit_nlinear_driver(max_iterations, 1e-10, 1e-10, 1e-14, nullptr, nullptr, &info,
                                                    work.get());
-    // No progress means no step lowers the sum of squares any more: a minimum (e.g. started at the optimum).
-    fit.converged = status == GSL_SUCCESS || status == GSL_ENOPROG;
+    // No progress means no step lowers the sum of squares any more: a minimum. Started at the optimum (data that
+    // follow the law exactly, where the log-log line's start is already the fit), GSL's driver finds no step on its
+    // first iteration and reports that as GSL_EMAXITER with info = GSL_ENOPROG: the same minimum, not a failure.
+    fit.converged = status == GSL_SUCCESS || status == GSL_ENOPROG || (status == GSL_EMAXITER && info == GSL_ENOPROG);
     const gsl_vector* xs = gsl_multifit_nlinear_position(work.get());
     const gsl_vector* f = gsl_multifit_nlinear_residual(work.get());
     for (std::size_t i = 0; i < p; ++i) fit.params[i] = gsl_vector_get(xs, i);

@@ -8,6 +8,7 @@
 #include "app/commands.hpp"
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
+#include "app/result_files.hpp"
 #include "app/scaling_plots.hpp"
 #include "calibration/calibration_loop.hpp"
 #include "calibration/campaign_evaluator.hpp"
@@ -95,7 +96,7 @@ void print_level(const std::string& param, const SensitivityLevel& l) {
 void plot_parameter(const fs::path& dir, const ParameterSensitivity& p, const std::string& format) {
     const fs::path data = dir / ("sensitivity_" + p.name + ".dat"), fit = dir / ("sensitivity_" + p.name + "_fit.dat");
     {
-        std::ofstream d(data), f(fit);
+        std::ostringstream d, f;
         d << "# value mu_b se_mu_b tau_c se_tau_c\n";
         for (const auto& l : p.levels) d << l.value << " " << l.mu_b << " " << l.se_mu_b << " " << l.tau_c << " " << l.se_tau_c << "\n";
         f << "# value mu_b_fit tau_c_fit\n";
@@ -103,6 +104,8 @@ void plot_parameter(const fs::path& dir, const ParameterSensitivity& p, const st
             const double x = p.low() + (p.high() - p.low()) * i / 60;
             f << x << " " << p.mu_b.value(x) << " " << p.tau_c.value(x) << "\n";
         }
+        write_result_file(data, d.str());
+        write_result_file(fit, f.str());
     }
     // 5 % of the range on each side, so that the end levels' error bars do not sit on the frame
     const double pad = 0.05 * (p.high() - p.low());
@@ -121,8 +124,8 @@ void plot_parameter(const fs::path& dir, const ParameterSensitivity& p, const st
 }
 
 void write_study(const fs::path& dir, const SensitivityStudy& study, const std::string& format) {
-    orchestrator::write_text_file_atomically(dir / "sensitivity.json", study.to_json().dump(2) + "\n");
-    orchestrator::write_text_file_atomically(dir / "sensitivity_table.txt", study.table());
+    write_result_file(dir / "sensitivity.json", study.to_json().dump(2) + "\n");
+    write_result_file(dir / "sensitivity_table.txt", study.table());
     for (const auto& p : study.parameters) {
         try {
             plot_parameter(dir, p, format);
@@ -354,14 +357,14 @@ void add_calibrate(CLI::App& app) {
                                   {"simulations_run", study.simulations_run},
                                   {"simulations_reused", study.simulations_reused},
                                   {"cpu_s", study.cpu_s}};
-        orchestrator::write_text_file_atomically(dir / ("calibration_" + o->method + ".json"), summary.dump(2) + "\n");
+        write_result_file(dir / ("calibration_" + o->method + ".json"), summary.dump(2) + "\n");
         // a baseline run over the same campaign must not overwrite the loop's material
         const std::string default_name =
             o->method == "surrogate" ? "calibrated_material.json" : "calibrated_material_" + o->method + ".json";
         const fs::path out = o->output.empty() ? dir / default_name : fs::path(o->output);
         nlohmann::json material = result.material;
         material["description"] = "calibrated by demcal calibrate (" + to_string(result.status) + "): " + result.message;
-        orchestrator::write_text_file_atomically(out, material.dump(1) + "\n");
+        write_result_file(out, material.dump(1) + "\n");
         const auto& best = result.iterations[result.best];
         std::cout << "\n" << to_string(result.status) << ": " << result.message << "\n"
                   << "final: mu_b = " << best.mu_b << " +/- " << best.mu_b_half_width << ", tau_c = " << best.tau_c
@@ -467,7 +470,7 @@ void add_enlarge(CLI::App& app) {
                             {"points", nlohmann::json::array()}};
         for (std::size_t i = 0; i < r.size(); ++i)
             j["points"].push_back({{"particle_radius", r[i]}, {"young_modulus", e[i]}, {"poisson_ratio", nu[i]}});
-        orchestrator::write_text_file_atomically(o->output, j.dump(2) + "\n");
+        write_result_file(o->output, j.dump(2) + "\n");
         bool plotted = false;
         if (!o->no_plot) try {  // the laws are written: a missing gnuplot costs only the picture
                 plot_enlargement(o->output, r, e, nu, e_law, nu_law, o->plot_format);

@@ -7,6 +7,7 @@
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
 #include "app/shear_report.hpp"
+#include "app/result_files.hpp"
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
@@ -123,7 +124,7 @@ void write_plots(const fs::path& dir, const std::map<ShearEngine, calibration::F
         const auto& f = ev.at(e);
         const std::string name = to_string(e);
         const fs::path points = dir / ("crosscheck_points_" + name + ".dat");
-        std::ofstream p(points);
+        std::ostringstream p;
         double smax = 0;
         for (const auto& r : f.outcome.runs) {
             if (r.state != RunState::done) continue;
@@ -132,15 +133,17 @@ void write_plots(const fs::path& dir, const std::map<ShearEngine, calibration::F
             p << s << " " << r.result["peak_shear_stress"].get<double>() << "\n";
             if (!r.result.contains("curve")) continue;
             const fs::path curve = dir / ("crosscheck_curve_" + name + "_" + r.hash.substr(0, 12) + ".dat");
-            std::ofstream cf(curve);
+            std::ostringstream cf;
             const auto& cv = r.result["curve"];
             for (std::size_t i = 0; i < cv["displacement"].size(); ++i)
                 cf << cv["displacement"][i].get<double>() << " " << cv["shear_stress"][i].get<double>() << "\n";
+            write_result_file(curve, cf.str());
             c << (first_curve ? "" : ", \\\n  ") << gnuplot_quote(curve) << " using ($1*1e3):($2/1e3) with lines dt "
               << (e == ShearEngine::yade ? 1 : 2) << " lc " << (e == ShearEngine::yade ? 1 : 2) << " title '" << name
               << " " << s / 1e3 << " kPa #" << r.label["replicate"].get<int>() << "'";
             first_curve = false;
         }
+        write_result_file(points, p.str());
         if (!f.peak) continue;
         g << (first_line ? "" : ", \\\n  ") << gnuplot_quote(points) << " using ($1/1e3):($2/1e3) with points pt "
           << (e == ShearEngine::yade ? 7 : 6) << " lc " << (e == ShearEngine::yade ? 1 : 2) << " title '" << name
@@ -243,8 +246,8 @@ int run_crosscheck(const CrosscheckOptions& opt) {
     }
     j["peak_comparison"] = peak ? peak->to_json() : nlohmann::json(nullptr);
     j["residual_comparison"] = residual ? residual->to_json() : nlohmann::json(nullptr);
-    write_text_file_atomically(report, j.dump(2) + "\n");
-    write_text_file_atomically(dir / "crosscheck.md", md);
+    write_result_file(report, j.dump(2) + "\n");
+    write_result_file(dir / "crosscheck.md", md);
     try {
         write_plots(runner.dir(), ev, opt.plot_format);
     } catch (const std::exception& e) {

@@ -3,13 +3,14 @@
 // with a cohesive material (kernel/silo/silo_case.hpp); measured cases in examples/cohesive_arch/README.md.
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "app/result_files.hpp"
 #include "app/silo_campaign.hpp"
 #include "app/silo_settings.hpp"
 #include "kernel/cases/cohesive_hopper.hpp"
 #include "analytics/number_text.hpp"
 #include "kernel/silo/input_error.hpp"  // setting_text
 #include "kernel/silo/silo_case.hpp"
-#include "orchestrator/run_identity.hpp"  // write_text_file_atomically
+#include "orchestrator/run_identity.hpp"  // sha256_hex
 #include "orchestrator/shear_campaign.hpp"  // check_run_count
 
 #include <nlohmann/json.hpp>
@@ -156,7 +157,7 @@ int conclude(const kc::CutoffResult& res, nlohmann::json out, const std::string&
         std::printf("no cut-off found: %s\n", res.reason);
     }
     if (res.runs.size() > 0) report_seed_brackets(res, out);
-    if (!json_file.empty()) orchestrator::write_text_file_atomically(json_file, out.dump(1) + "\n");
+    if (!json_file.empty()) write_result_file(json_file, out.dump(1) + "\n");
     return res.found ? 0 : 1;
 }
 

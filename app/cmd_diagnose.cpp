@@ -9,6 +9,7 @@
 #include "app/commands.hpp"
 #include "app/diagnose_silo_dem.hpp"
 #include "app/gnuplot.hpp"
+#include "app/result_files.hpp"
 #include "orchestrator/run_identity.hpp"
 
 #include <nlohmann/json.hpp>
@@ -40,16 +41,6 @@ optional model constants (defaults in brackets):
   delta_e_deg, phi_w_deg (effective internal and wall friction angles: with both, Jenike's mass-flow limit decides
   the flow pattern and each model says whether it applies))";
 
-void write_text(const std::string& path, const std::string& text) {
-    // the folders an output path names are created (checked creatable before any work)
-    if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
-        std::filesystem::create_directories(folder);
-    try {
-        orchestrator::write_text_file_atomically(path, text);  // whole or not at all
-    } catch (const std::exception& e) {
-        throw UserError("cannot write " + path + ": " + e.what());
-    }
-}
 
 std::string fixed(double v, int digits) {
     char buf[64];
@@ -83,7 +74,7 @@ void run_predict(const std::string& geometry_path, const std::string& json_out) 
         if (geometry.effective_friction_deg)
             j["jenike_mass_flow_limit_deg"] =
                 analytics::jenike_mass_flow_limit_deg(*geometry.effective_friction_deg, *geometry.wall_friction_deg);
-        write_text(json_out, j.dump(2) + "\n");
+        write_result_file(json_out, j.dump(2) + "\n");
     }
 }
 
@@ -201,7 +192,7 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
         if (std::find(levels.begin(), levels.end(), l) == levels.end()) levels.push_back(l);
     if (levels.empty()) levels.push_back("rows");
     {
-        std::ofstream out(dat);
+        std::ostringstream out;
         out << "# line observed fitted_before fitted_after residual_before residual_after x outlier regime_index\n";
         for (std::size_t i = 0; i < r.observed.size(); ++i) {
             const bool outlier = std::any_of(r.outliers.rows.begin(), r.outliers.rows.end(),
@@ -211,7 +202,7 @@ void plot_residuals(const analytics::DiagnoseResult& r, const analytics::Measure
                 << (x_col ? x_col->values[i] : static_cast<double>(i + 1)) << " " << (outlier ? 1 : 0) << " "
                 << (labels.empty() ? 0 : std::find(levels.begin(), levels.end(), labels[i]) - levels.begin()) << "\n";
         }
-        if (!out) throw UserError("cannot write " + dat.string());
+        write_result_file(dat, out.str());
     }
     const std::string unit = r.residual_scale == "relative" ? "residual [%]" : "residual [Pa]";
     for (int which = 0; which < 2; ++which) {
@@ -396,7 +387,7 @@ int run_diagnose(const DiagnoseArgs& a) {
                   << "\n";
     for (const auto& w : r.warnings) std::cout << "warning: " << w << "\n";
     for (const auto& w : r.undetermined) std::cout << "not determined: " << w << "\n";
-    if (!a.json_out.empty()) write_text(a.json_out, r.to_json().dump(2) + "\n");
+    if (!a.json_out.empty()) write_result_file(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
         const std::filesystem::path report(a.report_out);
         if (report.has_parent_path()) std::filesystem::create_directories(report.parent_path());
@@ -407,7 +398,7 @@ int run_diagnose(const DiagnoseArgs& a) {
             after_name = plots.after.filename().string();
             plot_residuals(r, data, plots.data, plots.before, plots.after);
         }
-        write_text(a.report_out, markdown_report(r, a.data, before_name, after_name));
+        write_result_file(a.report_out, markdown_report(r, a.data, before_name, after_name));
     }
     if (r.undetermined.empty() || a.allow_undetermined) return 0;
     std::cout << "the diagnosis is not determined by these data (exit 1; --allow-undetermined: exit 0)\n";

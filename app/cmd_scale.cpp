@@ -5,6 +5,7 @@
 #include "app/campaign_cli.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "app/result_files.hpp"
 #include "app/scaling_plots.hpp"
 #include "calibration/particle_enlargement.hpp"
 #include "orchestrator/run_identity.hpp"
@@ -79,9 +80,9 @@ void check_scale(const nlohmann::json& base, const ScaleCli& o, const calibratio
 // The JSON, the Markdown table beside it and the three plots (a missing gnuplot costs only the pictures).
 void write_outputs(const calibration::EnlargementStudy& study, const ScaleCli& o) {
     const fs::path json = output_of(o);
-    orchestrator::write_text_file_atomically(json, study.to_json().dump(2) + "\n");
+    write_result_file(json, study.to_json().dump(2) + "\n");
     fs::path table = json;
-    orchestrator::write_text_file_atomically(table.replace_extension(".md"), study.markdown());
+    write_result_file(table.replace_extension(".md"), study.markdown());
     if (o.no_plot) return;
     const std::string stem = (json.parent_path() / json.stem()).string(), ext = "." + o.campaign.plot_format;
     try {

@@ -3,6 +3,7 @@
 #include "app/commands.hpp"
 #include "app/execution_options.hpp"
 #include "app/gnuplot.hpp"
+#include "app/result_files.hpp"
 #include "app/shear_report.hpp"
 #include "analytics/failure_line.hpp"
 #include "calibration/failure_line_evaluation.hpp"
@@ -44,13 +45,14 @@ void write_plots(const fs::path& dir, const std::string& stem, const calibration
                  const std::string& format) {
     const fs::path points = dir / (stem + "_points.dat"), band = dir / (stem + "_band.dat");
     {
-        std::ofstream p(points);
+        std::ostringstream p;
         p << "# sigma_Pa peak_tau_Pa residual_tau_Pa\n";
         for (const auto& r : ev.outcome.runs)
             if (r.state == RunState::done)
                 p << r.label["normal_stress"].get<double>() << " " << r.result["peak_shear_stress"].get<double>() << " "
                   << r.result.value("residual_shear_stress", 0.0) << "\n";
-        std::ofstream b(band);
+        write_result_file(points, p.str());
+        std::ostringstream b;
         b << "# sigma_Pa peak_fit peak_low peak_high residual_fit\n";
         double smax = 0;
         for (const auto& r : ev.outcome.runs) smax = std::max(smax, r.label["normal_stress"].get<double>());
@@ -60,6 +62,7 @@ void write_plots(const fs::path& dir, const std::string& stem, const calibration
             b << s << " " << ev.peak->shear_stress(s) << " " << ev.peak->shear_stress(s) - w << " "
               << ev.peak->shear_stress(s) + w << " " << ev.residual->shear_stress(s) << "\n";
         }
+        write_result_file(band, b.str());
     }
     std::ostringstream g;
     g << "set title 'Failure line: mu_b = " << std::setprecision(3) << ev.peak->mu_b << " (phi_b = "
@@ -81,10 +84,11 @@ void write_plots(const fs::path& dir, const std::string& stem, const calibration
     for (const auto& r : ev.outcome.runs) {
         if (r.state != RunState::done || !r.result.contains("curve")) continue;
         const fs::path curve = r.run_dir / "curve.dat";
-        std::ofstream f(curve);
+        std::ostringstream f;
         const auto& cv = r.result["curve"];
         for (std::size_t i = 0; i < cv["displacement"].size(); ++i)
             f << cv["displacement"][i].get<double>() << " " << cv["shear_stress"][i].get<double>() << "\n";
+        write_result_file(curve, f.str());
         c << (first ? "" : ", \\\n  ") << gnuplot_quote(curve) << " using ($1*1e3):($2/1e3) with lines title '"
           << r.label["normal_stress"].get<double>() / 1e3 << " kPa #" << r.label["replicate"].get<int>() << "'";
         first = false;
@@ -125,7 +129,7 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
     j["peak_failure_line"] = ev.peak ? ev.peak->to_json() : nlohmann::json(nullptr);
     j["residual_failure_line"] = ev.residual ? ev.residual->to_json() : nlohmann::json(nullptr);
     const std::string stem = "failure_line_" + outcome.campaign.name;
-    write_text_file_atomically(dir / (stem + ".json"), j.dump(2) + "\n");
+    write_result_file(dir / (stem + ".json"), j.dump(2) + "\n");
     if (ev.peak && ev.residual) {
         std::cout << "\n";
         print_line("Peak failure line", *ev.peak);

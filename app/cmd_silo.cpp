@@ -1,9 +1,11 @@
 // demcal silo: the seed's silo case (filling, opening, discharge) on the native DEM kernel.
 #include "analytics/discharge_models.hpp"
+#include "analytics/number_text.hpp"  // shortened_text
 #include "analytics/user_input.hpp"  // json_value_text
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
+#include "app/result_files.hpp"
 #include "app/silo_bed_export.hpp"
 #include "app/silo_flow_pattern.hpp"
 #include "app/silo_material.hpp"
@@ -501,7 +503,7 @@ void write_plots(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::S
                     const double v = sec.vz(i, k);
                     if (!std::isnan(v)) f << sec.x_centre(i) << " " << sec.z_centre(k) << " " << v << "\n";
                 }
-            orchestrator::write_text_file_atomically(dir / "section.dat", f.str());
+            write_result_file(dir / "section.dat", f.str());
         }
         sec.write_outline(dir / "section_outline.dat");
         double zmax = r.fill_height + 0.01;
@@ -829,11 +831,16 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
         fs::remove(dir / "discharge.csv", ec);  // no table without its summary: a reader takes the pair for a result
         // a checkpoint on disk stays: resuming from it computes the end again and writes the results
         const bool resumable = !s.checkpoint_file.empty() && fs::exists(s.checkpoint_file, ec);
-        throw std::runtime_error(std::string(e.what()) + "; the results are not written" +
-                                 (resumable ? "; the checkpoint is kept: make room, then `demcal silo --resume " +
-                                                  dir.string() + "` finishes the run again"
-                                            : "; no checkpoint was written (none was due: --checkpoint-every), so "
-                                              "the run must be made again"));
+        std::cerr << "demcal: failed: "
+                  << analytics::shortened_text(
+                         std::string(e.what()) + "; the results are not written" +
+                             (resumable ? "; the checkpoint is kept: make room, then `demcal silo --resume " +
+                                              dir.string() + "` finishes the run again"
+                                        : "; no checkpoint was written (none was due: --checkpoint-every), so "
+                                          "the run must be made again"),
+                         4000)
+                  << std::endl;
+        throw CLI::RuntimeError(kExitResultsNotWritten);  // a campaign runs it again (app/silo_campaign.cpp)
     }
     // the results are written: the checkpoint has served its purpose (and would block a new run in this directory)
     if (!s.checkpoint_file.empty()) {

@@ -8,10 +8,10 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
+#include "app/result_files.hpp"
 #include "app/silo_campaign.hpp"
 #include "kernel/silo/bin_vibration.hpp"
 #include "orchestrator/shear_campaign.hpp"  // check_run_count
-#include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <gsl/gsl_statistics_double.h>
 #include <nlohmann/json.hpp>
@@ -213,7 +213,7 @@ void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<doubl
         std::ostringstream name;  // the runs' own spelling of the angle (RunSpec::name): distinct for distinct cells
         name << "vibration_theta" << theta << ".dat";
         const fs::path file = dir / name.str();
-        std::ofstream(file) << data;
+        write_result_file(file, data);
         body << (first ? "" : ", ") << gnuplot_quote(file) << " using 1:2:3 with yerrorlines title 'theta = "
              << theta << " deg'";
         first = false;
@@ -309,8 +309,8 @@ int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec
           "SE: the standard error of the pairs' mean. d ln(rate) = d ln(density) + d ln(speed) at the outlet splits a "
           "change of the rate.\n";
     const json out = {{"settings", campaign_settings(o)}, {"cells", table}, {"runs", all}};
-    orchestrator::write_text_file_atomically(dir / "vibration.json", out.dump(1) + "\n");
-    orchestrator::write_text_file_atomically(dir / "vibration.md", md.str());
+    write_result_file(dir / "vibration.json", out.dump(1) + "\n");
+    write_result_file(dir / "vibration.md", md.str());
     std::cout << md.str();
     plot_rates(o, dir, data_by_theta);
     return cells_with_rate;

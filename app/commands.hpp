@@ -16,6 +16,10 @@ struct UserError : std::runtime_error {
 // `demcal resume` once it is fixed (EX_TEMPFAIL of sysexits.h).
 inline constexpr int kExitResumeLater = 75;
 
+// Exit status of a silo run that ended but could not write its results (a full disk; EX_IOERR of sysexits.h): not
+// the run's failure. A campaign does not mark such a run failed: it stops, and the same command runs it again.
+inline constexpr int kExitResultsNotWritten = 74;
+
 void add_shear_commands(CLI::App& app);        // shear, status, resume            (cmd_shear.cpp)
 void add_shear_run_command(CLI::App& app);     // shear-run (one kernel shear box)   (cmd_shear_run.cpp)
 void add_crosscheck_command(CLI::App& app);    // crosscheck shear, crosscheck silo   (cmd_crosscheck.cpp)

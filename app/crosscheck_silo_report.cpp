@@ -1,6 +1,7 @@
 #include "app/crosscheck_silo_report.hpp"
 
 #include "app/gnuplot.hpp"
+#include "app/result_files.hpp"
 #include "app/silo_flow_pattern.hpp"
 #include "analytics/user_input.hpp"
 #include "kernel/silo/silo_geometry.hpp"
@@ -147,8 +148,9 @@ double largest_gap(const Curve& k, const Curve& y, double filled) {
 }
 
 void write_curve_data(const fs::path& file, const Curve& c) {
-    std::ofstream f(file);
+    std::ostringstream f;
     for (const auto& p : c) f << p.t << " " << p.mass * 1e3 << "\n";
+    write_result_file(file, f.str());
 }
 
 // `own`: YADE's discharge of the bed it filled itself (--fill both), drawn when not empty.
@@ -447,8 +449,8 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
     report["rates_agree"] = verdict.all_agree;
     report["patterns_agree"] = verdict.all_patterns_agree;  // at every angle where both codes determined one
     report["patterns_determined"] = verdict.all_patterns_determined;
-    orchestrator::write_text_file_atomically(root / "crosscheck_silo.json", report.dump(2) + "\n");
-    orchestrator::write_text_file_atomically(root / "crosscheck_silo.md", md.str());
+    write_result_file(root / "crosscheck_silo.json", report.dump(2) + "\n");
+    write_result_file(root / "crosscheck_silo.md", md.str());
     out.markdown = md.str();
     return out;
 }

@@ -5,6 +5,7 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/gnuplot.hpp"
+#include "app/result_files.hpp"
 #include "app/silo_campaign.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
@@ -216,10 +217,6 @@ std::string interval_text(const an::DemCandidateResult& c) {
            (c.interval_at_upper_bound ? " (bound)" : "") + "]";
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-    if (path.has_parent_path()) fs::create_directories(path.parent_path());
-    orchestrator::write_text_file_atomically(path, text);
-}
 
 // Residuals [%] per measured row against the hopper angle, before and after (the effect named in the title).
 void plot_residuals(const an::SiloMeasurements& data, const an::DemDiagnosis& r, const fs::path& dat,
@@ -232,7 +229,7 @@ void plot_residuals(const an::SiloMeasurements& data, const an::DemDiagnosis& r,
         rows << data.lines[i] << " " << data.conditions[c].theta_deg << " " << y << " " << d << " " << a << " "
              << 100 * (y - d) / d << " " << 100 * (y - a) / a << "\n";
     }
-    write_text(dat, rows.str());
+    write_result_file(dat, rows.str());
     const std::string effect =
         r.effect >= 0 ? r.candidates[std::size_t(r.effect)].spec.name + " = " +
                             sci(r.candidates[std::size_t(r.effect)].fitted)
@@ -437,7 +434,7 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
     j["silo_args"] = a.silo_args;
     j["runs"] = {{"used", campaign.runs_used()}, {"run_now", campaign.runs_started()},
                  {"wall_s", campaign.wall_seconds()}, {"cpu_s", campaign.cpu_seconds()}};
-    if (!a.json_out.empty()) write_text(a.json_out, j.dump(2) + "\n");
+    if (!a.json_out.empty()) write_result_file(a.json_out, j.dump(2) + "\n");
     if (!a.report_out.empty()) {
         const fs::path report(a.report_out);
         std::string before_name, after_name;
@@ -453,7 +450,7 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
                 before_name.clear();
             }
         }
-        write_text(report, markdown(a, data, r, campaign, before_name, after_name));
+        write_result_file(report, markdown(a, data, r, campaign, before_name, after_name));
     }
     return 0;
 }

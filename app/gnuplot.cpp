@@ -2,12 +2,14 @@
 
 #include "analytics/number_text.hpp"
 #include "app/commands.hpp"  // UserError
+#include "app/result_files.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <fstream>
@@ -19,6 +21,24 @@ extern char** environ;
 namespace demcal {
 
 namespace {
+
+// Whether gnuplot finished the file: a PNG ends with its IEND chunk, an SVG with its closing tag. A full disk left
+// gnuplot's output cut short while gnuplot itself exited 0.
+bool plot_is_complete(const std::filesystem::path& output) {
+    std::ifstream f(output, std::ios::binary | std::ios::ate);
+    if (!f) return false;
+    const std::streamoff size = f.tellg();
+    const std::streamoff tail = std::min<std::streamoff>(size, 64);
+    std::string end(static_cast<std::size_t>(tail), '\0');
+    f.seekg(size - tail);
+    f.read(end.data(), tail);
+    if (!f) return false;
+    if (output.extension() == ".png") {
+        static const std::string iend("\0\0\0\0IEND\xAE\x42\x60\x82", 12);
+        return end.size() >= iend.size() && end.compare(end.size() - iend.size(), iend.size(), iend) == 0;
+    }
+    return end.find("</svg>") != std::string::npos;
+}
 
 std::string single_quoted(const std::string& text) {
     std::string s = "'";
@@ -80,11 +100,8 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     std::filesystem::path script = output, log = output;
     script += ".gp";
     log += ".gp.log";
-    {
-        std::ofstream f(script);
-        f << "set terminal " << terminal << "\nset output " << gnuplot_quote(output) << "\n" << body << "\n";
-        if (!f) throw std::runtime_error("cannot write gnuplot script " + script.string());
-    }
+    for (const auto& f : gnuplot_files(output)) note_result_file(f);
+    write_result_file(script, "set terminal " + terminal + "\nset output " + gnuplot_quote(output) + "\n" + body + "\n");
     // gnuplot without a shell: the script's path is one argument, whatever it holds
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -102,8 +119,16 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     while (::waitpid(pid, &status, 0) < 0) {
         if (errno != EINTR) throw std::runtime_error("lost gnuplot while it rendered " + script.string());
     }
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    std::error_code ec;
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        std::filesystem::remove(output, ec);  // whatever gnuplot began is no plot
         throw std::runtime_error("gnuplot failed on " + script.string() + " (see " + log.string() + ")");
+    }
+    if (!plot_is_complete(output)) {
+        std::filesystem::remove(output, ec);
+        throw std::runtime_error("gnuplot did not finish " + output.string() +
+                                 " (the file was cut short or not written: is the disk full?); it is removed");
+    }
 }
 
 }  // namespace demcal

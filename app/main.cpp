@@ -1,6 +1,7 @@
 #include "analytics/number_text.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
+#include "app/result_files.hpp"
 
 #include <cerrno>
 #include <cstdio>
@@ -15,6 +16,17 @@ namespace {
 // analytics::shortened_text escapes a value (and bounded: a message is one line a person reads).
 constexpr std::size_t kMaxMessageChars = 4000;
 std::string one_line(std::string_view message) { return demcal::analytics::shortened_text(message, kMaxMessageChars); }
+
+// A command that ended with an exception: its message on one line, and the result files it had begun removed
+// (app/result_files.hpp), said when there were any.
+int failed(int status, const char* kind, const std::string& message) {
+    std::string text = one_line(message);
+    if (const int removed = demcal::discard_unfinished_results(); removed > 0)
+        text += "; removed the " + std::to_string(removed) + " result file" + (removed == 1 ? "" : "s") +
+                " this command had begun (its result is whole or absent)";
+    std::cerr << "demcal: " << kind << ": " << text << "\n";
+    return status;
+}
 
 int run_command(int argc, char** argv) {
     CLI::App app{"demcal: DEM calibration, YADE campaigns, discharge models and a native DEM kernel"};
@@ -47,20 +59,19 @@ int run_command(int argc, char** argv) {
         // --help and --version exit 0; a malformed command line is bad input like any other: exit 2
         return app.exit(e) == 0 ? 0 : 2;
     } catch (const demcal::UserError& e) {
-        std::cerr << "demcal: error: " << one_line(e.what()) << "\n";
-        return 2;
+        return failed(2, "error", e.what());
     } catch (const std::filesystem::filesystem_error& e) {
+        const int code = e.code().value();
+        if (code == ENOSPC || code == EDQUOT || code == EIO)  // the machine's state, not the path the user gave
+            return failed(1, "failed", "'" + e.path1().string() + "': " + e.code().message());
         // a path the user gave that the file system will not take (a file where a folder belongs, a link loop, a
         // read-only folder): the path and the reason, not the library's text
-        std::cerr << "demcal: error: '" << one_line(e.path1().string()) << "': " << e.code().message()
-                  << " (a file where a folder belongs, a link loop or a read-only folder in the path?)\n";
-        return 2;
+        return failed(2, "error", "'" + e.path1().string() + "': " + e.code().message() +
+                                      " (a file where a folder belongs, a link loop or a read-only folder in the path?)");
     } catch (const std::invalid_argument& e) {  // the libraries' word for bad input
-        std::cerr << "demcal: error: " << one_line(e.what()) << "\n";
-        return 2;
+        return failed(2, "error", e.what());
     } catch (const std::exception& e) {
-        std::cerr << "demcal: failed: " << one_line(e.what()) << "\n";
-        return 1;
+        return failed(1, "failed", e.what());
     }
     return 0;
 }

@@ -1,7 +1,7 @@
+#include "app/result_files.hpp"
 #include "app/scaling_plots.hpp"
 
 #include "app/gnuplot.hpp"
-#include "orchestrator/run_identity.hpp"
 
 #include <iomanip>
 #include <sstream>
@@ -28,7 +28,7 @@ void plot_enlargement(const fs::path& output, const std::vector<double>& r, cons
     std::ostringstream d;
     d << "# particle_radius_m young_modulus_Pa poisson_ratio\n" << std::setprecision(10);
     for (std::size_t i = 0; i < r.size(); ++i) d << r[i] << " " << e[i] << " " << nu[i] << "\n";
-    orchestrator::write_text_file_atomically(data, d.str());
+    write_result_file(data, d.str());
     std::ostringstream g;
     g << std::setprecision(10) << "set multiplot layout 1,2\nset xlabel 'particle radius r_p [mm]'\nunset key\n"
       << "set ylabel 'E [MPa]'\nset title 'E(r_p) = A r_p + B'\n"
@@ -68,8 +68,8 @@ void plot_macro_trends(const fs::path& picture, const calibration::EnlargementSt
     v << "# r_m mu_b se_mu_b tau_c_Pa se_tau_c_Pa (the laws' materials)\n" << std::setprecision(10);
     for (const auto& x : s.verifications)
         if (x.not_run_because.empty()) row(v, x.radius, x.line);
-    orchestrator::write_text_file_atomically(data, d.str());
-    orchestrator::write_text_file_atomically(verified, v.str());
+    write_result_file(data, d.str());
+    write_result_file(verified, v.str());
     const auto& ref = s.bases.front().line;
     const bool has_verified = !s.verifications.empty();
     auto panel = [&](const std::string& label, int col, double ref_value, const auto& trend) {
@@ -103,7 +103,7 @@ void plot_run_cost(const fs::path& picture, const calibration::EnlargementStudy&
         if (b.cost.runs > 0)
             d << b.radius << " " << b.cost.cpu_s << " " << b.cost.cpu_sd << " " << b.cost.wall_s << " "
               << b.cost.particles << "\n";
-    orchestrator::write_text_file_atomically(data, d.str());
+    write_result_file(data, d.str());
     std::ostringstream g;
     g << std::setprecision(10) << "set grid\nset offsets graph 0.05, graph 0.05, 0, 0\n"
       << "set xlabel 'particle radius r_p [mm]'\nset ylabel 'time per run [s]'\n"

@@ -251,6 +251,12 @@ void record_run_end(const fs::path& rd, const std::string& name, int rc, bool st
         outcome.stopped = true;
         return;
     }
+    if (rc == kExitResultsNotWritten) {  // the disk, not the run: no failure marker, the next command runs it again
+        std::cerr << "demcal " << command << ": run " << name << " could not write its results (see " << (rd / log)
+                  << "); the campaign stops here: make room, then the same command runs it again\n";
+        outcome.stopped = true;
+        return;
+    }
     std::ofstream(rd / "failed") << "exit status " << rc << "; see " << log << "\n";
     std::cerr << "demcal " << command << ": run " << name << " failed (exit " << rc << "), see " << (rd / log) << "\n";
     ++outcome.failed;

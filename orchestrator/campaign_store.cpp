@@ -13,6 +13,7 @@
 #include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
@@ -63,12 +64,25 @@ CampaignKind campaign_kind_from_string(const std::string& s) {
 
 namespace {
 
+// SQLite's message for the last failure, with the system's reason where the file system refused ("disk I/O error"
+// alone hid that the disk was full).
+std::string sqlite_failure(sqlite3* db) {
+    if (!db) return "out of memory";
+    std::string m = sqlite3_errmsg(db);
+    const int code = sqlite3_errcode(db), sys = sqlite3_system_errno(db);
+    if ((code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_CANTOPEN) && sys != 0)
+        m += std::string(" (") + std::strerror(sys) + ")";
+    else if (code == SQLITE_FULL)  // a short write: SQLite keeps no errno for it (demcal sets no page limit)
+        m += " (no space left on the device)";
+    return m;
+}
+
 // A prepared statement that finalises itself; bind by 1-based position.
 class Statement {
 public:
     Statement(sqlite3* db, const std::string& sql) : db_(db) {
         if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) != SQLITE_OK)
-            throw std::runtime_error(std::string("store: ") + sqlite3_errmsg(db) + " in: " + sql);
+            throw std::runtime_error("store: " + sqlite_failure(db) + " in: " + sql);
     }
     ~Statement() { sqlite3_finalize(st_); }
     Statement& bind(int i, const std::string& v) {
@@ -91,7 +105,7 @@ public:
         if (rc == SQLITE_DONE) return false;
         if (rc == SQLITE_CORRUPT || rc == SQLITE_NOTADB)  // the file's fault, not the machine's: bad input
             throw std::invalid_argument(std::string("store: damaged: ") + sqlite3_errmsg(db_));
-        throw std::runtime_error(std::string("store: ") + sqlite3_errmsg(db_));
+        throw std::runtime_error("store: " + sqlite_failure(db_));
     }
     std::string text(int c) const {
         auto p = sqlite3_column_text(st_, c);
@@ -111,7 +125,7 @@ template <class F>
 void in_transaction(sqlite3* db, F&& f) {
     char* err = nullptr;
     if (sqlite3_exec(db, "BEGIN IMMEDIATE", nullptr, nullptr, &err) != SQLITE_OK) {
-        std::string m = err ? err : "?";
+        std::string m = sqlite_failure(db);
         sqlite3_free(err);
         throw std::runtime_error("store: cannot begin transaction: " + m);
     }
@@ -122,7 +136,7 @@ void in_transaction(sqlite3* db, F&& f) {
         throw;
     }
     if (sqlite3_exec(db, "COMMIT", nullptr, nullptr, &err) != SQLITE_OK) {
-        std::string m = err ? err : "?";
+        std::string m = sqlite_failure(db);
         sqlite3_free(err);
         throw std::runtime_error("store: cannot commit: " + m);
     }
@@ -382,15 +396,20 @@ CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess a
         // 0 or 4096 bytes that every later command refused as not demcal's
         const std::filesystem::path fresh = db_path.string() + ".new-" + std::to_string(::getpid());
         std::filesystem::remove(fresh, ec);
-        {
+        try {
             CampaignStore made(fresh, db_path.parent_path());
+        } catch (const std::exception& e) {
+            std::string why = e.what();  // named by the store, not by its temporary name
+            const std::string inner = "store " + fresh.string() + ": ";
+            if (why.compare(0, inner.size(), inner) == 0) why.erase(0, inner.size());
+            throw std::runtime_error("cannot create the campaign store " + db_path.string() + ": " + why);
         }
         std::filesystem::rename(fresh, db_path);
     }
     const std::string name = read_only ? read_only_uri(db_path) : db_path.string();
     const int flags = read_only ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI : SQLITE_OPEN_READWRITE;
     if (sqlite3_open_v2(name.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
-        std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        std::string m = sqlite_failure(db_);
         sqlite3_close(db_);
         throw std::runtime_error("store: cannot open " + db_path.string() + ": " + m);
     }
@@ -440,7 +459,7 @@ CREATE INDEX IF NOT EXISTS runs_by_state ON runs(state);
 CampaignStore::CampaignStore(const std::filesystem::path& fresh_path, const std::filesystem::path& base_dir)
     : path_(fresh_path), base_dir_(std::filesystem::absolute(base_dir).lexically_normal()) {
     if (sqlite3_open_v2(fresh_path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
-        std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        std::string m = sqlite_failure(db_);
         sqlite3_close(db_);
         std::error_code ec;
         std::filesystem::remove(fresh_path, ec);
@@ -474,7 +493,7 @@ CampaignStore::~CampaignStore() { sqlite3_close(db_); }
 void CampaignStore::exec(const std::string& sql) {
     char* err = nullptr;
     if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
-        std::string m = err ? err : "?";
+        std::string m = sqlite_failure(db_);
         sqlite3_free(err);
         throw std::runtime_error("store " + path_.string() + ": " + m);
     }

@@ -43,6 +43,21 @@ TEST_CASE("nu(r) = C r^-D is recovered by the nonlinear fit", "[scaling_law]") {
         CHECK(fit.params[1].value == Approx(1.282).epsilon(1e-6));
         CHECK(fit(2.0) == Approx(0.2344 * std::pow(2.0, -1.282)).epsilon(1e-6));
     }
+    SECTION("exact points whose log-log line is already the fit (GSL finds no step from it) are converged") {
+        // radii in m (what demcal enlarge reads), several exponents: the start is the optimum to rounding, and GSL's
+        // driver reported that as "exceeded max number of iterations" (enlarge printed the law as not determined)
+        for (const double d : {0.5, 1.282, 2.0, 3.7})
+            for (const std::vector<double>& r : {std::vector<double>{0.001, 0.0012, 0.0015, 0.002},
+                                                 std::vector<double>{0.002, 0.0025, 0.003, 0.0035, 0.004}}) {
+                std::vector<double> y;
+                for (double x : r) y.push_back(0.01 * std::pow(x, -d));
+                const auto fit = fit_power_law(r, y);
+                INFO("D = " << d << ", " << r.size() << " radii from " << r.front() << " m");
+                CHECK(fit.converged);
+                CHECK(fit.determined());
+                CHECK(fit.params[1].value == Approx(d).epsilon(1e-9));
+            }
+    }
     SECTION("noisy points: the intervals cover the truth and are not absurdly wide") {
         std::unique_ptr<gsl_rng, decltype(&gsl_rng_free)> rng(gsl_rng_alloc(gsl_rng_mt19937), gsl_rng_free);
         gsl_rng_set(rng.get(), 7);
