@@ -371,13 +371,22 @@ std::vector<double> holm(const std::vector<double>& p) {
     return adjusted;
 }
 
+// The p quantile of F(1, nu), as the square of Student's t quantile at (1 + p) / 2 (T^2 ~ F(1, nu)). GSL's F
+// quantile at (0.95, 1, nu) fails to converge for most nu above 270 (betainv.c: "inverse failed to converge"), which
+// GSL's default handler turns into an abort: diagnose silo-dem crashed when a rival's separation design needed many
+// repeats. The t quantile has no such failure.
+double f1_quantile(double p, double nu) {
+    const double t = gsl_cdf_tdist_Pinv(0.5 + p / 2, nu);
+    return t * t;
+}
+
 constexpr int kMaxSeparationMultiplier = 1000;  // beyond: not a design anyone would run
 
 DemRivalSeparation rival_separation(const ConditionStats& s, int K, const DemCandidateResult& effect,
                                     const DemCandidateResult& rival, int rival_index, double level) {
     DemRivalSeparation sep;
     sep.rival = rival_index;
-    sep.needed_chi2_difference = gsl_cdf_fdist_Pinv(level, 1.0, double(s.df_pure_error));
+    sep.needed_chi2_difference = f1_quantile(level, double(s.df_pure_error));
     std::vector<double> part;
     for (std::size_t c = 0; c < s.mean.size(); ++c) {
         const double var = s.s2 * (1.0 / s.count[c] + 1.0 / K);
@@ -393,7 +402,7 @@ DemRivalSeparation rival_separation(const ConditionStats& s, int K, const DemCan
         // m times the repeats also gives the pure error m N - C degrees of freedom, which lowers the threshold
         const int rows = std::accumulate(s.count.begin(), s.count.end(), 0), conditions = int(s.count.size());
         for (int m = 1; m <= kMaxSeparationMultiplier; ++m)
-            if (m * sep.observed_chi2_difference >= gsl_cdf_fdist_Pinv(level, 1.0, double(m * rows - conditions))) {
+            if (m * sep.observed_chi2_difference >= f1_quantile(level, double(m * rows - conditions))) {
                 sep.multiplier = m;
                 break;
             }
@@ -471,7 +480,7 @@ DemDiagnosis diagnose_dem(const SiloMeasurements& data, const std::vector<double
     r.rmse_before_g_s = rmse_g_s(data, rates_declared);
     r.chi2_before = chi2_of(s, log_declared, K);
     r.lack_of_fit_p_before = gsl_cdf_fdist_Q(r.chi2_before / double(C), double(C), double(s.df_pure_error));
-    const double delta_chi2 = gsl_cdf_fdist_Pinv(o.interval_level, 1.0, double(s.df_pure_error));
+    const double delta_chi2 = f1_quantile(o.interval_level, double(s.df_pure_error));
 
     std::vector<std::size_t> tested;
     for (const DemCandidateSetup& setup : setups) {

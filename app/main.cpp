@@ -3,6 +3,8 @@
 #include "app/commands.hpp"
 #include "app/result_files.hpp"
 
+#include <gsl/gsl_errno.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -91,4 +93,10 @@ int with_standard_output_checked(int status) {
 
 }  // namespace
 
-int main(int argc, char** argv) { return with_standard_output_checked(run_command(argc, argv)); }
+int main(int argc, char** argv) {
+    // GSL's default error handler aborts the process (its F quantile did, on valid input: analytics/dem_diagnosis.cpp
+    // f1_quantile). A command checks what the numerics return (a fit not converged, a value not finite) and says so;
+    // an abort says nothing and leaves a core.
+    gsl_set_error_handler_off();
+    return with_standard_output_checked(run_command(argc, argv));
+}

@@ -60,10 +60,17 @@ CASES = [
     ("vibration", ["vibration", "--theta", "70", "--frequency", "0,100", "--amplitude", "1e-4", "--repeats", "1",
                    "--jobs", "2", "--campaign", "{o}/vib", "--"] + SMALL_SILO,
      ["vib/vibration.json"], None),
+    ("cutoff --json", ["cutoff", "--bond-number", "10", "--grains", "200", "--bracket", "0,400", "--tol", "200",
+                       "--seeds", "1", "--json", "{o}/c.json"], ["c.json"], None),
+    ("scale --engine kernel", ["scale", ex("materials/sand-scale-tiny.json"), "--radii", "2e-3,3e-3,4e-3",
+                               "--normal-stress", "4e3,6e3,8e3", "--replicates", "1", "--max-evaluations", "2",
+                               "--engine", "kernel", "--allow-unconverged", "--jobs", "2", "--dir", "{o}/scale",
+                               "-o", "{o}/scale.json"], ["scale.json"], None),
 ]
 # sizes at which a campaign gets past its start (the kernel engine copies the demcal binary, about 6 MB, into it)
 # and the disk fills while its runs and report are written
-LATE_SIZES = {"shear --engine kernel": ["6300k", "6600k", "7m"], "vibration": ["64k", "256k", "1m", "4m"]}
+LATE_SIZES = {"shear --engine kernel": ["6300k", "6600k", "7m"], "vibration": ["64k", "256k", "1m", "4m"],
+              "scale --engine kernel": ["6400k", "6700k", "7m", "8m"]}
 
 
 def run(args, o, limit=600):

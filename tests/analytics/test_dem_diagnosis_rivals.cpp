@@ -91,3 +91,31 @@ TEST_CASE("silo-dem: a candidate that fits clearly worse is no rival", "[diagnos
     CHECK(r.rivals.empty());
     CHECK(r.to_json(data)["effect"]["rivals"].empty());
 }
+
+TEST_CASE("silo-dem: a rival that only many repeats would separate gets its design, not a crash",
+          "[diagnose][silo-dem]") {
+    // The design's search asks the F(1, m N - C) quantile for growing m; GSL's own F quantile fails to converge
+    // beyond about 270 degrees of freedom and its default handler aborted the process (found by a golden run of
+    // diagnose_dem over synthetic scenarios, stop 51).
+    const SyntheticSilo truth{3.0};
+    SyntheticSilo tilted{3.0};
+    tilted.angle_slope = 0.01;  // an eighth of the rival above: separated only by many times the repeats
+    int calls = 0;
+    const auto data = truth.measured(0.1);
+    const auto r = an::diagnose_dem(
+        data, truth.rates(data, 0.0),
+        {truth.candidate("cohesion", "grain_grain.surface_energy_J_m2", 0.3, data, &calls),
+         tilted.candidate("rolling_friction", "grain_grain.rolling_friction", 0.3, data, &calls)},
+        {});
+    REQUIRE(r.effect == 0);
+    REQUIRE(r.separations.size() == 1);
+    const auto& sep = r.separations[0];
+    INFO("observed " << sep.observed_chi2_difference << ", needed " << sep.needed_chi2_difference);
+    // 12 rows, 4 conditions: a multiplier above 23 needs quantiles beyond 272 degrees of freedom
+    CHECK(sep.multiplier > 23);
+    CHECK(sep.multiplier <= 1000);
+    // the found m does reach the quantile at m N - C degrees of freedom, and m - 1 does not
+    const double q = 4.0;  // F(1, nu) quantile at 95 % lies between 3.84 (nu -> inf) and 4.0 for nu > 60
+    CHECK(sep.multiplier * sep.observed_chi2_difference >= 3.84);
+    CHECK((sep.multiplier - 1) * sep.observed_chi2_difference < q);
+}
