@@ -137,6 +137,58 @@ void check_separator(const std::vector<std::string>& header, const std::string& 
 }
 }  // namespace
 
+namespace {
+
+// The header line: one column per name, none empty or repeated (a JSON file or another separator named as such).
+void read_header(MeasuredData& data, const std::vector<std::string>& fields, char first, const std::string& source,
+                 int line_no) {
+    if (first == '{' || first == '[')
+        throw std::invalid_argument(source + ": line " + std::to_string(line_no) + " starts with '" +
+                                    std::string(1, first) + "': a JSON file, not a table (CSV: a header line "
+                                    "of column names, then one line per measurement)");
+    check_separator(fields, source, line_no);
+    for (const auto& name : fields) {
+        if (name.empty())
+            throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": empty column name");
+        for (const auto& c : data.columns)
+            if (c.name == name)
+                throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": duplicate column " +
+                                            shortened_text(name));
+        data.columns.push_back(DataColumn{name, true, {}, {}});
+    }
+}
+
+// Whether a column holds numbers or categories, and its numbers read: a column of mostly numbers with some text is a
+// typo, not a category (e.g. "1,5" or "n/a"); a cell that reads as a number must be a usable one ("nan", "inf",
+// "1e-320" are not categories).
+void type_column(const MeasuredData& data, DataColumn& col) {
+    std::size_t numbers = 0, texts = 0, first_text = 0;
+    for (std::size_t r = 0; r < data.rows(); ++r) {
+        const auto& cell = col.text[r];
+        if (cell.empty()) {
+            if (!may_be_empty(col.name)) throw std::invalid_argument(data.where(r, col.name) + ": missing value");
+            continue;
+        }
+        if (const auto n = read_typed_number(cell); n.is_number && n.defect)
+            throw std::invalid_argument(data.where(r, col.name) + ": " + quote(cell) + " " + *n.defect);
+        if (parse_number(cell)) {
+            ++numbers;
+        } else if (texts++ == 0) {
+            first_text = r;
+        }
+    }
+    col.numeric = texts == 0 || (numbers >= texts && col.name != "geometry");
+    if (col.numeric && texts > 0)
+        throw std::invalid_argument(data.where(first_text, col.name) + ": " + quote(col.text[first_text]) +
+                                    " is not a number");
+    if (col.numeric) {
+        col.values.reserve(data.rows());
+        for (const auto& cell : col.text) col.values.push_back(cell.empty() ? nan : *parse_number(cell));
+    }
+}
+
+}  // namespace
+
 MeasuredData parse_csv(std::istream& in, const std::string& source) {
     MeasuredData data;
     data.source = source;
@@ -148,22 +200,9 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
         if (line_no == 1) strip_byte_order_mark(line, source);
         const std::string t = trim(line);
         if (t.empty() || t[0] == '#') continue;  // blank lines and comments hold no data
-        auto fields = split_csv_line(line, source, line_no);
+        const auto fields = split_csv_line(line, source, line_no);
         if (!have_header) {
-            if (t[0] == '{' || t[0] == '[')
-                throw std::invalid_argument(source + ": line " + std::to_string(line_no) + " starts with '" +
-                                            std::string(1, t[0]) + "': a JSON file, not a table (CSV: a header line "
-                                            "of column names, then one line per measurement)");
-            check_separator(fields, source, line_no);
-            for (auto& name : fields) {
-                if (name.empty())
-                    throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": empty column name");
-                for (const auto& c : data.columns)
-                    if (c.name == name)
-                        throw std::invalid_argument(source + ": line " + std::to_string(line_no) +
-                                                    ": duplicate column " + shortened_text(name));
-                data.columns.push_back(DataColumn{name, true, {}, {}});
-            }
+            read_header(data, fields, t[0], source, line_no);
             have_header = true;
             continue;
         }
@@ -180,34 +219,7 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
     }
     if (!have_header) throw std::invalid_argument(source + ": no header line");
     if (data.rows() == 0) throw std::invalid_argument(source + ": header but no data rows");
-
-    for (auto& col : data.columns) {
-        std::size_t numbers = 0, texts = 0, first_text = 0;
-        for (std::size_t r = 0; r < data.rows(); ++r) {
-            const auto& cell = col.text[r];
-            if (cell.empty()) {
-                if (!may_be_empty(col.name)) throw std::invalid_argument(data.where(r, col.name) + ": missing value");
-                continue;
-            }
-            // a cell that reads as a number must be a usable one ("nan", "inf", "1e-320" are not categories)
-            if (const auto n = read_typed_number(cell); n.is_number && n.defect)
-                throw std::invalid_argument(data.where(r, col.name) + ": " + quote(cell) + " " + *n.defect);
-            if (parse_number(cell)) {
-                ++numbers;
-            } else if (texts++ == 0) {
-                first_text = r;
-            }
-        }
-        // A column of mostly numbers with some text is a typo, not a category (e.g. "1,5" or "n/a").
-        col.numeric = texts == 0 || (numbers >= texts && col.name != "geometry");
-        if (col.numeric && texts > 0)
-            throw std::invalid_argument(data.where(first_text, col.name) + ": " + quote(col.text[first_text]) +
-                                        " is not a number");
-        if (col.numeric) {
-            col.values.reserve(data.rows());
-            for (const auto& cell : col.text) col.values.push_back(cell.empty() ? nan : *parse_number(cell));
-        }
-    }
+    for (auto& col : data.columns) type_column(data, col);
     return data;
 }
 

@@ -303,7 +303,9 @@ void record_campaign_status(orchestrator::CampaignStore& store, std::int64_t cam
     const bool any_failed = std::any_of(runs.begin(), runs.end(), [](const orchestrator::RunRecord& r) {
         return r.state == orchestrator::RunState::failed;
     });
-    store.set_campaign_status(campaign_id, all_done ? "complete" : any_failed ? "failed" : "open");
+    store.set_campaign_status(campaign_id, all_done     ? orchestrator::CampaignStatus::complete
+                                          : any_failed ? orchestrator::CampaignStatus::failed
+                                                       : orchestrator::CampaignStatus::open);
 }
 
 crosscheck_silo::ReportSettings report_settings(const SiloCrosscheckOptions& o, const CrosscheckInputs& in) {

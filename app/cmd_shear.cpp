@@ -233,7 +233,7 @@ void add_shear_commands(CLI::App& app) {
                 ++by_state[to_string(r.state)];
                 wall += r.wall_s;
             }
-            std::cout << o.campaign.name << " [" << o.campaign.status << "] " << to_string(o.campaign.kind) << ": "
+            std::cout << o.campaign.name << " [" << to_string(o.campaign.status) << "] " << to_string(o.campaign.kind) << ": "
                       << o.runs.size() << " runs";
             // runs marked running while no demcal holds the folder belong to one that died: the next resume reruns them
             const bool holder = orchestrator::FolderLock::held(*status_dir);

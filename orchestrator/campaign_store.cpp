@@ -63,6 +63,29 @@ CampaignKind campaign_kind_from_string(const std::string& s) {
 }
 
 namespace {
+constexpr std::pair<CampaignStatus, const char*> kCampaignStatusNames[] = {{CampaignStatus::open, "open"},
+                                                                          {CampaignStatus::complete, "complete"},
+                                                                          {CampaignStatus::interrupted, "interrupted"},
+                                                                          {CampaignStatus::failed, "failed"}};
+}  // namespace
+
+std::string to_string(CampaignStatus s) {
+    for (const auto& [status, name] : kCampaignStatusNames)
+        if (status == s) return name;
+    return "?";
+}
+
+CampaignStatus campaign_status_from_string(const std::string& s) {
+    std::string known;
+    for (const auto& [status, name] : kCampaignStatusNames) {
+        if (s == name) return status;
+        known += (known.empty() ? "" : ", ") + std::string(name);
+    }
+    throw std::invalid_argument("campaign status '" + analytics::shortened_text(s) + "' is not one demcal knows (" +
+                                known + ")");
+}
+
+namespace {
 
 // SQLite's message for the last failure, with the system's reason where the file system refused ("disk I/O error"
 // alone hid that the disk was full).
@@ -212,7 +235,7 @@ CampaignRecord read_campaign(const Statement& st) {
     c.name = st.text(1);
     c.kind = campaign_kind_from_string(st.text(2));
     c.spec = stored_json(st, 3, "campaigns.spec");
-    c.status = st.text(4);
+    c.status = campaign_status_from_string(st.text(4));
     c.created_at = st.real(5);
     return c;
 }
@@ -522,9 +545,9 @@ std::vector<CampaignRecord> CampaignStore::campaigns() {
     return out;
 }
 
-void CampaignStore::set_campaign_status(std::int64_t campaign_id, const std::string& status) {
+void CampaignStore::set_campaign_status(std::int64_t campaign_id, CampaignStatus status) {
     in_transaction(db_, [&] {
-        Statement(db_, "UPDATE campaigns SET status = ? WHERE id = ?").bind(1, status).bind(2, campaign_id).step();
+        Statement(db_, "UPDATE campaigns SET status = ? WHERE id = ?").bind(1, to_string(status)).bind(2, campaign_id).step();
     });
 }
 

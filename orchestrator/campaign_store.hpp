@@ -25,6 +25,14 @@ std::string to_string(CampaignKind k);
 // Throws std::invalid_argument naming the value and the kinds known.
 CampaignKind campaign_kind_from_string(const std::string& s);
 
+// Where a campaign stands, as its last command left it: open (runs to do, or the simulator could not be started),
+// complete (every run done), interrupted (Ctrl-C, a signal), failed (runs failed for good). resume continues every
+// campaign that is not complete; a store holding another word is refused (a newer demcal's, or damaged).
+enum class CampaignStatus { open, complete, interrupted, failed };
+std::string to_string(CampaignStatus s);
+// Throws std::invalid_argument naming the value and the statuses known.
+CampaignStatus campaign_status_from_string(const std::string& s);
+
 struct RunRecord {
     std::string hash;
     nlohmann::json params;
@@ -43,7 +51,7 @@ struct CampaignRecord {
     std::int64_t id = 0;
     std::string name;
     CampaignKind kind = CampaignKind::shear;
-    std::string status;
+    CampaignStatus status = CampaignStatus::open;
     nlohmann::json spec;
     double created_at = 0;
 };
@@ -73,7 +81,7 @@ public:
     CampaignRecord ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec);
     std::optional<CampaignRecord> find_campaign(const std::string& name);
     std::vector<CampaignRecord> campaigns();
-    void set_campaign_status(std::int64_t campaign_id, const std::string& status);
+    void set_campaign_status(std::int64_t campaign_id, CampaignStatus status);
 
     // Registers a run (new identity: pending) and links it to the campaign with its label. Returns the stored record.
     RunRecord ensure_run(std::int64_t campaign_id, const std::string& hash, const nlohmann::json& params,

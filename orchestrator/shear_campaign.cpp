@@ -510,9 +510,11 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     }
     const bool all_done = std::all_of(out.runs.begin(), out.runs.end(),
                                       [](const RunRecord& r) { return r.state == RunState::done; });
-    store_->set_campaign_status(out.campaign.id, all_done ? "complete" : out.interrupted ? "interrupted"
-                                                         : !out.infrastructure_failure.empty() ? "open"
-                                                         : out.failed ? "failed" : "open");
+    store_->set_campaign_status(out.campaign.id, all_done                               ? CampaignStatus::complete
+                                                 : out.interrupted                      ? CampaignStatus::interrupted
+                                                 : !out.infrastructure_failure.empty() ? CampaignStatus::open
+                                                 : out.failed                           ? CampaignStatus::failed
+                                                                                        : CampaignStatus::open);
     out.campaign = *store_->find_campaign(out.campaign.name);
     return out;
 }
@@ -520,7 +522,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
 std::vector<ShearCampaignOutcome> ShearCampaignRunner::resume(const ProgressCallback& progress) {
     std::vector<ShearCampaignOutcome> outs;
     for (const auto& c : store_->campaigns()) {
-        if (c.kind != CampaignKind::shear || c.status == "complete") continue;
+        if (c.kind != CampaignKind::shear || c.status == CampaignStatus::complete) continue;
         outs.push_back(run(ShearCampaignSpec::from_json(c.spec), progress));
         if (outs.back().interrupted) break;
     }

@@ -123,7 +123,7 @@ TEST_CASE("resume does not take another replicate's result, copied into an inter
     {
         orchestrator::CampaignStore store(dir / "campaign.sqlite");
         store.mark_running(b->hash, 0, gone, "local");
-        store.set_campaign_status(store.campaigns().front().id, "interrupted");
+        store.set_campaign_status(store.campaigns().front().id, orchestrator::CampaignStatus::interrupted);
     }
     fs::copy_file(a->run_dir / "result.json", b->run_dir / "result.json", fs::copy_options::overwrite_existing);
     REQUIRE(test::run_demcal({"resume", dir.string()}, dir / "resume.log") == 0);
