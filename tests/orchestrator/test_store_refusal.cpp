@@ -119,6 +119,8 @@ TEST_CASE("status and resume refuse a newer schema, an unknown kind or an unread
         {"UPDATE meta SET value = '999' WHERE key = 'schema_version'", "schema_version 999 is newer than this demcal's"},
         {"UPDATE meta SET value = 'two' WHERE key = 'schema_version'", "schema_version 'two' is not a version demcal"},
         {"UPDATE campaigns SET kind = 'martian'", "campaign 1: kind 'martian' is not one demcal knows (shear"},
+        {"UPDATE campaigns SET status = 'paused'",
+         "campaign 1: campaign status 'paused' is not one demcal knows (open, complete, interrupted, failed)"},
         {"UPDATE campaigns SET spec = '{not json'", "campaigns.spec is not valid JSON"},
         {"UPDATE runs SET result = '{\"peak' WHERE rowid = 1", "runs.result is not valid JSON"},
         // rows edited to send demcal's writes outside the campaign, or to make nonsense of its line (probe 44)
