@@ -24,65 +24,49 @@ double now_seconds() {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-std::string to_string(RunState s) {
-    switch (s) {
-        case RunState::pending: return "pending";
-        case RunState::running: return "running";
-        case RunState::done: return "done";
-        case RunState::failed: return "failed";
-    }
-    return "?";
-}
-
-RunState run_state_from_string(const std::string& s) {
-    if (s == "pending") return RunState::pending;
-    if (s == "running") return RunState::running;
-    if (s == "done") return RunState::done;
-    if (s == "failed") return RunState::failed;
-    throw std::invalid_argument("store: unknown run state '" + analytics::shortened_text(s) + "' (a damaged store)");
-}
-
 namespace {
-constexpr std::pair<CampaignKind, const char*> kCampaignKindNames[] = {
-    {CampaignKind::shear, "shear"}, {CampaignKind::crosscheck_silo, "crosscheck_silo"}};
-}  // namespace
 
-std::string to_string(CampaignKind k) {
-    for (const auto& [kind, name] : kCampaignKindNames)
-        if (kind == k) return name;
+// The word the store holds for each value of a stored enum, one table each; the same table reads it back.
+template <class E, std::size_t N>
+using WordTable = std::pair<E, const char*>[N];
+
+constexpr WordTable<RunState, 4> kRunStateWords = {
+    {RunState::pending, "pending"}, {RunState::running, "running"}, {RunState::done, "done"}, {RunState::failed, "failed"}};
+constexpr WordTable<CampaignKind, 2> kCampaignKindWords = {{CampaignKind::shear, "shear"},
+                                                           {CampaignKind::crosscheck_silo, "crosscheck_silo"}};
+constexpr WordTable<CampaignStatus, 4> kCampaignStatusWords = {{CampaignStatus::open, "open"},
+                                                               {CampaignStatus::complete, "complete"},
+                                                               {CampaignStatus::interrupted, "interrupted"},
+                                                               {CampaignStatus::failed, "failed"}};
+
+template <class E, std::size_t N>
+std::string word_of(const WordTable<E, N>& table, E value) {
+    for (const auto& [v, word] : table)
+        if (v == value) return word;
     return "?";
 }
 
-CampaignKind campaign_kind_from_string(const std::string& s) {
+// Throws std::invalid_argument naming `what`, the word and the words known (a newer demcal's store, or a damaged one).
+template <class E, std::size_t N>
+E value_of(const WordTable<E, N>& table, const std::string& word, const std::string& what) {
     std::string known;
-    for (const auto& [kind, name] : kCampaignKindNames) {
-        if (s == name) return kind;
-        known += (known.empty() ? "" : ", ") + std::string(name);
+    for (const auto& [v, w] : table) {
+        if (word == w) return v;
+        known += (known.empty() ? "" : ", ") + std::string(w);
     }
-    throw std::invalid_argument("kind '" + analytics::shortened_text(s) + "' is not one demcal knows (" + known + ")");
+    throw std::invalid_argument(what + " '" + analytics::shortened_text(word) + "' is not one demcal knows (" + known +
+                                ")");
 }
 
-namespace {
-constexpr std::pair<CampaignStatus, const char*> kCampaignStatusNames[] = {{CampaignStatus::open, "open"},
-                                                                          {CampaignStatus::complete, "complete"},
-                                                                          {CampaignStatus::interrupted, "interrupted"},
-                                                                          {CampaignStatus::failed, "failed"}};
 }  // namespace
 
-std::string to_string(CampaignStatus s) {
-    for (const auto& [status, name] : kCampaignStatusNames)
-        if (status == s) return name;
-    return "?";
-}
-
+std::string to_string(RunState s) { return word_of(kRunStateWords, s); }
+RunState run_state_from_string(const std::string& s) { return value_of(kRunStateWords, s, "run state"); }
+std::string to_string(CampaignKind k) { return word_of(kCampaignKindWords, k); }
+CampaignKind campaign_kind_from_string(const std::string& s) { return value_of(kCampaignKindWords, s, "kind"); }
+std::string to_string(CampaignStatus s) { return word_of(kCampaignStatusWords, s); }
 CampaignStatus campaign_status_from_string(const std::string& s) {
-    std::string known;
-    for (const auto& [status, name] : kCampaignStatusNames) {
-        if (s == name) return status;
-        known += (known.empty() ? "" : ", ") + std::string(name);
-    }
-    throw std::invalid_argument("campaign status '" + analytics::shortened_text(s) + "' is not one demcal knows (" +
-                                known + ")");
+    return value_of(kCampaignStatusWords, s, "campaign status");
 }
 
 namespace {

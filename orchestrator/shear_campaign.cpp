@@ -360,6 +360,97 @@ ShearCampaignRunner::ShearCampaignRunner(const fs::path& dir, ExecutionOptions o
 
 ShearCampaignRunner::~ShearCampaignRunner() = default;
 
+namespace {
+
+// The runs a pass has to compute, each run folder written and each run entered in the store: the pending ones in
+// plan order, the done ones counted as reused.
+struct PreparedRuns {
+    std::deque<std::string> queue;                      // hashes to run
+    std::map<std::string, const PlannedRun*> by_hash;  // every distinct run of the plan
+    int reused = 0;
+};
+
+PreparedRuns prepare_runs(CampaignStore& store, std::int64_t campaign_id, const std::vector<PlannedRun>& plan,
+                          ShearEngine engine_kind, const EngineSetup& engine, bool force) {
+    PreparedRuns p;
+    for (const auto& r : plan) {
+        if (p.by_hash.count(r.hash)) continue;  // the same run twice in a plan (repeated stress) runs once
+        p.by_hash[r.hash] = &r;
+        if (engine_kind == ShearEngine::kernel)
+            write_kernel_run_directory(r, engine);
+        else
+            write_run_directory(r, engine.identity_text, engine.wrapper_text);
+        RunRecord rec = store.ensure_run(campaign_id, r.hash, r.params, r.dir, r.label);
+        if (force && rec.state != RunState::pending) {
+            store.reset_to_pending(r.hash, "forced recomputation");
+            rec.state = RunState::pending;
+        }
+        // a failure that is not the physics' verdict (a timeout, a crash, a lost SLURM task) is tried again by a new
+        // invocation (resume, or the same command; perhaps with a longer --timeout): one more attempt, then its
+        // retries as counted so far
+        if (rec.state == RunState::failed && !retry_is_pointless(rec.cause)) {
+            store.reset_to_pending(r.hash, "tried again: its last attempt ended by " + rec.cause);
+            rec.state = RunState::pending;
+        }
+        if (rec.state == RunState::done) ++p.reused;
+        if (rec.state == RunState::pending) p.queue.push_back(r.hash);
+    }
+    return p;
+}
+
+// What an attempt that ran to its end left: its result (cause empty) or the cause of its failure and a message.
+struct AttemptVerdict {
+    std::string cause, message;
+    nlohmann::json result;
+};
+
+AttemptVerdict judge_attempt(const JobOutcome& o, const fs::path& run_dir, const nlohmann::json& params) {
+    AttemptVerdict v{o.failure_cause, o.message, {}};
+    if (o.succeeded()) {
+        try {
+            v.result = read_shear_result(run_dir / "result.json", &params);
+        } catch (const DamagedResult& e) {
+            // damaged between its write and this read (disk, copy): not the run's physics, so run it again
+            v.cause = kDamagedResult;
+            v.message = std::string("exit code 0 but result.json is damaged: ") + e.what();
+        } catch (const std::exception& e) {
+            v.cause = "no_result";
+            v.message = std::string("exit code 0 but result.json is unusable: ") + e.what();
+        }
+    } else if (v.cause.empty()) {
+        v.cause = "exit_code";
+        v.message = "exit code " + std::to_string(o.exit_code) + (v.message.empty() ? "" : ": " + v.message);
+    }
+    return v;
+}
+
+// The time left: the mean wall time of the runs finished in this pass times the runs left, over the slots in use.
+double remaining_seconds(const CampaignProgress& prog, double finished_wall, int finished, int slots) {
+    if (finished == 0) return -1;
+    return (finished_wall / finished) * (prog.pending + 0.5 * prog.running) /
+           std::min(slots, std::max(1, prog.pending + prog.running));
+}
+
+// The campaign's runs as the store now holds them, its failures and CPU counted, and its status recorded.
+void conclude(CampaignStore& store, ShearCampaignOutcome& out) {
+    out.runs.clear();
+    for (auto& rec : store.campaign_runs(out.campaign.id)) {
+        if (rec.state == RunState::failed) ++out.failed;
+        if (rec.state == RunState::done) out.cpu_s += rec.cpu_s;
+        out.runs.push_back(std::move(rec));
+    }
+    const bool all_done = std::all_of(out.runs.begin(), out.runs.end(),
+                                      [](const RunRecord& r) { return r.state == RunState::done; });
+    store.set_campaign_status(out.campaign.id, all_done                               ? CampaignStatus::complete
+                                               : out.interrupted                      ? CampaignStatus::interrupted
+                                               : !out.infrastructure_failure.empty() ? CampaignStatus::open
+                                               : out.failed                           ? CampaignStatus::failed
+                                                                                      : CampaignStatus::open);
+    out.campaign = *store.find_campaign(out.campaign.name);
+}
+
+}  // namespace
+
 ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, const ProgressCallback& progress) {
     validate_shear_spec(spec_in);
     const ShearCampaignSpec spec = resolved(spec_in);
@@ -369,31 +460,10 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
 
     ShearCampaignOutcome out;
     out.campaign = store_->ensure_campaign(campaign_name(spec), CampaignKind::shear, spec.to_json());
-    std::deque<std::string> queue;
-    std::map<std::string, const PlannedRun*> by_hash;
-    std::set<std::string> seen;
-    for (const auto& r : plan) {
-        if (!seen.insert(r.hash).second) continue;  // the same run twice in a plan (repeated stress) runs once
-        by_hash[r.hash] = &r;
-        if (spec.engine == ShearEngine::kernel)
-            write_kernel_run_directory(r, engine);
-        else
-            write_run_directory(r, engine.identity_text, engine.wrapper_text);
-        RunRecord rec = store_->ensure_run(out.campaign.id, r.hash, r.params, r.dir, r.label);
-        if (options_.force && rec.state != RunState::pending) {
-            store_->reset_to_pending(r.hash, "forced recomputation");
-            rec.state = RunState::pending;
-        }
-        // a failure that is not the physics' verdict (a timeout, a crash, a lost SLURM task) is tried again by a new
-        // invocation (resume, or the same command; perhaps with a longer --timeout): one more attempt, then its
-        // retries as counted so far
-        if (rec.state == RunState::failed && !retry_is_pointless(rec.cause)) {
-            store_->reset_to_pending(r.hash, "tried again: its last attempt ended by " + rec.cause);
-            rec.state = RunState::pending;
-        }
-        if (rec.state == RunState::done) ++out.reused;
-        if (rec.state == RunState::pending) queue.push_back(r.hash);
-    }
+    PreparedRuns runs = prepare_runs(*store_, out.campaign.id, plan, spec.engine, engine, options_.force);
+    std::deque<std::string>& queue = runs.queue;
+    const auto& by_hash = runs.by_hash;
+    out.reused = runs.reused;
 
     CampaignProgress prog;
     prog.total = static_cast<int>(by_hash.size());
@@ -410,9 +480,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     auto report = [&](const std::string& event, const std::string& hash) {
         if (!progress) return;
         prog.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        prog.remaining_s = finished_here > 0 ? (finished_wall / finished_here) *
-                                                   (prog.pending + 0.5 * prog.running) / std::min(slots, std::max(1, prog.pending + prog.running))
-                                             : -1;
+        prog.remaining_s = remaining_seconds(prog, finished_wall, finished_here, slots);
         prog.event = event;
         std::optional<RunRecord> rec = store_->run(hash);
         if (rec) rec->label = by_hash.at(hash)->label;
@@ -439,42 +507,26 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         }
         finished_wall += o.wall_s;
         ++finished_here;
-        std::string cause = o.failure_cause, message = o.message;
-        nlohmann::json result;
-        if (o.succeeded()) {
-            try {
-                result = read_shear_result(job.dir / "result.json", &by_hash.at(job.id)->params);
-            } catch (const DamagedResult& e) {
-                // damaged between its write and this read (disk, copy): not the run's physics, so run it again
-                cause = kDamagedResult;
-                message = std::string("exit code 0 but result.json is damaged: ") + e.what();
-            } catch (const std::exception& e) {
-                cause = "no_result";
-                message = std::string("exit code 0 but result.json is unusable: ") + e.what();
-            }
-        } else if (cause.empty()) {
-            cause = "exit_code";
-            message = "exit code " + std::to_string(o.exit_code) + (message.empty() ? "" : ": " + message);
-        }
-        if (cause.empty()) {
-            store_->mark_done(job.id, result, o.exit_code, o.wall_s, o.cpu_s);
+        const AttemptVerdict v = judge_attempt(o, job.dir, by_hash.at(job.id)->params);
+        if (v.cause.empty()) {
+            store_->mark_done(job.id, v.result, o.exit_code, o.wall_s, o.cpu_s);
             ++out.executed;
             ++prog.done;
             report("done", job.id);
             return;
         }
-        if (cause == kSimulatorNotStarted) {
+        if (v.cause == kSimulatorNotStarted) {
             // the machine's fault, not the run's: the run stays pending for a resume with a working simulator, and
             // no further run is started (each would fail the same way)
-            store_->mark_attempt_failed(job.id, cause, message, o.exit_code, o.wall_s, o.cpu_s, false);
+            store_->mark_attempt_failed(job.id, v.cause, v.message, o.exit_code, o.wall_s, o.cpu_s, false);
             ++prog.pending;
-            if (out.infrastructure_failure.empty()) out.infrastructure_failure = message;
+            if (out.infrastructure_failure.empty()) out.infrastructure_failure = v.message;
             report("not started", job.id);
             return;
         }
         const int attempts = store_->run(job.id)->attempts;
-        const bool final = retry_is_pointless(cause) || attempts > options_.retries;
-        store_->mark_attempt_failed(job.id, cause, message, o.exit_code, o.wall_s, o.cpu_s, final);
+        const bool final = retry_is_pointless(v.cause) || attempts > options_.retries;
+        store_->mark_attempt_failed(job.id, v.cause, v.message, o.exit_code, o.wall_s, o.cpu_s, final);
         if (final) {
             ++prog.failed;
             report("failed", job.id);
@@ -501,21 +553,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
         if (!queue.empty()) executor->run(next, events);
         if (interrupted()) out.interrupted = true;
     }
-
-    out.runs.clear();
-    for (auto& rec : store_->campaign_runs(out.campaign.id)) {
-        if (rec.state == RunState::failed) ++out.failed;
-        if (rec.state == RunState::done) out.cpu_s += rec.cpu_s;
-        out.runs.push_back(std::move(rec));
-    }
-    const bool all_done = std::all_of(out.runs.begin(), out.runs.end(),
-                                      [](const RunRecord& r) { return r.state == RunState::done; });
-    store_->set_campaign_status(out.campaign.id, all_done                               ? CampaignStatus::complete
-                                                 : out.interrupted                      ? CampaignStatus::interrupted
-                                                 : !out.infrastructure_failure.empty() ? CampaignStatus::open
-                                                 : out.failed                           ? CampaignStatus::failed
-                                                                                        : CampaignStatus::open);
-    out.campaign = *store_->find_campaign(out.campaign.name);
+    conclude(*store_, out);
     return out;
 }
 
