@@ -133,6 +133,7 @@ void write_study(const fs::path& dir, const SensitivityStudy& study, const std::
             std::cerr << "demcal: warning: plot for " << p.name << " not written: " << e.what() << "\n";
         }
     }
+    keep_results();  // the study is whole: calibrate's loop, hours later, does not take it with a failure of its own
 }
 
 // Checks every level's material before anything is written or run: a bad range must not cost simulations.
@@ -375,6 +376,7 @@ void add_calibrate(CLI::App& app) {
                   << (o->sensitivity_file.empty() ? std::to_string(study.simulations_run) + " simulations run now"
                                                   : "read from " + o->sensitivity_file + " (not run now)")
                   << "\nmaterial: " << out.string() << "\n";
+        keep_results();  // what follows is the verdict on these results, not a failure to write them
         if (result.status == CalibrationStatus::unreachable) throw UserError("calibration stopped: " + result.message);
         if (result.status != CalibrationStatus::converged) throw std::runtime_error(result.message);
     });

@@ -155,6 +155,7 @@ void add_scale_command(CLI::App& app) {
         const auto print = [](const std::string& line) { std::cout << line << std::endl; };
         const auto study = calibration::run_enlargement_study(base, session.evaluate, options, print);
         write_outputs(study, *o);
+        keep_results();  // the study is written: an undetermined law below is its verdict, not a lost result
         print_summary(study, *o);
         if (!study.problems.empty() && !o->allow_unconverged) {
             std::string list;

@@ -145,6 +145,7 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
     } else {
         std::cout << "no failure line: fewer than 3 finished runs on 2 normal stresses\n";
     }
+    keep_results();  // this campaign's report is whole: a later campaign's failure (resume) does not take it
     if (outcome.interrupted) return 130;
     if (!outcome.infrastructure_failure.empty()) {
         std::cout << "the simulator could not be started (" << outcome.infrastructure_failure

@@ -30,6 +30,11 @@ void write_result_file(const std::filesystem::path& path, const std::string& tex
     orchestrator::write_text_file_atomically(path, text);
 }
 
+void keep_results() {
+    const std::lock_guard<std::mutex> lock(journal_mutex);
+    created_results.clear();
+}
+
 int discard_unfinished_results() {
     const std::lock_guard<std::mutex> lock(journal_mutex);
     int removed = 0;
