@@ -21,6 +21,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace demcal {
@@ -392,13 +393,17 @@ int run_diagnose(const DiagnoseArgs& a) {
         const std::filesystem::path report(a.report_out);
         if (report.has_parent_path()) std::filesystem::create_directories(report.parent_path());
         std::string before_name, after_name;
+        std::optional<ReportPlots> plots;
         if (!a.no_plots) {
-            const ReportPlots plots = report_plots(report);
-            before_name = plots.before.filename().string();
-            after_name = plots.after.filename().string();
-            plot_residuals(r, data, plots.data, plots.before, plots.after);
+            plots = report_plots(report);
+            before_name = plots->before.filename().string();
+            after_name = plots->after.filename().string();
         }
+        // the report before its plots: a run stopped while gnuplot draws (Ctrl-C) leaves the report, and the same
+        // command then replaces it and its side files (without it, they would be files it may not replace); a plot
+        // that fails takes the report with it (app/result_files.hpp)
         write_result_file(a.report_out, markdown_report(r, a.data, before_name, after_name));
+        if (plots) plot_residuals(r, data, plots->data, plots->before, plots->after);
     }
     if (r.undetermined.empty() || a.allow_undetermined) return 0;
     std::cout << "the diagnosis is not determined by these data (exit 1; --allow-undetermined: exit 0)\n";
