@@ -15,7 +15,9 @@ void validate(const CutoffSearch& s) {
     throw std::invalid_argument("bracket = [" + silo::setting_text(s.lo) + ", " + silo::setting_text(s.hi) +
                                 "]: needs 0 <= LO < HI <= 1000 Hz");
   if (!(s.tol > 0 && s.tol < s.hi - s.lo))
-    throw std::invalid_argument("tol = " + silo::setting_text(s.tol) + ": must be > 0 and below HI - LO");
+    throw std::invalid_argument("tol = " + silo::setting_text(s.tol) + " Hz: must be > 0 and below the bracket's width (" +
+                                silo::setting_text(s.hi - s.lo) + " Hz for bracket " + silo::setting_text(s.lo) + "," +
+                                silo::setting_text(s.hi) + ")");
   if (s.tol < std::ldexp(s.hi - s.lo, -kMaxBisections))
     throw std::invalid_argument("tol = " + silo::setting_text(s.tol) + ": finer than 2^-" +
                                 std::to_string(kMaxBisections) + " of the bracket: the bisection would not end");
