@@ -14,7 +14,6 @@
 #include "orchestrator/shear_params.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>

@@ -10,7 +10,6 @@
 #include "app/diagnose_silo_dem.hpp"
 #include "app/gnuplot.hpp"
 #include "app/result_files.hpp"
-#include "orchestrator/run_identity.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -18,7 +17,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -41,7 +39,6 @@ optional model constants (defaults in brackets):
   phi_d_deg [45] (Rose-Tanaka stagnant-zone angle to the horizontal),
   delta_e_deg, phi_w_deg (effective internal and wall friction angles: with both, Jenike's mass-flow limit decides
   the flow pattern and each model says whether it applies))";
-
 
 std::string fixed(double v, int digits) {
     char buf[64];
@@ -391,7 +388,6 @@ int run_diagnose(const DiagnoseArgs& a) {
     if (!a.json_out.empty()) write_result_file(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
         const std::filesystem::path report(a.report_out);
-        if (report.has_parent_path()) std::filesystem::create_directories(report.parent_path());
         std::string before_name, after_name;
         std::optional<ReportPlots> plots;
         if (!a.no_plots) {

@@ -100,7 +100,8 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     std::filesystem::path script = output, log = output;
     script += ".gp";
     log += ".gp.log";
-    for (const auto& f : gnuplot_files(output)) note_result_file(f);
+    note_result_file(output);  // the two files gnuplot writes; the script is noted by write_result_file
+    note_result_file(log);
     write_result_file(script, "set terminal " + terminal + "\nset output " + gnuplot_quote(output) + "\n" + body + "\n");
     // gnuplot without a shell: the script's path is one argument, whatever it holds
     posix_spawn_file_actions_t actions;

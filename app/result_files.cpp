@@ -16,10 +16,9 @@ std::vector<std::filesystem::path> created_results;  // in the order they were n
 
 void note_result_file(const std::filesystem::path& path) {
     std::error_code ec;
-    if (std::filesystem::exists(std::filesystem::symlink_status(path, ec))) return;  // there before: not ours
+    // there before: not ours (or ours already, noted when this command created it)
+    if (std::filesystem::exists(std::filesystem::symlink_status(path, ec))) return;
     const std::lock_guard<std::mutex> lock(journal_mutex);
-    for (const auto& p : created_results)
-        if (p == path) return;
     created_results.push_back(path);
 }
 
