@@ -245,22 +245,11 @@ class BasicSimulation {
   static constexpr const char* kStateFormat = "demcal-kernel-state/5";
   void prepare();
   void compute_forces(bool rebuild, double dt_history);
-  struct PairLoad {
-    Vec3 force_i, torque_j;  // one pair's force on i and torque on j, side by side for the gather's one read
-  };
-  // compute_forces' steps. One evaluation's settings, shared by its steps:
-  struct ForcePass {
-    PairLoad* load = nullptr;            // per pair: its force on i, its torque on j
-    Vec3* torque_i = nullptr;            // per pair: its torque on i (kept for an exact removal only, else null)
-    const double* omega_norm = nullptr;  // per sphere: |omega| (read if Law::uses_omega_norm)
-    double dt = 0;                       // the tangential springs advance by v_t dt
-    bool bond_now = false;               // YADE's setCohesionNow: bond the contacts acting in this evaluation
-  };
+  // compute_forces' steps around its pair and wall loop (which stays one loop: as functions, even inlined, its parts
+  // made the peer case 2.4-6.5 % slower, stop 52)
   void prepare_lists(bool rebuild);  // the neighbour list rebuilt if asked or stale, a loaded state's wall lists
-  [[gnu::always_inline]] void add_pair_loads(std::int64_t i, const ForcePass& pass, Vec3& fi, Vec3& ti);  // i's row of the half list
-  [[gnu::always_inline]] void add_wall_loads(std::int64_t i, const ForcePass& pass, Vec3& fi, Vec3& ti);  // i's walls and their histories
-  void add_partner_loads(const ForcePass& pass);  // each pair's load on its j (in the parallel region)
-  void sum_clump_loads();                         // each clump's force and torque (in the parallel region)
+  void add_partner_loads();          // each pair's load on its j (an `omp for` in compute_forces' region)
+  void sum_clump_loads();            // each clump's force and torque (likewise)
   bool kick_drift(double kick);
   void kick(double sign = 1.0);  // the second half kick of velocity Verlet; -1 takes it back
   void refresh_forces();         // forces of the current state after a change (step() calls it)
@@ -311,6 +300,9 @@ class BasicSimulation {
   std::vector<std::int32_t> wall_slot_id_;                  // kWallSlots per sphere, -1 empty
   std::vector<double> wall_slot_s_;                         // kWallSlots * kHist per sphere: history
   std::vector<Vec3> wall_slot_f_;                           // kWallSlots per sphere: force on the sphere
+  struct PairLoad {
+    Vec3 force_i, torque_j;  // one pair's force on i and torque on j, side by side for the gather's one read
+  };
   std::vector<PairLoad> pair_load_;                         // per pair (written and gathered in compute_forces)
   // Each pair's torque on i, recorded when exact removals are on (set_exact_removal: a removal then takes a removed
   // body's contacts out of its neighbours' loads); known: they are the last evaluation's (false after load_state)

@@ -592,12 +592,17 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   prepare_lists(rebuild);
   const std::int64_t n = std::int64_t(x_.size());
   pair_load_.resize(nl_.num_pairs());
+  PairLoad* load = pair_load_.data();
   if (exact_removal_) pair_torque_i_.resize(nl_.num_pairs());
-  ForcePass pass;
-  pass.load = pair_load_.data();
-  pass.torque_i = exact_removal_ ? pair_torque_i_.data() : nullptr;  // (recorded for an exact removal only)
-  pass.dt = dt_history;  // the tangential springs advance by vt * dt_history
-  pass.bond_now = bond_next_evaluation_;  // (YADE's setCohesionNow: the contacts acting in this evaluation)
+  Vec3* torque_i = exact_removal_ ? pair_torque_i_.data() : nullptr;  // (recorded for an exact removal only)
+  const int nm = nm_coeffs_;
+  const double dt = dt_history;  // the tangential springs advance by vt * dt_history
+  const int nw = int(walls_.size());
+  const std::uint32_t* row = nl_.row.data();
+  const std::int32_t* nbr = nl_.nbr.data();
+  double* hist = nl_.hist.data();
+  const double law_reach = law_reach_;
+  const bool bond_now = bond_next_evaluation_;  // (YADE's setCohesionNow: the contacts acting in this evaluation)
   bond_next_evaluation_ = false;
   // |omega| once per sphere, not once per contact side (a sphere has several contacts); kick_drift has filled it
   // unless the angular velocities changed otherwise since (a velocity set, bodies added, removed or renumbered)
@@ -605,9 +610,7 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
   if (Law::uses_omega_norm) omega_norm_.resize(std::size_t(n));
   omega_norm_fresh_ = false;  // the next kick changes omega
   double* wnorm = omega_norm_.data();
-  pass.omega_norm = wnorm;
-  const bool walls = !walls_.empty();
-  // The steps below run inside one parallel region: their loops are `omp for` directives bound to it.
+  // the steps below share one parallel region: their loops are `omp for` directives bound to it
 #pragma omp parallel num_threads(nt())
   {
     if (fill_omega_norm) {
@@ -620,12 +623,137 @@ void BasicSimulation<Law>::compute_forces(bool rebuild, double dt_history) {
 #pragma omp for schedule(dynamic, 512)
     for (std::int64_t i = 0; i < n; ++i) {
       Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
-      add_pair_loads(i, pass, fi, ti);
-      if (walls) add_wall_loads(i, pass, fi, ti);
+      const Vec3 xi = x_[i], vi = v_[i], wi = w_[i];
+      const double ri = r_[i], mi = mass_[i];
+      const typename Law::Coeffs* crow = coeffs_.data() + std::size_t(mat_[i]) * nm;
+      for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
+        const std::int32_t j = nbr[p];
+        double* h = hist + std::size_t(p) * kHist;
+        const Vec3 d = xi - x_[j];
+        const double rs = ri + r_[j];
+        const double d2 = d.squaredNorm();
+        const double reach = Law::beyond_contact ? rs + law_reach : rs;
+        if (d2 >= reach * reach) {
+          std::fill_n(h, kHist, 0.0);
+          load[p].force_i.setZero();
+          load[p].torque_j.setZero();
+          if (torque_i) torque_i[p].setZero();
+          continue;
+        }
+        const double dist = std::sqrt(d2);
+        const double rj = r_[j], mj = mass_[j];
+        ContactGeometry geo;
+        geo.n = d * (1.0 / dist);
+        geo.dn = rs - dist;
+        geo.radius_i = ri;
+        geo.radius_j = rj;
+        // R* = ri rj / (ri + rj), m* = mi mj / (mi + mj) with one division
+        const double q = 1.0 / (rs * (mi + mj));
+        geo.r_star = ri * rj * (mi + mj) * q;
+        geo.m_star = mi * mj * rs * q;
+        geo.lever_i = ri - 0.5 * geo.dn;
+        geo.lever_j = r_[j] - 0.5 * geo.dn;
+        const typename Law::Coeffs& coeffs = crow[mat_[j]];
+        if constexpr (Law::beyond_contact) {
+          if (!Law::acts(coeffs, geo, h)) {  // a gap the contact does not (or no longer) bridge
+            std::fill_n(h, kHist, 0.0);
+            load[p].force_i.setZero();
+            load[p].torque_j.setZero();
+            if (torque_i) torque_i[p].setZero();
+            continue;
+          }
+        }
+        ContactKinematics kin;
+        kin.omega_i = wi;
+        kin.omega_j = w_[j];
+        if (Law::uses_omega_norm) {
+          kin.omega_i_norm = wnorm[i];
+          kin.omega_j_norm = wnorm[j];
+        }
+        kin.v_rel = (vi - geo.lever_i * wi.cross(geo.n)) - (v_[j] + geo.lever_j * w_[j].cross(geo.n));
+        if constexpr (Law::uses_centre_velocities) {
+          kin.v_i = vi;
+          kin.v_j = v_[j];
+        }
+        const ContactResult res = Law::compute(coeffs, geo, kin, h, dt, false, bond_now);
+        fi += res.force_i;
+        ti += res.torque_i;
+        load[p].force_i = res.force_i;
+        load[p].torque_j = res.torque_j;
+        if (torque_i) torque_i[p] = res.torque_i;
+      }
+      // walls: up to kWallSlots simultaneous contacts keep a history
+      if (nw > 0) {
+        constexpr int kH = kHist > 0 ? kHist : 1;  // (no zero-length arrays)
+        std::int32_t* sid = &wall_slot_id_[std::size_t(i) * kWallSlots];
+        double* ss = wall_slot_s_.data() + std::size_t(i) * kWallSlots * kHist;
+        Vec3* sf = &wall_slot_f_[std::size_t(i) * kWallSlots];
+        std::int32_t nid[kWallSlots] = {-1, -1, -1};
+        double ns[kWallSlots][kH];
+        Vec3 nf[kWallSlots];
+        int used = 0;
+        // only the walls within reach at the last neighbour build, in ascending order: the set bits of the candidate
+        // mask, or past kMaxWallCandidates walls the sphere's candidate list; not a test of every wall
+        const bool masked = nw <= kMaxWallCandidates;
+        std::uint64_t candidates = masked ? wall_cand_[i] : 0;
+        std::uint32_t listed = masked ? 0 : wall_list_row_[i];
+        const std::uint32_t listed_end = masked ? 0 : wall_list_row_[i + 1];
+        auto next_candidate = [&]() -> int {
+          if (masked) return next_wall_candidate(candidates);
+          return listed < listed_end ? wall_list_[listed++] : nw;
+        };
+        for (int wdx = next_candidate(); wdx < nw; wdx = next_candidate()) {
+          const Wall& wall = walls_[wdx];
+          if (!wall.enabled) continue;
+          Vec3 nrm;
+          double dn, dist;
+          if (!wall.contact(xi, Law::beyond_contact ? ri + law_reach : ri, nrm, dn, dist)) continue;
+          double s[kH] = {};
+          for (int k = 0; k < kWallSlots; ++k)
+            if (sid[k] == wdx) std::copy_n(ss + k * kHist, kHist, s);
+          const typename Law::Coeffs& coeffs = crow[wall.material];
+          ContactGeometry geo;
+          geo.n = nrm;
+          geo.dn = Law::beyond_contact ? dn - law_reach : dn;
+          geo.radius_i = ri;
+          geo.radius_j = 0;
+          geo.r_star = ri;
+          geo.m_star = mi;
+          geo.lever_i = Law::lever_at_overlap_middle ? ri - 0.5 * geo.dn : dist;
+          geo.lever_j = 0;
+          if constexpr (Law::beyond_contact) {
+            if (!Law::acts(coeffs, geo, s)) continue;
+          }
+          ContactKinematics kin;
+          kin.omega_i = wi;
+          kin.omega_j = Vec3::Zero();
+          if (Law::uses_omega_norm) kin.omega_i_norm = wnorm[i];
+          kin.v_rel = vi - geo.lever_i * wi.cross(nrm) - wall.velocity;
+          if constexpr (Law::uses_centre_velocities) {
+            kin.v_i = vi;
+            kin.v_j = wall.velocity;
+          }
+          const ContactResult res = Law::compute(coeffs, geo, kin, s, dt, true, bond_now);
+          fi += res.force_i;
+          ti += res.torque_i;
+          if (used < kWallSlots) {
+            nid[used] = wdx;
+            std::copy_n(s, kHist, ns[used]);
+            nf[used] = res.force_i;
+            ++used;
+          }
+        }
+        if (used > 0 || sid[0] >= 0)  // (slots are filled from the front: sid[0] < 0 means all empty)
+          for (int k = 0; k < kWallSlots; ++k) {
+            sid[k] = nid[k];
+            for (int m = 0; m < kHist; ++m) ss[k * kHist + m] = k < used ? ns[k][m] : 0.0;
+            sf[k] = k < used ? nf[k] : Vec3::Zero();
+          }
+      }
       f_[i] = fi;
       t_[i] = ti;
     }
-    add_partner_loads(pass);
+    add_partner_loads();
     sum_clump_loads();
   }
   pair_torques_i_known_ = exact_removal_;
@@ -648,161 +776,9 @@ void BasicSimulation<Law>::prepare_lists(bool rebuild) {
 }
 
 template <class Law>
-inline void BasicSimulation<Law>::add_pair_loads(std::int64_t i, const ForcePass& pass, Vec3& f_sum, Vec3& t_sum) {
-  // sums kept in locals: written through the references, they could alias the pair loads stored below
-  Vec3 fi = f_sum, ti = t_sum;
-  PairLoad* load = pass.load;
-  Vec3* torque_i = pass.torque_i;
-  const std::uint32_t* row = nl_.row.data();
-  const std::int32_t* nbr = nl_.nbr.data();
-  double* hist = nl_.hist.data();
-  const double law_reach = law_reach_;
-  const Vec3 xi = x_[i], vi = v_[i], wi = w_[i];
-  const double ri = r_[i], mi = mass_[i];
-  const typename Law::Coeffs* crow = coeffs_.data() + std::size_t(mat_[i]) * nm_coeffs_;
-  for (std::uint32_t p = row[i]; p < row[i + 1]; ++p) {
-    const std::int32_t j = nbr[p];
-    double* h = hist + std::size_t(p) * kHist;
-    const Vec3 d = xi - x_[j];
-    const double rs = ri + r_[j];
-    const double d2 = d.squaredNorm();
-    const double reach = Law::beyond_contact ? rs + law_reach : rs;
-    if (d2 >= reach * reach) {
-      std::fill_n(h, kHist, 0.0);
-      load[p].force_i.setZero();
-      load[p].torque_j.setZero();
-      if (torque_i) torque_i[p].setZero();
-      continue;
-    }
-    const double dist = std::sqrt(d2);
-    const double rj = r_[j], mj = mass_[j];
-    ContactGeometry geo;
-    geo.n = d * (1.0 / dist);
-    geo.dn = rs - dist;
-    geo.radius_i = ri;
-    geo.radius_j = rj;
-    // R* = ri rj / (ri + rj), m* = mi mj / (mi + mj) with one division
-    const double q = 1.0 / (rs * (mi + mj));
-    geo.r_star = ri * rj * (mi + mj) * q;
-    geo.m_star = mi * mj * rs * q;
-    geo.lever_i = ri - 0.5 * geo.dn;
-    geo.lever_j = r_[j] - 0.5 * geo.dn;
-    const typename Law::Coeffs& coeffs = crow[mat_[j]];
-    if constexpr (Law::beyond_contact) {
-      if (!Law::acts(coeffs, geo, h)) {  // a gap the contact does not (or no longer) bridge
-        std::fill_n(h, kHist, 0.0);
-        load[p].force_i.setZero();
-        load[p].torque_j.setZero();
-        if (torque_i) torque_i[p].setZero();
-        continue;
-      }
-    }
-    ContactKinematics kin;
-    kin.omega_i = wi;
-    kin.omega_j = w_[j];
-    if (Law::uses_omega_norm) {
-      kin.omega_i_norm = pass.omega_norm[i];
-      kin.omega_j_norm = pass.omega_norm[j];
-    }
-    kin.v_rel = (vi - geo.lever_i * wi.cross(geo.n)) - (v_[j] + geo.lever_j * w_[j].cross(geo.n));
-    if constexpr (Law::uses_centre_velocities) {
-      kin.v_i = vi;
-      kin.v_j = v_[j];
-    }
-    const ContactResult res = Law::compute(coeffs, geo, kin, h, pass.dt, false, pass.bond_now);
-    fi += res.force_i;
-    ti += res.torque_i;
-    load[p].force_i = res.force_i;
-    load[p].torque_j = res.torque_j;
-    if (torque_i) torque_i[p] = res.torque_i;
-  }
-  f_sum = fi;
-  t_sum = ti;
-}
-
-template <class Law>
-inline void BasicSimulation<Law>::add_wall_loads(std::int64_t i, const ForcePass& pass, Vec3& f_sum, Vec3& t_sum) {
-  // sums kept in locals: written through the references, they could alias the pair loads stored below
-  Vec3 fi = f_sum, ti = t_sum;
-  // up to kWallSlots simultaneous contacts keep a history
-  constexpr int kH = kHist > 0 ? kHist : 1;  // (no zero-length arrays)
-  const int nw = int(walls_.size());
-  const double law_reach = law_reach_;
-  const Vec3 xi = x_[i], vi = v_[i], wi = w_[i];
-  const double ri = r_[i], mi = mass_[i];
-  const typename Law::Coeffs* crow = coeffs_.data() + std::size_t(mat_[i]) * nm_coeffs_;
-  std::int32_t* sid = &wall_slot_id_[std::size_t(i) * kWallSlots];
-  double* ss = wall_slot_s_.data() + std::size_t(i) * kWallSlots * kHist;
-  Vec3* sf = &wall_slot_f_[std::size_t(i) * kWallSlots];
-  std::int32_t nid[kWallSlots] = {-1, -1, -1};
-  double ns[kWallSlots][kH];
-  Vec3 nf[kWallSlots];
-  int used = 0;
-  // only the walls within reach at the last neighbour build, in ascending order: the set bits of the candidate
-  // mask, or past kMaxWallCandidates walls the sphere's candidate list; not a test of every wall
-  const bool masked = nw <= kMaxWallCandidates;
-  std::uint64_t candidates = masked ? wall_cand_[i] : 0;
-  std::uint32_t listed = masked ? 0 : wall_list_row_[i];
-  const std::uint32_t listed_end = masked ? 0 : wall_list_row_[i + 1];
-  auto next_candidate = [&]() -> int {
-    if (masked) return next_wall_candidate(candidates);
-    return listed < listed_end ? wall_list_[listed++] : nw;
-  };
-  for (int wdx = next_candidate(); wdx < nw; wdx = next_candidate()) {
-    const Wall& wall = walls_[wdx];
-    if (!wall.enabled) continue;
-    Vec3 nrm;
-    double dn, dist;
-    if (!wall.contact(xi, Law::beyond_contact ? ri + law_reach : ri, nrm, dn, dist)) continue;
-    double s[kH] = {};
-    for (int k = 0; k < kWallSlots; ++k)
-      if (sid[k] == wdx) std::copy_n(ss + k * kHist, kHist, s);
-    const typename Law::Coeffs& coeffs = crow[wall.material];
-    ContactGeometry geo;
-    geo.n = nrm;
-    geo.dn = Law::beyond_contact ? dn - law_reach : dn;
-    geo.radius_i = ri;
-    geo.radius_j = 0;
-    geo.r_star = ri;
-    geo.m_star = mi;
-    geo.lever_i = Law::lever_at_overlap_middle ? ri - 0.5 * geo.dn : dist;
-    geo.lever_j = 0;
-    if constexpr (Law::beyond_contact) {
-      if (!Law::acts(coeffs, geo, s)) continue;
-    }
-    ContactKinematics kin;
-    kin.omega_i = wi;
-    kin.omega_j = Vec3::Zero();
-    if (Law::uses_omega_norm) kin.omega_i_norm = pass.omega_norm[i];
-    kin.v_rel = vi - geo.lever_i * wi.cross(nrm) - wall.velocity;
-    if constexpr (Law::uses_centre_velocities) {
-      kin.v_i = vi;
-      kin.v_j = wall.velocity;
-    }
-    const ContactResult res = Law::compute(coeffs, geo, kin, s, pass.dt, true, pass.bond_now);
-    fi += res.force_i;
-    ti += res.torque_i;
-    if (used < kWallSlots) {
-      nid[used] = wdx;
-      std::copy_n(s, kHist, ns[used]);
-      nf[used] = res.force_i;
-      ++used;
-    }
-  }
-  if (used > 0 || sid[0] >= 0)  // (slots are filled from the front: sid[0] < 0 means all empty)
-    for (int k = 0; k < kWallSlots; ++k) {
-      sid[k] = nid[k];
-      for (int m = 0; m < kHist; ++m) ss[k * kHist + m] = k < used ? ns[k][m] : 0.0;
-      sf[k] = k < used ? nf[k] : Vec3::Zero();
-    }
-  f_sum = fi;
-  t_sum = ti;
-}
-
-template <class Law>
-void BasicSimulation<Law>::add_partner_loads(const ForcePass& pass) {
+void BasicSimulation<Law>::add_partner_loads() {
   // the j-side of each pair, gathered in a fixed order (ascending i); an `omp for` of compute_forces' region
-  const PairLoad* load = pass.load;
+  const PairLoad* load = pair_load_.data();
   const std::uint32_t* trow = nl_.trow.data();
   const std::uint32_t* tpair = nl_.tpair.data();
   const std::int64_t n = std::int64_t(x_.size());
