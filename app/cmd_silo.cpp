@@ -730,16 +730,19 @@ std::string cpu_text(const ks::SiloCaseResult& r) {
 // A time that may be unknown (NaN) as JSON: the number or null.
 nlohmann::json seconds_or_null(double seconds) { return std::isfinite(seconds) ? nlohmann::json(seconds) : nullptr; }
 
-void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
-    if (r.suspended) {  // nothing final to write: the checkpoint holds the run
-        std::cout << "\nsuspended: " << r.stop_reason << ", "
-                  << (r.discharge_time > 0 ? fixed(r.discharge_time, 3) + " s after the opening" : "while filling")
-                  << " (" << r.steps << " steps, " << r.grains_discharged << " grains discharged); checkpoint "
-                  << r.checkpoints << " written to " << s.checkpoint_file << "\nwall time so far "
-                  << duration_text(r.wall_s) << ", " << cpu_text(r) << "; continue with `demcal silo --resume "
-                  << dir.string() << "`" << std::endl;
-        throw CLI::RuntimeError(kExitSuspended);
-    }
+// A run stopped before its end (a time budget, a signal): where it stands and how to go on; exits kExitSuspended.
+[[noreturn]] void report_suspension(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
+    std::cout << "\nsuspended: " << r.stop_reason << ", "
+              << (r.discharge_time > 0 ? fixed(r.discharge_time, 3) + " s after the opening" : "while filling")
+              << " (" << r.steps << " steps, " << r.grains_discharged << " grains discharged); checkpoint "
+              << r.checkpoints << " written to " << s.checkpoint_file << "\nwall time so far "
+              << duration_text(r.wall_s) << ", " << cpu_text(r) << "; continue with `demcal silo --resume "
+              << dir.string() << "`" << std::endl;
+    throw CLI::RuntimeError(kExitSuspended);
+}
+
+// The run's summary.json (before its seal).
+nlohmann::json summary_json(const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
     nlohmann::json j;
     j["schema"] = orchestrator::kSiloSummarySchema;
     j["geometry"] = silo_geometry_json(s.geometry);
@@ -820,6 +823,13 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                      {"material", silo_material_json(s.materials)},
                      {"contact_law", r.contact_law}};
     if (!s.vtk_dir.empty()) j["vtk"] = {{"dir", s.vtk_dir}, {"files", r.vtk_files}};
+    return j;
+}
+
+// discharge.csv, then the sealed summary.json that marks the run finished; either both or neither (exit 74: the
+// campaigns run it again). The results written, the checkpoint has served its purpose and is removed.
+void write_results(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r,
+                   const nlohmann::json& j) {
     try {
         // (the table first, then the summary that marks the run finished; a failure removes the table again below)
         orchestrator::write_text_file_atomically(dir / "discharge.csv", ks::discharge_csv_text(r.discharge));
@@ -848,8 +858,10 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
         fs::remove(s.checkpoint_file, ec);
         fs::remove(s.checkpoint_file + ".tmp", ec);
     }
-    if (!no_plots) write_plots(dir, s, r);  // after the results: a plot that fails loses no data
+}
 
+// The run in a few lines on stdout.
+void print_summary(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
     std::cout << "\n" << r.grains << " grains (" << fixed(r.filled_mass * 1e3, 1) << " g), filled in "
               << fixed(r.fill_time, 3) << " s" << (r.fill_at_rest ? " (at rest)" : " (time limit, not at rest)")
               << ", bulk density " << fixed(r.bulk_density, 0) << " kg/m^3\n";
@@ -857,8 +869,9 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
               << r.stop_reason << ")\n";
     if (r.fit.ok)
         std::cout << "rate W = " << fixed(r.fit.rate * 1e3, 2) << " +/- " << fixed(r.fit.rate_se * 1e3, 2)
-                  << " g/s (slope SE; batch SE " << fixed(r.fit.rate_batch_se * 1e3, 2) << " g/s) (steady part " << fixed(r.fit.t_begin, 3) << ".." << fixed(r.fit.t_end, 3)
-                  << " s), R^2 = " << fixed(r.fit.r_squared, 5) << "\n";
+                  << " g/s (slope SE; batch SE " << fixed(r.fit.rate_batch_se * 1e3, 2) << " g/s) (steady part "
+                  << fixed(r.fit.t_begin, 3) << ".." << fixed(r.fit.t_end, 3) << " s), R^2 = "
+                  << fixed(r.fit.r_squared, 5) << "\n";
     else
         std::cout << "rate: not determined (" << r.fit.message << ")\n";
     if (s.vibration.vibrates()) std::cout << "vibration: " << vibration_text(s) << "\n";
@@ -870,6 +883,13 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     std::cout << ", " << cpu_text(r);
     std::cout << "\nwrote " << (dir / "summary.json").string() << ", "
               << (dir / "discharge.csv").string() << (no_plots ? "" : ", section.png, discharge.png") << "\n";
+}
+
+void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
+    if (r.suspended) report_suspension(dir, s, r);  // nothing final to write: the checkpoint holds the run
+    write_results(dir, s, r, summary_json(s, r));
+    if (!no_plots) write_plots(dir, s, r);  // after the results: a plot that fails loses no data
+    print_summary(dir, s, r, no_plots);
 }
 
 // Every option of `demcal silo`, into `o`.
