@@ -170,143 +170,165 @@ nlohmann::json DischargePrediction::to_json() const {
     return j;
 }
 
-std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
-    validate(g);
+namespace {
+
+// Jenike's conical limit decides the flow pattern; for a wedge the plane-flow limit is wider, so the conical limit
+// only proves mass flow there (theta below it), it cannot prove funnel flow.
+struct FlowPatternCheck {
+    std::optional<bool> mass_flow;  // unknown without the effective and wall friction angles
+    std::string note = "flow pattern unknown: give delta_e_deg and phi_w_deg to check it";
+};
+
+FlowPatternCheck check_flow_pattern(const SiloGeometry& g) {
+    FlowPatternCheck c;
+    if (!g.effective_friction_deg) return c;
+    const double theta = g.half_angle_deg;
+    const double limit = jenike_mass_flow_limit_deg(*g.effective_friction_deg, *g.wall_friction_deg);
+    if (theta < limit) {
+        c.mass_flow = true;
+        c.note = "mass flow (theta " + number_text(theta) + " < Jenike limit " + number_text(limit) + " deg)";
+    } else if (g.shape == SiloShape::conical) {
+        c.mass_flow = false;
+        c.note = "funnel flow (theta " + number_text(theta) + " >= Jenike limit " + number_text(limit) + " deg)";
+    } else {
+        c.note = "theta " + number_text(theta) + " >= conical Jenike limit " + number_text(limit) +
+                 " deg; the plane-flow limit of a wedge is wider, flow pattern not decided";
+    }
+    return c;
+}
+
+// The checks the models share, each adding its warning to a prediction (and invalidating it where it rules it out).
+void check_funnel_flow_model(DischargePrediction& p, const FlowPatternCheck& flow) {
+    if (flow.mass_flow == true) {
+        p.valid = false;
+        p.warnings.push_back("a funnel-flow model used in " + flow.note);
+    } else if (!flow.mass_flow) {
+        p.warnings.push_back(flow.note);
+    }
+}
+
+void check_mass_flow_model(DischargePrediction& p, const FlowPatternCheck& flow) {
+    if (flow.mass_flow == false) {
+        p.valid = false;
+        p.warnings.push_back("a mass-flow model used in " + flow.note);
+    } else if (!flow.mass_flow) {
+        p.warnings.push_back(flow.note);
+    }
+}
+
+void check_outlet_ratio(DischargePrediction& p, const SiloGeometry& g) {
+    if (g.outlet < min_outlet_particle_ratio * g.particle_size) {
+        p.valid = false;
+        p.warnings.push_back("outlet/d_p = " + number_text(g.outlet / g.particle_size) + " < " +
+                             number_text(min_outlet_particle_ratio) +
+                             ": intermittent flow and clogging, correlation not valid");
+    }
+}
+
+// Every model here is for coarse, free-flowing grains: below about 0.4 mm the interstitial air's pressure gradient
+// slows the flow (Nedderman 1992, Statics and Kinematics of Granular Materials) and they overpredict it.
+void check_coarse_particles(DischargePrediction& p, const SiloGeometry& g) {
+    if (p.rate && g.particle_size < min_coarse_particle_size) {
+        p.valid = false;
+        p.warnings.push_back("d_p = " + number_text(g.particle_size) + " m < " + number_text(min_coarse_particle_size) +
+                             " m: a fine powder, the interstitial air slows the flow, the model overpredicts");
+    }
+}
+
+// A model of the other silo shape: no rate, and why.
+bool refuse_shape(DischargePrediction& p, const SiloGeometry& g, SiloShape applies_to) {
+    if (g.shape == applies_to) return false;
+    p.valid = false;
+    p.warnings.push_back(std::string("applies to ") + (applies_to == SiloShape::conical ? "conical" : "rectangular") +
+                         " silos only");
+    return true;
+}
+
+// One function per model: its rate where it applies, its warnings.
+DischargePrediction predict_beverloo(const SiloGeometry& g) {
+    DischargePrediction p;
+    p.model = "beverloo";
+    if (refuse_shape(p, g, SiloShape::conical)) return p;
+    p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k);
+    check_outlet_ratio(p, g);
+    if (g.silo_diameter < min_silo_outlet_ratio * g.outlet)
+        p.warnings.push_back("D/d = " + number_text(g.silo_diameter / g.outlet) + " < 2.5: wall effects likely");
+    if (rose_tanaka_factor(g.half_angle_deg, g.stagnant_angle_deg) > 1.0)
+        p.warnings.push_back("hopper steeper than the stagnant zone (theta < 90 - phi_d): Beverloo "
+                             "underestimates, see beverloo+rose-tanaka");
+    check_coarse_particles(p, g);
+    return p;
+}
+
+DischargePrediction predict_beverloo_rose_tanaka(const SiloGeometry& g) {
+    DischargePrediction p;
+    p.model = "beverloo+rose-tanaka";
+    if (refuse_shape(p, g, SiloShape::conical)) return p;
+    p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k) *
+             rose_tanaka_factor(g.half_angle_deg, g.stagnant_angle_deg);
+    check_outlet_ratio(p, g);
+    check_coarse_particles(p, g);
+    return p;
+}
+
+DischargePrediction predict_beverloo_slot(const SiloGeometry& g) {
+    DischargePrediction p;
+    p.model = "beverloo-slot";
+    if (refuse_shape(p, g, SiloShape::rectangular)) return p;
+    p.rate = beverloo_slot_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.slot_c, g.beverloo_k);
+    check_outlet_ratio(p, g);
+    check_coarse_particles(p, g);
+    return p;
+}
+
+DischargePrediction predict_johanson(const SiloGeometry& g, const FlowPatternCheck& flow) {
     const bool conical = g.shape == SiloShape::conical;
     const double theta = g.half_angle_deg;
-    // Flow pattern from Jenike's conical limit; for a wedge the plane-flow limit is wider, so the conical limit only
-    // proves mass flow there (theta below it), it cannot prove funnel flow.
-    std::optional<bool> mass_flow;
-    std::string pattern_note = "flow pattern unknown: give delta_e_deg and phi_w_deg to check it";
-    if (g.effective_friction_deg) {
-        const double limit = jenike_mass_flow_limit_deg(*g.effective_friction_deg, *g.wall_friction_deg);
-        if (theta < limit) {
-            mass_flow = true;
-            pattern_note = "mass flow (theta " + number_text(theta) + " < Jenike limit " + number_text(limit) + " deg)";
-        } else if (conical) {
-            mass_flow = false;
-            pattern_note = "funnel flow (theta " + number_text(theta) + " >= Jenike limit " + number_text(limit) + " deg)";
-        } else {
-            pattern_note = "theta " + number_text(theta) + " >= conical Jenike limit " + number_text(limit) +
-                           " deg; the plane-flow limit of a wedge is wider, flow pattern not decided";
-        }
-    }
-    auto funnel_flow_model = [&](DischargePrediction& p) {
-        if (mass_flow == true) {
-            p.valid = false;
-            p.warnings.push_back("a funnel-flow model used in " + pattern_note);
-        } else if (!mass_flow) {
-            p.warnings.push_back(pattern_note);
-        }
-    };
-    auto needs_outlet_ratio = [&](DischargePrediction& p, double outlet) {
-        if (outlet < min_outlet_particle_ratio * g.particle_size) {
-            p.valid = false;
-            p.warnings.push_back("outlet/d_p = " + number_text(outlet / g.particle_size) + " < " +
-                                 number_text(min_outlet_particle_ratio) + ": intermittent flow and clogging, correlation not valid");
-        }
-    };
-    // Every model here is for coarse, free-flowing grains: below about 0.4 mm the interstitial air's pressure gradient
-    // slows the flow (Nedderman 1992, Statics and Kinematics of Granular Materials) and they overpredict it.
-    auto needs_coarse_particles = [&](DischargePrediction& p) {
-        if (g.particle_size < min_coarse_particle_size) {
-            p.valid = false;
-            p.warnings.push_back("d_p = " + number_text(g.particle_size) + " m < " +
-                                 number_text(min_coarse_particle_size) +
-                                 " m: a fine powder, the interstitial air slows the flow, the model overpredicts");
-        }
-    };
-    auto wrong_shape = [&](DischargePrediction& p) {
+    DischargePrediction p;
+    p.model = conical ? "johanson-conical" : "johanson-wedge";
+    if (theta >= 90.0) {
         p.valid = false;
-        p.warnings.push_back(std::string("applies to ") + (conical ? "rectangular" : "conical") + " silos only");
-    };
+        p.warnings.push_back("flat bottom (theta = 90): Johanson's hopper model does not apply");
+        return p;
+    }
+    p.rate = conical ? johanson_conical_rate(g.outlet, theta, g.bulk_density)
+                     : johanson_wedge_rate(g.depth, g.outlet, theta, g.bulk_density);
+    check_mass_flow_model(p, flow);
+    check_coarse_particles(p, g);
+    return p;
+}
 
-    std::vector<DischargePrediction> out;
-    {
-        DischargePrediction p;
-        p.model = "beverloo";
-        if (!conical) wrong_shape(p);
-        else {
-            p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k);
-            needs_outlet_ratio(p, g.outlet);
-            if (g.silo_diameter < min_silo_outlet_ratio * g.outlet)
-                p.warnings.push_back("D/d = " + number_text(g.silo_diameter / g.outlet) + " < 2.5: wall effects likely");
-            if (rose_tanaka_factor(theta, g.stagnant_angle_deg) > 1.0)
-                p.warnings.push_back("hopper steeper than the stagnant zone (theta < 90 - phi_d): Beverloo "
-                                     "underestimates, see beverloo+rose-tanaka");
-        }
-        if (p.rate) needs_coarse_particles(p);
-        out.push_back(p);
+DischargePrediction predict_oldal(const SiloGeometry& g, const FlowPatternCheck& flow) {
+    DischargePrediction p;
+    p.model = "oldal";
+    if (refuse_shape(p, g, SiloShape::conical)) return p;
+    p.rate = oldal_rate(g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
+    check_funnel_flow_model(p, flow);
+    check_coarse_particles(p, g);
+    return p;
+}
+
+DischargePrediction predict_oldal_rectangular(const SiloGeometry& g, const FlowPatternCheck& flow) {
+    DischargePrediction p;
+    p.model = "oldal-rect";
+    if (refuse_shape(p, g, SiloShape::rectangular)) return p;
+    p.rate = oldal_rectangular_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
+    for (auto& w : oldal_rectangular_limit_violations(g.depth, g.width, g.outlet)) {
+        p.valid = false;
+        p.warnings.push_back(w);
     }
-    {
-        DischargePrediction p;
-        p.model = "beverloo+rose-tanaka";
-        if (!conical) wrong_shape(p);
-        else {
-            p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k) *
-                     rose_tanaka_factor(theta, g.stagnant_angle_deg);
-            needs_outlet_ratio(p, g.outlet);
-        }
-        if (p.rate) needs_coarse_particles(p);
-        out.push_back(p);
-    }
-    {
-        DischargePrediction p;
-        p.model = "beverloo-slot";
-        if (conical) wrong_shape(p);
-        else {
-            p.rate = beverloo_slot_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.slot_c, g.beverloo_k);
-            needs_outlet_ratio(p, g.outlet);
-        }
-        if (p.rate) needs_coarse_particles(p);
-        out.push_back(p);
-    }
-    {
-        DischargePrediction p;
-        p.model = conical ? "johanson-conical" : "johanson-wedge";
-        if (theta >= 90.0) {
-            p.valid = false;
-            p.warnings.push_back("flat bottom (theta = 90): Johanson's hopper model does not apply");
-        } else {
-            p.rate = conical ? johanson_conical_rate(g.outlet, theta, g.bulk_density)
-                             : johanson_wedge_rate(g.depth, g.outlet, theta, g.bulk_density);
-            if (mass_flow == false) {
-                p.valid = false;
-                p.warnings.push_back("a mass-flow model used in " + pattern_note);
-            } else if (!mass_flow) {
-                p.warnings.push_back(pattern_note);
-            }
-        }
-        if (p.rate) needs_coarse_particles(p);
-        out.push_back(p);
-    }
-    {
-        DischargePrediction p;
-        p.model = "oldal";
-        if (!conical) wrong_shape(p);
-        else {
-            p.rate = oldal_rate(g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
-            funnel_flow_model(p);
-        }
-        if (p.rate) needs_coarse_particles(p);
-        out.push_back(p);
-    }
-    {
-        DischargePrediction p;
-        p.model = "oldal-rect";
-        if (conical) wrong_shape(p);
-        else {
-            p.rate = oldal_rectangular_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
-            for (auto& w : oldal_rectangular_limit_violations(g.depth, g.width, g.outlet)) {
-                p.valid = false;
-                p.warnings.push_back(w);
-            }
-            funnel_flow_model(p);
-        }
-        if (p.rate) needs_coarse_particles(p);
-        out.push_back(p);
-    }
-    return out;
+    check_funnel_flow_model(p, flow);
+    check_coarse_particles(p, g);
+    return p;
+}
+
+}  // namespace
+
+std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
+    validate(g);
+    const FlowPatternCheck flow = check_flow_pattern(g);
+    return {predict_beverloo(g), predict_beverloo_rose_tanaka(g), predict_beverloo_slot(g),
+            predict_johanson(g, flow), predict_oldal(g, flow), predict_oldal_rectangular(g, flow)};
 }
 
 SiloGeometry geometry_from_json(const nlohmann::json& j) {
