@@ -319,15 +319,16 @@ void check_planned_runs(const SiloDemArgs& a, const an::SiloMeasurements& data, 
                                       std::to_string(a.refine_steps) + " refine steps)) materials");
 }
 
-}  // namespace
+// What the diagnosis starts from, read and checked before any run (issue 23: outputs first): the measurements, the
+// declared material, the candidates to try.
+struct SiloDemInputs {
+    an::SiloMeasurements data;
+    json declared;
+    std::vector<an::DemEffectCandidate> candidates;
+};
 
-std::string default_silo_dem_campaign(const std::string& data_path) {
-    return "silo_dem_" + fs::path(data_path).stem().string();
-}
-
-int run_silo_dem_diagnosis(const SiloDemArgs& input) {
-    SiloDemArgs a = input;
-    if (a.campaign.empty()) a.campaign = default_silo_dem_campaign(a.data);
+SiloDemInputs read_silo_dem_inputs(const SiloDemArgs& a) {
+    SiloDemInputs in;
     if (a.material.empty()) throw UserError("--material: silo-dem needs the declared silo material (a JSON file)");
     // outputs first (issue 23): a path that cannot be written is refused before any run
     check_output_file_in_new_folders(a.json_out, "--json");
@@ -337,7 +338,7 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
     if (fs::exists(a.campaign) && !fs::is_directory(a.campaign))
         throw UserError("--campaign = '" + a.campaign + "' is a file; give a folder");
     check_output_file_in_new_folders((fs::path(a.campaign) / "campaign.json").string(), "--campaign");
-    an::SiloMeasurements data;
+    an::SiloMeasurements& data = in.data;
     try {
         data = an::read_silo_measurements(a.data);
     } catch (const std::invalid_argument& e) {
@@ -352,25 +353,17 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
                         std::to_string(data.conditions.size()) +
                         " conditions: silo-dem needs at least 3 conditions (leave-one-out) and repeats of one at least "
                         "(the noise scale)");
-    const json declared = read_json_file(a.material, "--material");
+    in.declared = read_json_file(a.material, "--material");
     const auto defects = an::candidate_table_defects(an::dem_effect_candidates());
     if (!defects.empty()) throw std::logic_error("the DEM candidate table: " + defects.front());
-    const auto candidates = chosen_candidates(a.candidates);
-    check_planned_runs(a, data, declared, candidates);
-    SiloDemCampaign campaign(a, data, declared);
-    campaign.check_settings();  // silo's own checks of every condition and the material, nothing written
-    const json settings{{"command", "diagnose --model silo-dem"}, {"silo_args", a.silo_args},
-                        {"first_seed", a.first_seed}, {"prediction_seeds", a.seeds}};
-    // runs are named by material, condition and seed, so more (or other) prediction seeds reuse the runs already made:
-    // the design for separating a rival asks for exactly that (--seeds m)
-    open_silo_campaign(a.campaign, settings, "diagnose silo-dem", {"first_seed", "prediction_seeds"});
+    in.candidates = chosen_candidates(a.candidates);
+    check_planned_runs(a, data, in.declared, in.candidates);
+    return in;
+}
 
-    an::DemDiagnoseOptions options;
-    options.grid_points = a.grid_points;
-    options.refine_steps = a.refine_steps;
-    options.prediction_seeds = a.seeds;
-    options.alpha = a.alpha;
-    options.min_cv_gain = a.min_cv_gain;
+// Each candidate's declared value and how to predict the rates at others: materials run in the campaign.
+std::vector<an::DemCandidateSetup> candidate_setups(SiloDemCampaign& campaign, const json& declared,
+                                                    const std::vector<an::DemEffectCandidate>& candidates) {
     std::vector<an::DemCandidateSetup> setups;
     for (const auto& spec : candidates) {
         an::DemCandidateSetup s;
@@ -386,19 +379,11 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
         };
         setups.push_back(s);
     }
-    an::DemDiagnosis r;
-    try {
-        std::cout << "declared material (" << a.material << "): " << data.conditions.size() << " conditions x "
-                  << a.seeds << " seed(s)" << std::endl;
-        const auto declared_rates = campaign.rates({declared}).front();
-        r = an::diagnose_dem(data, declared_rates, setups, options);
-    } catch (const CampaignStopped&) {
-        std::cout << "stopped; the same command continues the campaign in " << a.campaign << " (finished runs kept)\n";
-        return kExitResumeLater;
-    } catch (const std::invalid_argument& e) {
-        throw UserError(e.what());
-    }
+    return setups;
+}
 
+// The diagnosis in a few lines on stdout.
+void print_diagnosis(const an::DemDiagnosis& r, const SiloDemCampaign& campaign) {
     std::cout << "model silo-dem: " << r.n << " rows, " << r.conditions << " conditions, repeat scatter "
               << percent(r.noise_sd) << "\nbefore: RMSE " << percent(r.rmse_before) << " (" << sci(r.rmse_before_g_s)
               << " g/s), lack of fit p = " << sci(r.lack_of_fit_p_before) << "\n";
@@ -426,7 +411,11 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
               << duration_text(campaign.wall_seconds()) << " wall, " << duration_text(campaign.cpu_seconds())
               << " CPU\n";
     for (const auto& w : r.warnings) std::cout << "warning: " << w << "\n";
+}
 
+// --json and --report (with its residual plots), whichever were asked for.
+void write_diagnosis_outputs(const SiloDemArgs& a, const an::SiloMeasurements& data, const an::DemDiagnosis& r,
+                             const SiloDemCampaign& campaign) {
     json j = r.to_json(data);
     j["data"] = a.data;
     j["material"] = a.material;
@@ -452,6 +441,49 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
         }
         write_result_file(report, markdown(a, data, r, campaign, before_name, after_name));
     }
+}
+
+}  // namespace
+
+std::string default_silo_dem_campaign(const std::string& data_path) {
+    return "silo_dem_" + fs::path(data_path).stem().string();
+}
+
+int run_silo_dem_diagnosis(const SiloDemArgs& input) {
+    SiloDemArgs a = input;
+    if (a.campaign.empty()) a.campaign = default_silo_dem_campaign(a.data);
+    const SiloDemInputs in = read_silo_dem_inputs(a);
+    const an::SiloMeasurements& data = in.data;
+    SiloDemCampaign campaign(a, data, in.declared);
+    campaign.check_settings();  // silo's own checks of every condition and the material, nothing written
+    const json settings{{"command", "diagnose --model silo-dem"}, {"silo_args", a.silo_args},
+                        {"first_seed", a.first_seed}, {"prediction_seeds", a.seeds}};
+    // runs are named by material, condition and seed, so more (or other) prediction seeds reuse the runs already made:
+    // the design for separating a rival asks for exactly that (--seeds m)
+    open_silo_campaign(a.campaign, settings, "diagnose silo-dem", {"first_seed", "prediction_seeds"});
+
+    an::DemDiagnoseOptions options;
+    options.grid_points = a.grid_points;
+    options.refine_steps = a.refine_steps;
+    options.prediction_seeds = a.seeds;
+    options.alpha = a.alpha;
+    options.min_cv_gain = a.min_cv_gain;
+    const std::vector<an::DemCandidateSetup> setups = candidate_setups(campaign, in.declared, in.candidates);
+    an::DemDiagnosis r;
+    try {
+        std::cout << "declared material (" << a.material << "): " << data.conditions.size() << " conditions x "
+                  << a.seeds << " seed(s)" << std::endl;
+        const auto declared_rates = campaign.rates({in.declared}).front();
+        r = an::diagnose_dem(data, declared_rates, setups, options);
+    } catch (const CampaignStopped&) {
+        std::cout << "stopped; the same command continues the campaign in " << a.campaign << " (finished runs kept)\n";
+        return kExitResumeLater;
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+
+    print_diagnosis(r, campaign);
+    write_diagnosis_outputs(a, data, r, campaign);
     return 0;
 }
 
