@@ -179,34 +179,101 @@ SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition
     max_array_size_ = code == 0 ? parse_max_array_size(config) : kSlurmDefaultMaxArraySize;
 }
 
+namespace {
+
+// The batch script: one array of `tasks` tasks, `slots` at once, each running the run.sh named on its line of `list`.
+std::string array_script_text(const fs::path& list, std::size_t tasks, int slots, double longest_s,
+                              const std::string& partition) {
+    std::ostringstream s;
+    s << "#!/bin/bash\n#SBATCH --job-name=demcal\n#SBATCH --output=/dev/null\n#SBATCH --cpus-per-task=1\n"
+      << "#SBATCH --array=0-" << tasks - 1 << "%" << slots << "\n"
+      << "#SBATCH --time=" << static_cast<long>(std::ceil(longest_s / 60.0)) << "\n"
+      << (partition.empty() ? "" : "#SBATCH --partition=" + partition + "\n")
+      << "exec bash \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" " << shell_quote(list.string()) << ")\"\n";
+    return s.str();
+}
+
+// Submits `batch` as one array (its task list and script named by `stem` in work_dir); returns its tasks.
+std::vector<Task> submit_array(const std::vector<Job>& batch, const fs::path& work_dir, const std::string& stem,
+                               int slots, const std::string& partition) {
+    const fs::path list = work_dir / (stem + ".tasks"), script = work_dir / (stem + ".sbatch");
+    std::ostringstream l;
+    double longest = 0;
+    for (const auto& j : batch) {
+        write_task_script(j);
+        l << (j.dir / "run.sh").string() << "\n";
+        longest = std::max(longest, j.timeout_s);
+    }
+    write_text_file_atomically(list, l.str());
+    write_text_file_atomically(script, array_script_text(list, batch.size(), slots, longest, partition));
+    const std::string out = capture("sbatch --parsable " + shell_quote(script.string()));
+    const std::optional<long> array_id = parse_sbatch_job_id(out);
+    if (!array_id) throw std::runtime_error("sbatch printed no job id: " + analytics::shortened_text(out, 300));
+    const auto now = std::chrono::steady_clock::now();
+    std::vector<Task> tasks;
+    for (std::size_t i = 0; i < batch.size(); ++i) tasks.push_back({batch[i], *array_id, static_cast<int>(i), now, now});
+    return tasks;
+}
+
+// How a task ended that SLURM ended in `state` (TIMEOUT, CANCELLED, NODE_FAIL, ...) without an exit status of its own.
+JobOutcome outcome_of_slurm_state(const Task& t, const std::string& state) {
+    JobOutcome o;
+    o.exit_code = -1;
+    o.timed_out = state == "TIMEOUT";
+    o.interrupted = t.cancel_sent;
+    o.failure_cause = o.timed_out ? "timeout" : o.interrupted ? "interrupted" : "slurm";
+    o.message = "SLURM ended the task in state " + state;
+    o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t.submitted).count();
+    return o;
+}
+
+// A task SLURM no longer lists and that left no exit status (the controller restarted without its state, the job
+// removed by hand): waiting would never end, so it is tried again like a node failure.
+JobOutcome outcome_of_vanished_task(const Task& t, std::chrono::steady_clock::time_point now) {
+    JobOutcome o;
+    o.exit_code = -1;
+    o.interrupted = t.cancel_sent;
+    o.failure_cause = o.interrupted ? "interrupted" : "slurm";
+    o.message = "SLURM no longer lists array task " + std::to_string(t.array_id) + "_" + std::to_string(t.index) +
+                " and it left no exit status";
+    o.wall_s = std::chrono::duration<double>(now - t.submitted).count();
+    return o;
+}
+
+// squeue's answer per array job, asked once per poll (nothing: squeue failed)
+using ArrayStates = std::map<long, std::optional<std::map<int, std::string>>>;
+
+// Whether task t has ended, and how (into o): its exit_status file, else SLURM's state for it.
+bool poll_task(Task& t, ArrayStates& states, JobOutcome& o) {
+    if (read_exit_status(t.job, o)) return true;
+    if (!states.count(t.array_id)) states[t.array_id] = array_task_states(t.array_id);
+    static const std::map<int, std::string> unknown;
+    const auto& s = states[t.array_id] ? *states[t.array_id] : unknown;
+    const auto it = s.find(t.index);
+    const auto now = std::chrono::steady_clock::now();
+    if (it != s.end() || !states[t.array_id]) t.last_listed = now;  // (squeue failed: no news)
+    if (it != s.end() && is_terminal(it->second)) {
+        // a task that ended between the file's read and SLURM's answer left its record by then: read again
+        if (!read_exit_status(t.job, o)) o = outcome_of_slurm_state(t, it->second);
+        return true;
+    }
+    if (task_vanished(it != s.end(), std::chrono::duration<double>(now - t.last_listed).count())) {
+        if (!read_exit_status(t.job, o)) o = outcome_of_vanished_task(t, now);
+        return true;
+    }
+    return false;
+}
+
+}  // namespace
+
 void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events) {
     fs::create_directories(work_dir_);
     std::vector<Task> tasks;
     auto submit_batch = [&](const std::vector<Job>& batch) {
         const std::string stem = "batch-" + std::to_string(::getpid()) + "-" + std::to_string(batches_++);
-        const fs::path list = work_dir_ / (stem + ".tasks"), script = work_dir_ / (stem + ".sbatch");
-        std::ostringstream l;
-        double longest = 0;
-        for (const auto& j : batch) {
-            write_task_script(j);
-            l << (j.dir / "run.sh").string() << "\n";
-            longest = std::max(longest, j.timeout_s);
-        }
-        write_text_file_atomically(list, l.str());
-        std::ostringstream s;
-        s << "#!/bin/bash\n#SBATCH --job-name=demcal\n#SBATCH --output=/dev/null\n#SBATCH --cpus-per-task=1\n"
-          << "#SBATCH --array=0-" << batch.size() - 1 << "%" << slots_ << "\n"
-          << "#SBATCH --time=" << static_cast<long>(std::ceil(longest / 60.0)) << "\n"
-          << (partition_.empty() ? "" : "#SBATCH --partition=" + partition_ + "\n")
-          << "exec bash \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" " << shell_quote(list.string()) << ")\"\n";
-        write_text_file_atomically(script, s.str());
-        const std::string out = capture("sbatch --parsable " + shell_quote(script.string()));
-        const std::optional<long> array_id = parse_sbatch_job_id(out);
-        if (!array_id) throw std::runtime_error("sbatch printed no job id: " + analytics::shortened_text(out, 300));
-        const auto now = std::chrono::steady_clock::now();
-        for (std::size_t i = 0; i < batch.size(); ++i) {
-            tasks.push_back({batch[i], *array_id, static_cast<int>(i), now, now});
-            if (events.started) events.started(batch[i], *array_id * kTaskBase + static_cast<long>(i));
+        for (const Task& t : submit_array(batch, work_dir_, stem, slots_, partition_)) {
+            tasks.push_back(t);
+            if (events.started) events.started(t.job, t.array_id * kTaskBase + static_cast<long>(t.index));
         }
     };
     auto submit_ready_jobs = [&] {
@@ -225,43 +292,11 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
     while (!tasks.empty()) {
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
         const bool stop = interrupted();
-        std::map<long, std::optional<std::map<int, std::string>>> states;
+        ArrayStates states;
         for (std::size_t i = 0; i < tasks.size();) {
             Task& t = tasks[i];
             JobOutcome o;
-            bool ended = read_exit_status(t.job, o);
-            if (!ended) {
-                if (!states.count(t.array_id)) states[t.array_id] = array_task_states(t.array_id);
-                static const std::map<int, std::string> unknown;
-                const auto& s = states[t.array_id] ? *states[t.array_id] : unknown;
-                const auto it = s.find(t.index);
-                const auto now = std::chrono::steady_clock::now();
-                if (it != s.end() || !states[t.array_id]) t.last_listed = now;  // (squeue failed: no news)
-                // a task that ended between the file's read and SLURM's answer left its record by then: read again
-                if (it != s.end() && is_terminal(it->second) && read_exit_status(t.job, o)) {
-                    ended = true;
-                } else if (it != s.end() && is_terminal(it->second)) {
-                    ended = true;
-                    o.exit_code = -1;
-                    o.timed_out = it->second == "TIMEOUT";
-                    o.interrupted = t.cancel_sent;
-                    o.failure_cause = o.timed_out ? "timeout" : o.interrupted ? "interrupted" : "slurm";
-                    o.message = "SLURM ended the task in state " + it->second;
-                    o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t.submitted).count();
-                } else if (task_vanished(it != s.end(), std::chrono::duration<double>(now - t.last_listed).count())) {
-                    // purged from SLURM's memory: the controller restarted without its state, the job removed by
-                    // hand. Waiting would never end; without a record of its own it is tried again like a node failure
-                    ended = true;
-                    if (!read_exit_status(t.job, o)) {
-                        o.exit_code = -1;
-                        o.interrupted = t.cancel_sent;
-                        o.failure_cause = o.interrupted ? "interrupted" : "slurm";
-                        o.message = "SLURM no longer lists array task " + std::to_string(t.array_id) + "_" +
-                                    std::to_string(t.index) + " and it left no exit status";
-                        o.wall_s = std::chrono::duration<double>(now - t.submitted).count();
-                    }
-                }
-            }
+            const bool ended = poll_task(t, states, o);
             if (!ended && stop && !t.cancel_sent) {
                 capture("scancel " + std::to_string(t.array_id) + "_" + std::to_string(t.index), &o.exit_code);
                 t.cancel_sent = true;
