@@ -198,21 +198,15 @@ FlowPatternCheck check_flow_pattern(const SiloGeometry& g) {
 }
 
 // The checks the models share, each adding its warning to a prediction (and invalidating it where it rules it out).
-void check_funnel_flow_model(DischargePrediction& p, const FlowPatternCheck& flow) {
-    if (flow.mass_flow == true) {
-        p.valid = false;
-        p.warnings.push_back("a funnel-flow model used in " + flow.note);
-    } else if (!flow.mass_flow) {
+// A model made for one flow pattern: not valid where the check found the other, a warning where it could not tell.
+enum class ModelFlow { mass, funnel };
+void check_model_flow(DischargePrediction& p, const FlowPatternCheck& flow, ModelFlow made_for) {
+    if (!flow.mass_flow) {
         p.warnings.push_back(flow.note);
-    }
-}
-
-void check_mass_flow_model(DischargePrediction& p, const FlowPatternCheck& flow) {
-    if (flow.mass_flow == false) {
+    } else if (*flow.mass_flow != (made_for == ModelFlow::mass)) {
         p.valid = false;
-        p.warnings.push_back("a mass-flow model used in " + flow.note);
-    } else if (!flow.mass_flow) {
-        p.warnings.push_back(flow.note);
+        p.warnings.push_back(std::string(made_for == ModelFlow::mass ? "a mass-flow" : "a funnel-flow") +
+                             " model used in " + flow.note);
     }
 }
 
@@ -293,7 +287,7 @@ DischargePrediction predict_johanson(const SiloGeometry& g, const FlowPatternChe
     }
     p.rate = conical ? johanson_conical_rate(g.outlet, theta, g.bulk_density)
                      : johanson_wedge_rate(g.depth, g.outlet, theta, g.bulk_density);
-    check_mass_flow_model(p, flow);
+    check_model_flow(p, flow, ModelFlow::mass);
     check_coarse_particles(p, g);
     return p;
 }
@@ -303,7 +297,7 @@ DischargePrediction predict_oldal(const SiloGeometry& g, const FlowPatternCheck&
     p.model = "oldal";
     if (refuse_shape(p, g, SiloShape::conical)) return p;
     p.rate = oldal_rate(g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
-    check_funnel_flow_model(p, flow);
+    check_model_flow(p, flow, ModelFlow::funnel);
     check_coarse_particles(p, g);
     return p;
 }
@@ -317,7 +311,7 @@ DischargePrediction predict_oldal_rectangular(const SiloGeometry& g, const FlowP
         p.valid = false;
         p.warnings.push_back(w);
     }
-    check_funnel_flow_model(p, flow);
+    check_model_flow(p, flow, ModelFlow::funnel);
     check_coarse_particles(p, g);
     return p;
 }
