@@ -231,11 +231,9 @@ namespace {
 constexpr int kDemcalApplicationId = 0x64656d63;  // "demc" in the SQLite header: marks a file as a demcal store
 constexpr int kSchemaVersion = 1;                 // meta.schema_version of the stores this demcal writes
 
-// Refuses, reading only, a file that is not an intact demcal store: nothing may be written into a file that is not
-// ours (status and resume wrote demcal's tables into any SQLite file), and a damaged store must not be resumed as if
-// it were whole.
-void check_existing_store(sqlite3* db, const std::string& name) {
-    const std::string store = "campaign store '" + name + "'";
+// The checks of an existing store, reading only; `store` names it in their refusals.
+// A demcal store: our application_id, or (stores written before demcal set it) our five tables.
+void check_store_identity(sqlite3* db, const std::string& store) {
     std::int64_t application_id = 0;
     bool has_demcal_tables = false;
     try {
@@ -254,7 +252,10 @@ void check_existing_store(sqlite3* db, const std::string& name) {
         throw std::invalid_argument(store + " is a SQLite database but not a demcal campaign store (application_id " +
                                     std::to_string(application_id) + ", " + (has_demcal_tables ? "" : "no ") +
                                     "demcal tables); nothing was written to it");
-    // every column demcal reads is there (quick_check passes a schema whose text was damaged)
+}
+
+// Every column demcal reads is there (quick_check passes a schema whose text was damaged).
+void check_store_columns(sqlite3* db, const std::string& store) {
     for (const char* columns : {"SELECT key, value FROM meta", DEMCAL_CAMPAIGN_QUERY,
                                 kRunColumnsQuery, "SELECT campaign_id, hash, label, position FROM campaign_runs",
                                 "SELECT id, hash, attempt, executor, started_at, finished_at, exit_code, cause, message, "
@@ -266,6 +267,10 @@ void check_existing_store(sqlite3* db, const std::string& name) {
                                         "); nothing was written to it");
         }
     }
+}
+
+// SQLite's own check of the file's pages.
+void check_store_integrity(sqlite3* db, const std::string& store) {
     std::string verdict;
     try {
         Statement check(db, "PRAGMA quick_check(1)");
@@ -276,7 +281,10 @@ void check_existing_store(sqlite3* db, const std::string& name) {
     if (verdict != "ok")
         throw std::invalid_argument(store + " is damaged (SQLite quick_check: " + analytics::shortened_text(verdict, 200) +
                                     "); restore it from a copy, or move it away to start the campaign afresh");
-    // a newer demcal's store may hold what this one cannot read or would write wrongly: refused, not migrated
+}
+
+// A newer demcal's store may hold what this one cannot read or would write wrongly: refused, not migrated.
+void check_schema_version(sqlite3* db, const std::string& store) {
     Statement version(db, "SELECT value FROM meta WHERE key = 'schema_version'");
     if (version.step()) {
         const std::string v = version.text(0);
@@ -289,7 +297,10 @@ void check_existing_store(sqlite3* db, const std::string& name) {
             throw std::invalid_argument(store + ": schema_version " + v + " is newer than this demcal's (" +
                                         std::to_string(kSchemaVersion) + "); nothing was written to it");
     }
-    // every row a command may read, read now: refused later, a resume would have taken the lock and written already
+}
+
+// Every row a command may read, read now: refused later, a resume would have taken the lock and written already.
+void check_stored_rows(sqlite3* db, const std::string& store) {
     auto readable = [&](const std::string& what, const std::string& sql, auto&& read) {
         Statement rows(db, sql);
         while (rows.step()) {
@@ -325,6 +336,18 @@ void check_existing_store(sqlite3* db, const std::string& name) {
                                                  analytics::json_value_text(label["normal_stress"]) +
                                                  " is not the run's");
              });
+}
+
+// Refuses, reading only, a file that is not an intact demcal store: nothing may be written into a file that is not
+// ours (status and resume wrote demcal's tables into any SQLite file), and a damaged store must not be resumed as if
+// it were whole.
+void check_existing_store(sqlite3* db, const std::string& name) {
+    const std::string store = "campaign store '" + name + "'";
+    check_store_identity(db, store);
+    check_store_columns(db, store);
+    check_store_integrity(db, store);
+    check_schema_version(db, store);
+    check_stored_rows(db, store);
 }
 
 // The store as a SQLite URI for a read-only open. A read-only connection to a WAL store leaves a -wal and a -shm
