@@ -14,6 +14,7 @@
 #include "kernel/silo/silo_case.hpp"
 #include "orchestrator/folder_lock.hpp"
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
+#include "orchestrator/stop_signals.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -97,43 +98,29 @@ constexpr const char* kRunFiles[] = {kCheckpointName,       "summary.json",     
                                      "section_outline.dat", "section.png.gp",       "section.png.gp.log",
                                      "discharge.png.gp",    "discharge.png.gp.log"};
 
-// SIGTERM (a batch system's time limit or scancel, kill) and SIGINT (Ctrl-C) during a checkpointed run: the run ends
-// the step it is in, writes its checkpoint and exits 75, as at --wall-limit. The handler only records the signal
-// (async-signal-safe); the run asks for it after every step. SA_RESETHAND: a second signal takes the default
-// action and ends the process at once. A signal ignored at the start (SIGINT of a job started with `&` by a script)
-// stays ignored.
+// A stop signal (orchestrator/stop_signals.hpp: SIGTERM from kill, scancel or a batch system's time limit, SIGINT from
+// Ctrl-C, SIGHUP from a closed terminal or ssh session) during a checkpointed run: the run ends the step it is in,
+// writes its checkpoint and exits 75, as at --wall-limit. The handler only records the signal (async-signal-safe);
+// the run asks for it after every step. SA_RESETHAND: a second signal takes the default action and ends the process
+// at once. A signal ignored at the start (SIGINT of a job started with `&` by a script, SIGHUP under nohup) stays
+// ignored.
 volatile std::sig_atomic_t g_stop_signal = 0;
 
 void record_stop_signal(int sig) { g_stop_signal = sig; }
 
 class StopOnSignal {
 public:
-    StopOnSignal() {
-        for (int i = 0; i < 2; ++i) {
-            struct sigaction sa {};
-            sa.sa_handler = record_stop_signal;
-            sigemptyset(&sa.sa_mask);
-            sa.sa_flags = SA_RESETHAND;
-            ::sigaction(kSignals[i], &sa, &previous_[i]);
-            if (previous_[i].sa_handler == SIG_IGN) ::sigaction(kSignals[i], &previous_[i], nullptr);
-        }
-    }
-    ~StopOnSignal() {
-        for (int i = 0; i < 2; ++i) ::sigaction(kSignals[i], &previous_[i], nullptr);
-    }
-    StopOnSignal(const StopOnSignal&) = delete;
-    StopOnSignal& operator=(const StopOnSignal&) = delete;
+    StopOnSignal() : handlers_(record_stop_signal, SA_RESETHAND) {}
 
     // For SiloCaseSettings::stop_request: empty until a signal came.
     static std::string reason() {
         const int sig = g_stop_signal;
         if (sig == 0) return {};
-        return std::string(sig == SIGTERM ? "SIGTERM" : "SIGINT") + " received";
+        return orchestrator::stop_signal_name(sig) + " received";
     }
 
 private:
-    static constexpr int kSignals[2] = {SIGTERM, SIGINT};
-    struct sigaction previous_[2] {};
+    orchestrator::StopSignalHandlers handlers_;
 };
 
 std::string fixed(double v, int digits) {

@@ -8,6 +8,7 @@
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically, read_result_json
 #include "orchestrator/shear_campaign.hpp"  // pinned_program
 #include "orchestrator/slurm_executor.hpp"
+#include "orchestrator/stop_signals.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -55,7 +56,7 @@ pid_t spawn_demcal(const std::vector<std::string>& args, const fs::path& log) {
     sigset_t defaults;
     sigemptyset(&defaults);
     sigaddset(&defaults, SIGINT);
-    sigaddset(&defaults, SIGTERM);
+    sigaddset(&defaults, SIGTERM);  // (SIGHUP keeps its disposition: under nohup the runs ignore it too)
     posix_spawnattr_setsigdefault(&attr, &defaults);
     posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
     pid_t pid = 0;
@@ -93,24 +94,13 @@ std::vector<std::string> fresh_command(const SiloRunPlan& plan, const fs::path& 
     return a;
 }
 
-// Installs the stop handlers for the lifetime of a campaign call and puts the previous ones back.
+// The stop handlers for the lifetime of a campaign call (the previous ones put back after it), the flag cleared.
 class StopHandlers {
 public:
-    StopHandlers() {
-        g_stop_requested = 0;
-        previous_int_ = std::signal(SIGINT, request_campaign_stop);
-        previous_term_ = std::signal(SIGTERM, request_campaign_stop);
-    }
-    ~StopHandlers() {
-        std::signal(SIGINT, previous_int_);
-        std::signal(SIGTERM, previous_term_);
-    }
-    StopHandlers(const StopHandlers&) = delete;
-    StopHandlers& operator=(const StopHandlers&) = delete;
+    StopHandlers() : handlers_((g_stop_requested = 0, request_campaign_stop)) {}
 
 private:
-    void (*previous_int_)(int) = SIG_DFL;
-    void (*previous_term_)(int) = SIG_DFL;
+    orchestrator::StopSignalHandlers handlers_;
 };
 
 }  // namespace

@@ -2,6 +2,8 @@
 // what to do with its outcome; an executor only runs processes: a local pool (LocalExecutor) or SLURM job arrays
 // (SlurmExecutor). Both pull jobs from a callback, so the campaign can re-queue a retry while others still run.
 #pragma once
+#include "orchestrator/stop_signals.hpp"
+
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -59,8 +61,11 @@ bool interrupted();
 void request_interrupt();
 class InterruptGuard {
 public:
-    InterruptGuard();   // installs the handlers and clears the flag
-    ~InterruptGuard();  // restores the previous handlers
+    InterruptGuard();  // clears the flag and installs the handlers of the stop signals (stop_signals.hpp)
+    // (the previous handlers are put back when it ends)
+
+private:
+    StopSignalHandlers handlers_;
 };
 
 // Reads the tail of a job's stderr.log for the failure cause and message.

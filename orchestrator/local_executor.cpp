@@ -19,7 +19,6 @@ namespace demcal::orchestrator {
 
 namespace {
 std::atomic<bool> g_interrupted{false};
-struct sigaction g_old_int, g_old_term;
 extern "C" void on_interrupt_signal(int) { g_interrupted.store(true); }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -30,19 +29,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 bool interrupted() { return g_interrupted.load(); }
 void request_interrupt() { g_interrupted.store(true); }
 
-InterruptGuard::InterruptGuard() {
-    g_interrupted.store(false);
-    struct sigaction sa {};
-    sa.sa_handler = on_interrupt_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &g_old_int);
-    sigaction(SIGTERM, &sa, &g_old_term);
-}
-
-InterruptGuard::~InterruptGuard() {
-    sigaction(SIGINT, &g_old_int, nullptr);
-    sigaction(SIGTERM, &g_old_term, nullptr);
-}
+InterruptGuard::InterruptGuard() : handlers_((g_interrupted.store(false), on_interrupt_signal)) {}
 
 void read_failure_from_stderr(const std::filesystem::path& stderr_log, JobOutcome& out) {
     std::ifstream f(stderr_log, std::ios::binary);

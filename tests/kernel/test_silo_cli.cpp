@@ -1,7 +1,7 @@
 // demcal silo end to end: bad input exits 2 naming the field and the value, before anything is written; a tiny run
-// writes discharge.csv and summary.json; a run killed with -9, resumed, stopped by its wall limit and by SIGTERM and
-// resumed again writes the same discharge.csv as an uninterrupted one. Needs the demcal binary (built with the
-// project: CI builds everything).
+// writes discharge.csv and summary.json; a run killed with -9, resumed, stopped by its wall limit, by SIGTERM and by
+// SIGHUP, then finished under nohup (a hang-up ignored) writes the same discharge.csv as an uninterrupted one. Needs
+// the demcal binary (built with the project: CI builds everything).
 #include "test_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -267,7 +267,7 @@ TEST_CASE("demcal silo: results that cannot be written keep the checkpoint, and 
     fs::remove_all(dir);
 }
 
-TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to the uninterrupted result",
+TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM or SIGHUP resumes to the uninterrupted result",
           "[silo][cli]") {
     require_demcal();
     const fs::path dir = fs::temp_directory_path() / ("demcal_test_silo_cli_resume_" + std::to_string(::getpid()));
@@ -319,32 +319,51 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM resumes to th
     CHECK_FALSE(fs::exists(out / "summary.json"));
     CHECK_THAT(read_file(dir / "out.log"), Catch::Matchers::Contains("suspended: wall limit"));
 
-    // SIGTERM (a batch system's time limit, scancel) once the session steps: the same clean stop
-    const pid_t term_pid = spawn_demcal("--resume '" + out.string() + "' --threads 1", dir / "term.log");
-    REQUIRE(term_pid > 0);
-    int term_status = 0;
-    const bool term_finished =
-        wait_until(term_pid, [&] { return read_file(dir / "term.log").find("resumed") != std::string::npos; },
-                   term_status);
-    if (!term_finished) {
-        ::kill(term_pid, SIGTERM);
-        ::waitpid(term_pid, &term_status, 0);
-    }
-    INFO(read_file(dir / "term.log"));
-    REQUIRE_FALSE(term_finished);
-    CHECK(WIFEXITED(term_status));
-    CHECK(WEXITSTATUS(term_status) == 75);
-    CHECK(fs::exists(ckpt));
-    CHECK_FALSE(fs::exists(out / "summary.json"));
-    CHECK_THAT(read_file(dir / "term.log"), Catch::Matchers::Contains("suspended: SIGTERM received"));
+    // a session stopped by a signal once it steps: SIGTERM (a batch system's time limit, scancel) and SIGHUP (the
+    // terminal or the ssh session closed) make the same clean stop as the wall limit
+    auto stop_session_with = [&](int sig, const std::string& name) {
+        const fs::path log = dir / (name + ".log");
+        const pid_t pid = spawn_demcal("--resume '" + out.string() + "' --threads 1", log);
+        REQUIRE(pid > 0);
+        int st = 0;
+        const bool ended = wait_until(pid, [&] { return read_file(log).find("resumed") != std::string::npos; }, st);
+        if (!ended) {
+            ::kill(pid, sig);
+            ::waitpid(pid, &st, 0);
+        }
+        INFO(read_file(log));
+        REQUIRE_FALSE(ended);
+        CHECK(WIFEXITED(st));
+        CHECK(WEXITSTATUS(st) == 75);
+        CHECK(fs::exists(ckpt));
+        CHECK_FALSE(fs::exists(out / "summary.json"));
+        CHECK_THAT(read_file(log), Catch::Matchers::Contains("suspended: " + name + " received"));
+    };
+    stop_session_with(SIGTERM, "SIGTERM");
+    stop_session_with(SIGHUP, "SIGHUP");
 
-    const Run resumed = run_silo("--resume '" + out.string() + "' --threads 2", dir);
-    INFO(resumed.err);
-    REQUIRE(resumed.rc == 0);
+    // under nohup (SIGHUP ignored when the run starts) a hang-up does not stop the run: it finishes
+    struct sigaction ignore {}, previous {};
+    ignore.sa_handler = SIG_IGN;
+    ::sigaction(SIGHUP, &ignore, &previous);
+    const pid_t nohup_pid = spawn_demcal("--resume '" + out.string() + "' --threads 2", dir / "nohup.log");
+    ::sigaction(SIGHUP, &previous, nullptr);
+    REQUIRE(nohup_pid > 0);
+    int nohup_status = 0;
+    const bool ended_early = wait_until(
+        nohup_pid, [&] { return read_file(dir / "nohup.log").find("resumed") != std::string::npos; }, nohup_status);
+    if (!ended_early) {
+        ::kill(nohup_pid, SIGHUP);
+        ::waitpid(nohup_pid, &nohup_status, 0);
+    }
+    INFO(read_file(dir / "nohup.log"));
+    REQUIRE_FALSE(ended_early);
+    REQUIRE(WIFEXITED(nohup_status));
+    REQUIRE(WEXITSTATUS(nohup_status) == 0);
     CHECK(read_file(out / "discharge.csv") == read_file(dir / "whole" / "discharge.csv"));
     const std::string summary = read_file(out / "summary.json");
-    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 4"));
-    CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 4"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 5"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 5"));
     // the CPU split at the opening survives the sessions: the filling's part from the checkpoint
     const auto j = nlohmann::json::parse(summary);
     const double fill_cpu = j["fill"]["cpu_s"].get<double>(), discharge_cpu = j["discharge"]["cpu_s"].get<double>();

@@ -1,0 +1,48 @@
+// A shear campaign asked to stop by a signal (orchestrator/stop_signals.hpp): SIGTERM (kill, scancel) and SIGHUP
+// (the terminal or ssh session that started it closed) stop its runs, record them, and leave a campaign that resume
+// finishes; nothing it started is left running. Kernel engine: seconds per run, no YADE needed.
+#include <catch2/catch.hpp>
+
+#include "campaign_test_support.hpp"
+
+#include <chrono>
+#include <csignal>
+#include <sys/wait.h>
+#include <thread>
+
+namespace fs = std::filesystem;
+using namespace demcal;
+
+TEST_CASE("a shear campaign stopped by SIGTERM or SIGHUP stops its runs, and resume finishes it",
+          "[kernel_engine][signals]") {
+    const auto [sig, name] = GENERATE(std::pair<int, const char*>{SIGTERM, "sigterm"},
+                                      std::pair<int, const char*>{SIGHUP, "sighup"});
+    const fs::path dir = test::fresh_test_dir(std::string("campaign-stop-") + name);
+    const fs::path camp = dir / "camp", log = dir / "stopped.log";
+    const int pid = test::spawn_demcal({"shear", test::source_path("examples/materials/sand-tiny.json").string(),
+                                        "--normal-stress", "3e3,5e3,7e3", "--replicates", "2", "--engine", "kernel",
+                                        "--jobs", "1", "--campaign", camp.string()},
+                                       log);
+    REQUIRE(pid > 0);
+    // once a run is under way (one of six, about a second each)
+    int status = 0;
+    bool ended = false;
+    for (int i = 0; i < 6000 && !ended; ++i) {
+        if (!test::processes_under(camp / "runs").empty()) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        ended = ::waitpid(pid, &status, WNOHANG) == pid;
+    }
+    REQUIRE_FALSE(ended);
+    ::kill(pid, sig);
+    ::waitpid(pid, &status, 0);
+    INFO(test::read_file(log));
+    REQUIRE(WIFEXITED(status));  // stopped, not killed by the signal
+    CHECK(WEXITSTATUS(status) == 130);
+    CHECK_THAT(test::read_file(log), Catch::Matchers::Contains("interrupted: continue with `demcal resume"));
+    CHECK(test::processes_under(camp).empty());
+    REQUIRE(test::run_demcal({"status", camp.string()}, dir / "status.log") == 0);
+    CHECK_THAT(test::read_file(dir / "status.log"), Catch::Matchers::Contains("[interrupted]"));
+    REQUIRE(test::run_demcal({"resume", camp.string()}, dir / "resume.log") == 0);
+    CHECK_FALSE(test::find_file(camp, "failure_line_", ".json").empty());
+    fs::remove_all(dir);
+}
