@@ -451,6 +451,130 @@ void conclude(CampaignStore& store, ShearCampaignOutcome& out) {
 
 }  // namespace
 
+namespace {
+
+// One call of ShearCampaignRunner::run once its runs are prepared: hands the queued runs to the executor, records how
+// each attempt ended (done, retried, failed for good, interrupted, not started), and reports the progress.
+class CampaignExecution {
+public:
+    CampaignExecution(CampaignStore& store, const ExecutionOptions& options, const EngineSetup& engine,
+                      PreparedRuns& runs, ShearCampaignOutcome& out, const ProgressCallback& progress)
+        : store_(store), options_(options), engine_(engine), queue_(runs.queue), by_hash_(runs.by_hash), out_(out),
+          progress_(progress) {
+        prog_.total = static_cast<int>(by_hash_.size());
+        prog_.reused = out_.reused;
+        prog_.done = out_.reused;
+        for (const auto& [h, _] : by_hash_)
+            if (store_.run(h)->state == RunState::failed) ++prog_.failed;
+        prog_.pending = static_cast<int>(queue_.size());
+        slots_ = options_.jobs > 0 ? options_.jobs : std::max(1u, std::thread::hardware_concurrency());
+    }
+
+    // Runs the queue on `executor` until it is empty, a run cannot start, or the user interrupts (Ctrl-C, SIGTERM,
+    // SIGHUP: the running runs go back to pending).
+    void run(Executor& executor) {
+        executor_name_ = executor.name();
+        InterruptGuard guard;
+        ExecutorEvents events;
+        events.started = [this](const Job& job, long handle) { started(job, handle); };
+        events.finished = [this](const Job& job, const JobOutcome& o) { finished(job, o); };
+        if (!queue_.empty()) executor.run([this] { return next_job(); }, events);
+        if (interrupted()) out_.interrupted = true;
+    }
+
+private:
+    std::optional<Job> next_job() {
+        if (queue_.empty() || !out_.infrastructure_failure.empty()) return std::nullopt;
+        const std::string h = queue_.front();
+        queue_.pop_front();
+        const PlannedRun& r = *by_hash_.at(h);
+        fs::remove(r.dir / "result.json");  // a result must come from this attempt
+        keep_previous_attempt_logs(r.dir, store_.run(h)->attempts);
+        std::vector<std::string> argv = engine_.command;
+        argv.insert(argv.end(), {"params.json", "result.json"});
+        return Job{h, r.dir, std::move(argv), options_.timeout_s};
+    }
+
+    void started(const Job& job, long handle) {
+        store_.mark_running(job.id, handle, ::getpid(), executor_name_);
+        --prog_.pending;
+        ++prog_.running;
+        report("started", job.id);
+    }
+
+    void finished(const Job& job, const JobOutcome& o) {
+        --prog_.running;
+        if (o.interrupted) {
+            store_.reset_to_pending(job.id, "interrupted by the user");
+            ++prog_.pending;
+            out_.interrupted = true;
+            report("interrupted", job.id);
+            return;
+        }
+        finished_wall_ += o.wall_s;
+        ++finished_here_;
+        const AttemptVerdict v = judge_attempt(o, job.dir, by_hash_.at(job.id)->params);
+        if (v.cause.empty()) {
+            store_.mark_done(job.id, v.result, o.exit_code, o.wall_s, o.cpu_s);
+            ++out_.executed;
+            ++prog_.done;
+            report("done", job.id);
+        } else if (v.cause == kSimulatorNotStarted) {
+            // the machine's fault, not the run's: the run stays pending for a resume with a working simulator, and
+            // no further run is started (each would fail the same way)
+            store_.mark_attempt_failed(job.id, v.cause, v.message, o.exit_code, o.wall_s, o.cpu_s, false);
+            ++prog_.pending;
+            if (out_.infrastructure_failure.empty()) out_.infrastructure_failure = v.message;
+            report("not started", job.id);
+        } else {
+            failed(job, o, v);
+        }
+    }
+
+    // An attempt the run itself failed: tried again, or failed for good (a physical failure, or no retries left).
+    void failed(const Job& job, const JobOutcome& o, const AttemptVerdict& v) {
+        const int attempts = store_.run(job.id)->attempts;
+        const bool final = retry_is_pointless(v.cause) || attempts > options_.retries;
+        store_.mark_attempt_failed(job.id, v.cause, v.message, o.exit_code, o.wall_s, o.cpu_s, final);
+        if (final) {
+            ++prog_.failed;
+            report("failed", job.id);
+        } else {
+            queue_.push_back(job.id);
+            ++prog_.pending;
+            report("retry", job.id);
+        }
+    }
+
+    void report(const std::string& event, const std::string& hash) {
+        if (!progress_) return;
+        prog_.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+        prog_.remaining_s = remaining_seconds(prog_, finished_wall_, finished_here_, slots_);
+        prog_.event = event;
+        std::optional<RunRecord> rec = store_.run(hash);
+        if (rec) rec->label = by_hash_.at(hash)->label;
+        prog_.run = rec ? &*rec : nullptr;
+        progress_(prog_);
+        prog_.run = nullptr;
+    }
+
+    CampaignStore& store_;
+    const ExecutionOptions& options_;
+    const EngineSetup& engine_;
+    std::deque<std::string>& queue_;
+    const std::map<std::string, const PlannedRun*>& by_hash_;
+    ShearCampaignOutcome& out_;
+    const ProgressCallback& progress_;
+    std::string executor_name_;
+    CampaignProgress prog_;
+    int slots_ = 1;
+    const std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+    double finished_wall_ = 0;  // of the attempts that ended here (the estimate of the time left)
+    int finished_here_ = 0;
+};
+
+}  // namespace
+
 ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, const ProgressCallback& progress) {
     validate_shear_spec(spec_in);
     const ShearCampaignSpec spec = resolved(spec_in);
@@ -461,98 +585,9 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     ShearCampaignOutcome out;
     out.campaign = store_->ensure_campaign(campaign_name(spec), CampaignKind::shear, spec.to_json());
     PreparedRuns runs = prepare_runs(*store_, out.campaign.id, plan, spec.engine, engine, options_.force);
-    std::deque<std::string>& queue = runs.queue;
-    const auto& by_hash = runs.by_hash;
     out.reused = runs.reused;
-
-    CampaignProgress prog;
-    prog.total = static_cast<int>(by_hash.size());
-    prog.reused = out.reused;
-    prog.done = out.reused;
-    for (const auto& [h, _] : by_hash)
-        if (store_->run(h)->state == RunState::failed) ++prog.failed;
-    prog.pending = static_cast<int>(queue.size());
-    const auto t0 = std::chrono::steady_clock::now();
-    double finished_wall = 0;
-    int finished_here = 0;
     auto executor = make_executor(options_, dir_);
-    const int slots = options_.jobs > 0 ? options_.jobs : std::max(1u, std::thread::hardware_concurrency());
-    auto report = [&](const std::string& event, const std::string& hash) {
-        if (!progress) return;
-        prog.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        prog.remaining_s = remaining_seconds(prog, finished_wall, finished_here, slots);
-        prog.event = event;
-        std::optional<RunRecord> rec = store_->run(hash);
-        if (rec) rec->label = by_hash.at(hash)->label;
-        prog.run = rec ? &*rec : nullptr;
-        progress(prog);
-        prog.run = nullptr;
-    };
-
-    ExecutorEvents events;
-    events.started = [&](const Job& job, long handle) {
-        store_->mark_running(job.id, handle, ::getpid(), executor->name());
-        --prog.pending;
-        ++prog.running;
-        report("started", job.id);
-    };
-    events.finished = [&](const Job& job, const JobOutcome& o) {
-        --prog.running;
-        if (o.interrupted) {
-            store_->reset_to_pending(job.id, "interrupted by the user");
-            ++prog.pending;
-            out.interrupted = true;
-            report("interrupted", job.id);
-            return;
-        }
-        finished_wall += o.wall_s;
-        ++finished_here;
-        const AttemptVerdict v = judge_attempt(o, job.dir, by_hash.at(job.id)->params);
-        if (v.cause.empty()) {
-            store_->mark_done(job.id, v.result, o.exit_code, o.wall_s, o.cpu_s);
-            ++out.executed;
-            ++prog.done;
-            report("done", job.id);
-            return;
-        }
-        if (v.cause == kSimulatorNotStarted) {
-            // the machine's fault, not the run's: the run stays pending for a resume with a working simulator, and
-            // no further run is started (each would fail the same way)
-            store_->mark_attempt_failed(job.id, v.cause, v.message, o.exit_code, o.wall_s, o.cpu_s, false);
-            ++prog.pending;
-            if (out.infrastructure_failure.empty()) out.infrastructure_failure = v.message;
-            report("not started", job.id);
-            return;
-        }
-        const int attempts = store_->run(job.id)->attempts;
-        const bool final = retry_is_pointless(v.cause) || attempts > options_.retries;
-        store_->mark_attempt_failed(job.id, v.cause, v.message, o.exit_code, o.wall_s, o.cpu_s, final);
-        if (final) {
-            ++prog.failed;
-            report("failed", job.id);
-        } else {
-            queue.push_back(job.id);
-            ++prog.pending;
-            report("retry", job.id);
-        }
-    };
-    JobSource next = [&]() -> std::optional<Job> {
-        if (queue.empty() || !out.infrastructure_failure.empty()) return std::nullopt;
-        const std::string h = queue.front();
-        queue.pop_front();
-        const PlannedRun& r = *by_hash.at(h);
-        fs::remove(r.dir / "result.json");  // a result must come from this attempt
-        keep_previous_attempt_logs(r.dir, store_->run(h)->attempts);
-        std::vector<std::string> argv = engine.command;
-        argv.insert(argv.end(), {"params.json", "result.json"});
-        return Job{h, r.dir, std::move(argv), options_.timeout_s};
-    };
-
-    {
-        InterruptGuard guard;
-        if (!queue.empty()) executor->run(next, events);
-        if (interrupted()) out.interrupted = true;
-    }
+    CampaignExecution(*store_, options_, engine, runs, out, progress).run(*executor);
     conclude(*store_, out);
     return out;
 }
