@@ -97,7 +97,7 @@ std::vector<std::string> fresh_command(const SiloRunPlan& plan, const fs::path& 
 // The stop handlers for the lifetime of a campaign call (the previous ones put back after it), the flag cleared.
 class StopHandlers {
 public:
-    StopHandlers() : handlers_((g_stop_requested = 0, request_campaign_stop)) {}
+    StopHandlers() : handlers_((g_stop_requested = 0, request_campaign_stop)) {}  // (cleared, then installed)
 
 private:
     orchestrator::StopSignalHandlers handlers_;

@@ -29,6 +29,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 bool interrupted() { return g_interrupted.load(); }
 void request_interrupt() { g_interrupted.store(true); }
 
+// (the flag cleared before the handlers are installed: a signal that comes in between is kept)
 InterruptGuard::InterruptGuard() : handlers_((g_interrupted.store(false), on_interrupt_signal)) {}
 
 void read_failure_from_stderr(const std::filesystem::path& stderr_log, JobOutcome& out) {
