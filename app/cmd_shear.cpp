@@ -148,7 +148,9 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
     if (outcome.interrupted) return 130;
     if (!outcome.infrastructure_failure.empty()) {
         std::cout << "the simulator could not be started (" << outcome.infrastructure_failure
-                  << "); the runs it hit stay pending: fix it (--yade; the kernel engine: the demcal program), then `demcal resume " << dir.string() << "`\n";
+                  << "); the runs it hit stay pending: fix what stops it (its message; --yade for another YADE; the "
+                     "kernel engine: the demcal program), then `demcal resume "
+                  << dir.string() << "`\n";
         return kExitResumeLater;
     }
     // a campaign is run for its failure line: finished without one, it has not done its job

@@ -140,7 +140,11 @@ struct EngineSetup {
     std::string identity_text;           // the script (YADE) or the engine's name and version (kernel)
     std::string wrapper_text;            // YADE: run_clean.py
     std::vector<std::string> command;    // to which the run's files are appended
+    std::string started_marker;          // a file the run writes once the simulator has started (YADE), or none
 };
+
+// The file yade_scripts/run_clean.py writes in the run's folder first thing, once YADE has started.
+constexpr const char* kYadeStartedMarker = "yade_started";
 
 void write_params(const PlannedRun& r) {
     const fs::path params = r.dir / "params.json";
@@ -173,11 +177,12 @@ EngineSetup engine_setup(const ShearCampaignSpec& spec, const ExecutionOptions& 
     if (spec.engine == ShearEngine::kernel) {
         if (o.kernel_command.empty() || o.kernel_engine.empty())
             throw std::invalid_argument("engine = 'kernel': this program does not say how to run the kernel engine");
-        return {o.kernel_engine, "", o.kernel_command};
+        return {o.kernel_engine, "", o.kernel_command, ""};
     }
     return {read_text_file(spec.template_path),
             read_text_file(default_shear_template().parent_path() / kWrapperName),
-            {find_yade(o.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py"}};
+            {find_yade(o.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py"},
+            kYadeStartedMarker};
 }
 
 // The executors append to DIR/stdout.log and DIR/stderr.log and read the failure cause from stderr.log: an earlier
@@ -192,7 +197,8 @@ void keep_previous_attempt_logs(const fs::path& run_dir, int attempts_so_far) {
     }
 }
 
-// The executor's cause when the simulator's process could not be started (local_executor.cpp: execvp failed).
+// The cause of an attempt whose simulator did not start: its process could not be started (local_executor.cpp: execvp
+// failed), or it exited before it started the run (the started marker missing, judge_attempt).
 constexpr const char* kSimulatorNotStarted = "exec";
 
 // Physical failures and bad parameters are deterministic: a retry would fail the same way.
@@ -404,8 +410,19 @@ struct AttemptVerdict {
     nlohmann::json result;
 };
 
-AttemptVerdict judge_attempt(const JobOutcome& o, const fs::path& run_dir, const nlohmann::json& params) {
+// `started_marker`: the file the run writes once its simulator has started ("" if none): a run that failed without
+// it never got to its script, and its simulator cannot start here (the machine's fault: kSimulatorNotStarted).
+AttemptVerdict judge_attempt(const JobOutcome& o, const fs::path& run_dir, const nlohmann::json& params,
+                             const std::string& started_marker) {
     AttemptVerdict v{o.failure_cause, o.message, {}};
+    std::error_code ec;
+    if (!o.timed_out && !o.interrupted && !started_marker.empty() && v.cause.empty() &&
+        !fs::exists(run_dir / started_marker, ec)) {  // (exit 0 too: a launcher that is not YADE's)
+        v.cause = kSimulatorNotStarted;
+        v.message = "the simulator exited (code " + std::to_string(o.exit_code) + ") before it started the run" +
+                    (o.message.empty() ? "" : ": " + o.message);
+        return v;
+    }
     if (o.succeeded()) {
         try {
             v.result = read_shear_result(run_dir / "result.json", &params);
@@ -488,7 +505,8 @@ private:
         const std::string h = queue_.front();
         queue_.pop_front();
         const PlannedRun& r = *by_hash_.at(h);
-        fs::remove(r.dir / "result.json");  // a result must come from this attempt
+        fs::remove(r.dir / "result.json");  // a result (and the simulator's start) must come from this attempt
+        if (!engine_.started_marker.empty()) fs::remove(r.dir / engine_.started_marker);
         keep_previous_attempt_logs(r.dir, store_.run(h)->attempts);
         std::vector<std::string> argv = engine_.command;
         argv.insert(argv.end(), {"params.json", "result.json"});
@@ -513,7 +531,7 @@ private:
         }
         finished_wall_ += o.wall_s;
         ++finished_here_;
-        const AttemptVerdict v = judge_attempt(o, job.dir, by_hash_.at(job.id)->params);
+        const AttemptVerdict v = judge_attempt(o, job.dir, by_hash_.at(job.id)->params, engine_.started_marker);
         if (v.cause.empty()) {
             store_.mark_done(job.id, v.result, o.exit_code, o.wall_s, o.cpu_s);
             ++out_.executed;

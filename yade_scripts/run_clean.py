@@ -10,6 +10,11 @@ the engines, the functors), sees sys.argv = [SCRIPT, ARGS...] and its exit code 
 import os
 import sys
 
+# The first thing a run does once YADE has started: the orchestrator reads a run that failed without this file as a
+# simulator that could not start here (YADE's own start failed: no HOME, a broken install), not as the run's failure
+# (orchestrator/shear_campaign.cpp, kYadeStartedMarker). Written in the run's folder, YADE's working directory.
+open("yade_started", "w").close()
+
 
 def _remove_yade_temp_dir():
     try:

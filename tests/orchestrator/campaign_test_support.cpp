@@ -1,6 +1,7 @@
 #include "campaign_test_support.hpp"
 
 #include <fcntl.h>
+#include <fstream>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,6 +17,17 @@ fs::path fresh_test_dir(const std::string& name) {
 }
 
 fs::path source_path(const std::string& relative) { return fs::path(DEMCAL_SOURCE_DIR) / relative; }
+
+fs::path write_stand_in_yade(const fs::path& dir) {
+    const fs::path yade = dir / "stand-in-yade";
+    // as YADE with yade_scripts/run_clean.py: the started marker in the run's folder, then the result (schema /1: a
+    // template older than the result's seal, still read) into the file named by the last argument
+    std::ofstream(yade) << "#!/bin/sh\n: > yade_started\nfor last; do :; done\n"
+                           "echo '{\"schema\": \"demcal.shear_result/1\", \"peak_shear_stress\": 1000, "
+                           "\"residual_shear_stress\": 800}' > \"$last\"\n";
+    fs::permissions(yade, fs::perms::owner_all);
+    return yade;
+}
 
 namespace {
 std::string quote(const std::string& s) {

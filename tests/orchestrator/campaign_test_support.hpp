@@ -11,6 +11,8 @@ namespace demcal::test {
 
 std::filesystem::path fresh_test_dir(const std::string& name);
 std::filesystem::path source_path(const std::string& relative);  // a file of the source tree
+// A stand-in for YADE in `dir` (returned): writes the run's started marker and a fixed result, as a finished run does.
+std::filesystem::path write_stand_in_yade(const std::filesystem::path& dir);
 // Runs demcal with arguments (shell-quoted here); stdout+stderr go to `log`. Returns the exit code.
 int run_demcal(const std::vector<std::string>& args, const std::filesystem::path& log);
 // Starts demcal in the background; returns its pid.

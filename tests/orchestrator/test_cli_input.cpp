@@ -6,10 +6,12 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -203,26 +205,30 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
           "[cli][store]") {
     const fs::path dir = test::fresh_test_dir("cli-yade-not-started");
     const fs::path campaign = dir / "campaign";
-    // executable, but its interpreter does not exist: execvp fails, as for a launcher of a broken installation
-    std::ofstream(dir / "broken-yade") << "#!/nonexistent/interpreter\n";
-    // a stand-in simulator: writes the result file named by its last argument (schema /1: a template older than the
-    // result's seal, still read)
-    std::ofstream(dir / "stand-in-yade") << "#!/bin/sh\nfor last; do :; done\n"
-                                            "echo '{\"schema\": \"demcal.shear_result/1\", \"peak_shear_stress\": 1000, "
-                                            "\"residual_shear_stress\": 800}' > "
-                                            "\"$last\"\n";
-    fs::permissions(dir / "broken-yade", fs::perms::owner_all);
-    fs::permissions(dir / "stand-in-yade", fs::perms::owner_all);
+    // executable, but its interpreter does not exist: execvp fails, as for a launcher of a broken installation; or it
+    // starts and exits before the run's script (no started marker), as YADE without HOME does (KeyError: 'HOME')
+    const auto [launcher, text, expect] = GENERATE(
+        std::tuple<const char*, const char*, const char*>{"broken-yade", "#!/nonexistent/interpreter\n",
+                                                          "cannot start"},
+        std::tuple<const char*, const char*, const char*>{
+            "early-exit-yade", "#!/bin/sh\necho \"KeyError: 'HOME'\" >&2\nexit 1\n",
+            "the simulator exited (code 1) before it started the run: KeyError: 'HOME'"});
+    std::ofstream(dir / launcher) << text;
+    fs::permissions(dir / launcher, fs::perms::owner_all);
+    const fs::path stand_in = test::write_stand_in_yade(dir);
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
-    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4,2e4", "--yade", (dir / "broken-yade").string(),
-                                     "--campaign", campaign.string(), "--retries", "0"},
+    fs::remove_all(campaign);
+    const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4,2e4", "--yade", (dir / launcher).string(),
+                                     "--campaign", campaign.string(), "--retries", "0", "--jobs", "1"},
                                     dir / "out.log");
     INFO(test::read_file(dir / "out.log"));
     CHECK(rc == 75);
-    CHECK_THAT(test::read_file(dir / "out.log"), Contains("could not be started"));
-    for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::pending);
-    CHECK(test::run_demcal({"resume", campaign.string(), "--yade", (dir / "stand-in-yade").string()},
-                           dir / "resume.log") == 0);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("could not be started") && Contains(expect));
+    const auto runs = test::stored_runs(campaign);
+    for (const auto& r : runs) CHECK(r.state == orchestrator::RunState::pending);
+    // the first run that did not start stops the campaign: no other run is tried
+    CHECK(std::count_if(runs.begin(), runs.end(), [](const auto& r) { return r.attempts > 0; }) == 1);
+    CHECK(test::run_demcal({"resume", campaign.string(), "--yade", stand_in.string()}, dir / "resume.log") == 0);
     INFO(test::read_file(dir / "resume.log"));
     for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::done);
     fs::remove_all(dir);

@@ -61,11 +61,7 @@ void sql(const fs::path& db_file, const std::string& statements) {
 // campaign copied from elsewhere, so a lock a refused command leaves behind is seen; the store's time is set an hour
 // back, so a rewrite shows in it even on a file system with coarse times.
 fs::path complete_campaign(const fs::path& dir, const fs::path& campaign) {
-    const fs::path yade = dir / "stand-in-yade";
-    std::ofstream(yade) << "#!/bin/sh\nfor last; do :; done\n"
-                           "echo '{\"schema\": \"demcal.shear_result/1\", \"peak_shear_stress\": 1000, "
-                           "\"residual_shear_stress\": 800}' > \"$last\"\n";
-    fs::permissions(yade, fs::perms::owner_all);
+    const fs::path yade = test::write_stand_in_yade(dir);
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
     const int rc = test::run_demcal({"shear", tiny, "-s", "5e3,1e4,2e4", "--yade", yade.string(), "--campaign",
                                      campaign.string(), "--plot", "svg"},
