@@ -21,6 +21,20 @@ def make_fixtures(repo, work):
     json.dump(study["base_material"], open(work + "/sens_base.json", "w"))
 
 
+def tiny_shear_params(repo, normal_stress=5e3, seed=1):
+    """A shear run's params.json for examples/materials/sand-tiny.json (its documentation keys left out)."""
+    tiny = json.load(open(os.path.join(repo, "examples", "materials", "sand-tiny.json")))
+    params = {k: v for k, v in tiny.items() if not k.startswith("_")}
+    params.update(normal_stress=normal_stress, seed=seed)
+    return params
+
+
+def small_silo_args(repo):
+    """`demcal silo` options of a run of a second or two: 300 grains in the reduced 70 deg hopper, soft, one thread."""
+    return ["--geometry", os.path.join(repo, "examples", "silo", "reduced_conical_70deg.json"), "--particles", "300",
+            "--stiffness-scale", "0.001", "--fill-time", "0.1", "--max-time", "0.2", "--threads", "1"]
+
+
 def run_bounded(argv, cwd, limit_s=4, grace_s=20):
     """Runs argv in cwd. Returns (exit code, output, files created in cwd): 124 when it ran past limit_s and stopped on
     SIGTERM, 125 when it did not stop within grace_s more (then killed); output starts with ORPHANS when processes

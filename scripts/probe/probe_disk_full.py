@@ -20,15 +20,16 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import probe_common  # noqa: E402
+
 demcal, repo = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
 sizes = (sys.argv[3] if len(sys.argv) > 3 else "4k,16k,64k,256k,1m").split(",")
 ex = lambda p: os.path.join(repo, "examples", p)
 scratch = tempfile.mkdtemp(prefix="demcal-diskfull.")
 
 # inputs outside the tmpfs
-tiny = json.load(open(ex("materials/sand-tiny.json")))
-params = {k: v for k, v in tiny.items() if not k.startswith("_")}
-params.update(normal_stress=5e3, seed=1)
+params = probe_common.tiny_shear_params(repo)
 params_file = os.path.join(scratch, "params.json")
 json.dump(params, open(params_file, "w"))
 enlarge_inputs = []
@@ -40,8 +41,7 @@ for r in (0.001, 0.0012, 0.0015, 0.002):  # within sand-tiny's box (4 particle l
     json.dump(m, open(f, "w"))
     enlarge_inputs.append(f)
 
-SMALL_SILO = ["--geometry", ex("silo/reduced_conical_70deg.json"), "--particles", "300", "--stiffness-scale",
-              "0.001", "--fill-time", "0.1", "--max-time", "0.2", "--threads", "1", "--no-plots"]
+SMALL_SILO = probe_common.small_silo_args(repo) + ["--no-plots"]
 
 SELECT = os.environ.get("PROBE_CASES", "")  # a regular expression over the case names
 # name, arguments ({o}: the tmpfs), outputs that exit 0 promises (relative to the tmpfs), the command that finishes it

@@ -10,10 +10,12 @@ usage: probe_locale.py DEMCAL REPO [LOCALE]"""
 import json
 import os
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import probe_common  # noqa: E402
 
 demcal, repo = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
 locale_name = sys.argv[3] if len(sys.argv) > 3 else "de_DE.UTF-8"
@@ -35,13 +37,9 @@ check = subprocess.run(["python3", "-c", "import locale; locale.setlocale(locale
                        env=env_locale, capture_output=True, text=True).stdout.strip()
 print("locale %s formats 0.5 as %r" % (locale_name, check))
 
-tiny = json.load(open(ex("materials/sand-tiny.json")))
-params = {k: v for k, v in tiny.items() if not k.startswith("_")}
-params.update(normal_stress=5e3, seed=1)
 params_file = os.path.join(scratch, "params.json")
-json.dump(params, open(params_file, "w"))
-SMALL_SILO = ["--geometry", ex("silo/reduced_conical_70deg.json"), "--particles", "300", "--stiffness-scale",
-              "0.001", "--fill-time", "0.1", "--max-time", "0.2", "--threads", "1"]
+json.dump(probe_common.tiny_shear_params(repo), open(params_file, "w"))
+SMALL_SILO = probe_common.small_silo_args(repo)
 CASES = [
     ("predict", ["predict", ex("diagnose/silo_105mm_wheat.json"), "--json", "{o}/p.json"]),
     ("diagnose", ["diagnose", "--model", "oldal", "--data", ex("diagnose/oldal_clean.csv"), "--report",
