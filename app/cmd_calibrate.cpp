@@ -138,6 +138,7 @@ void write_study(const fs::path& dir, const SensitivityStudy& study, const std::
 
 // Checks every level's material before anything is written or run: a bad range must not cost simulations.
 void check_study(const nlohmann::json& base, const SensitivityCli& o) {
+    for (const auto& name : o.params) orchestrator::require_micromechanical_param(name, "--params");
     // the count first: planning a billion levels would itself take the memory
     const std::size_t params = o.params.empty() ? orchestrator::micromechanical_param_names().size() : o.params.size();
     const auto& c = o.campaign;
@@ -275,8 +276,9 @@ void add_calibrate(CLI::App& app) {
         // every option checked before the study or the campaign runs, and before the log is rewritten
         check_calibration_options(options);
         if (!o->controls.empty() && o->controls.size() != targets.size())
-            throw UserError("controls: " + std::to_string(o->controls.size()) + " given for " +
+            throw UserError("--controls: " + std::to_string(o->controls.size()) + " given for " +
                             std::to_string(targets.size()) + " targets");
+        for (const auto& name : o->controls) orchestrator::require_micromechanical_param(name, "--controls");
         for (const auto& [name, range] : bounds) check_control(start, {name, range.first, range.second});
         if (o->sensitivity_file.empty()) {
             if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
@@ -299,7 +301,7 @@ void add_calibrate(CLI::App& app) {
                 const auto* p = study.find(name);
                 auto b = bounds.find(name);
                 if (!p && b == bounds.end())
-                    throw UserError("controls: '" + name + "' is neither in the study nor given --bounds");
+                    throw UserError("--controls: '" + name + "' is neither in the study nor given --bounds");
                 picked.push_back({name, b != bounds.end() ? b->second.first : p->low(),
                                   b != bounds.end() ? b->second.second : p->high()});
             }

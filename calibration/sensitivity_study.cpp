@@ -67,12 +67,7 @@ double farthest_valid(const nlohmann::json& base, const std::string& name, doubl
 
 std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::string& name,
                                        const SensitivityOptions& options) {
-    const auto& micro = orchestrator::micromechanical_param_names();
-    if (std::find(micro.begin(), micro.end(), name) == micro.end()) {
-        std::string list;
-        for (const auto& m : micro) list += (list.empty() ? "" : ", ") + m;
-        throw std::invalid_argument("params: '" + name + "' is not a micromechanical parameter (" + list + ")");
-    }
+    orchestrator::require_micromechanical_param(name, "params");
     if (options.levels < 3)
         throw std::invalid_argument("levels = " + std::to_string(options.levels) + " must be >= 3 to tell a shape");
     if (options.levels > kMaxLevels)

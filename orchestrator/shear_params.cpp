@@ -78,6 +78,14 @@ const std::vector<std::string>& micromechanical_param_names() {
     return names;
 }
 
+void require_micromechanical_param(const std::string& name, const std::string& field) {
+    const auto& micro = micromechanical_param_names();
+    if (std::find(micro.begin(), micro.end(), name) != micro.end()) return;
+    std::string list;
+    for (const auto& m : micro) list += (list.empty() ? "" : ", ") + m;
+    throw std::invalid_argument(field + ": '" + name + "' is not a micromechanical parameter (" + list + ")");
+}
+
 double max_particle_length(const nlohmann::json& m) {
     const double r_max = m.at("particle_radius").get<double>() * (1 + m.at("radius_spread").get<double>());
     return 2 * r_max * m.at("particle_form").get<double>();

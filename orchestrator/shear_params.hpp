@@ -27,6 +27,9 @@ const ParamSpec* find_shear_param(const std::string& name);
 
 // The micromechanical parameters a sensitivity study varies (seed, Table 3.1).
 const std::vector<std::string>& micromechanical_param_names();
+// Throws std::invalid_argument "FIELD: 'name' is not a micromechanical parameter (the list)" unless it is one; FIELD
+// is what the caller's user called the list (an option, a JSON field).
+void require_micromechanical_param(const std::string& name, const std::string& field);
 
 // Checks a material (all fields except the per-run ones): unknown keys, missing fields, values out of range or not
 // numbers, a box smaller than a few particle lengths, a travel shorter than a fraction of a particle, a box whose

@@ -46,9 +46,10 @@ TEST_CASE("diagnose CLI: bad regime and outlier options exit 2 naming the field 
         std::string args, message;
     };
     const std::vector<Case> cases{
-        {"--regime-column flow_regime", "regime column 'flow_regime' is not in"},
-        {"--regime-column run_order", "'run_order' has 84 values"},
-        {"--wall-friction-deg 20", "wall_friction_deg=20 given, effective_friction_deg missing"},
+        {"--regime-column flow_regime", "--regime-column 'flow_regime' is not in"},
+        {"--regime-column run_order", "--regime-column 'run_order' has 84 values"},
+        {"--wall-friction-deg 20", "--wall-friction-deg requires --effective-friction-deg"},
+        {"--effective-friction-deg 30", "--effective-friction-deg requires --wall-friction-deg"},
         {"--wall-friction-deg 35 --effective-friction-deg 30", "phi_w_deg=35 is not below delta_e_deg=30"},
         {"--wall-friction-deg 95 --effective-friction-deg 30", "--wall-friction-deg: 95"},
         {"--outlier-alpha 0.9", "--outlier-alpha: 0.9"}};

@@ -63,7 +63,12 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--max-evaluations", "0"},
          "max-evaluations = 0"},
         {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--controls", "friction_coefficient"},
-         "controls: 1 given for 2 targets"},
+         "--controls: 1 given for 2 targets"},
+        // the option named, not the study's field it fills
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--controls", "1,2"},
+         "--controls: '1' is not a micromechanical parameter"},
+        {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "friction_coefficient,Young"},
+         "--params: 'Young' is not a micromechanical parameter"},
         {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--bounds", "friction_coefficient=-5:50"},
          "'friction_coefficient' = -5"},
         {{"calibrate", "--start", tiny, "--measured", "5e3x:7000,1e4:13000,2e4:25000"}, "measured point '5e3x:7000'"},
