@@ -232,6 +232,172 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
     return targets_from_measured_line(sigma, tau);
 }
 
+using RangeMap = std::map<std::string, std::pair<double, double>>;  // NAME -> [low, high], from NAME=LOW:HIGH
+
+CalibrationOptions calibration_options(const CalibrateCli& o) {
+    CalibrationOptions options;
+    options.tolerance = o.tol;
+    options.method = search_method_from_string(o.method);
+    options.sequential = o.sequential;
+    options.accept_simulated_interval = !o.strict;
+    options.max_evaluations = o.max_evaluations;
+    options.grid_points = o.grid_points;
+    options.line = line_kind_from_string(o.study.campaign.line);
+    return options;
+}
+
+// Every option checked before the study or the campaign runs, and before the log is rewritten. Fills the study's
+// parameters with the controls when neither they nor a stored study are given.
+void check_calibrate_options(CalibrateCli& o, const nlohmann::json& start, const std::vector<MacroTarget>& targets,
+                             const RangeMap& bounds, const CalibrationOptions& options) {
+    const auto& camp = o.study.campaign;
+    check_calibration_options(options);
+    if (!o.controls.empty() && o.controls.size() != targets.size())
+        throw UserError("--controls: " + std::to_string(o.controls.size()) + " given for " +
+                        std::to_string(targets.size()) + " targets");
+    for (const auto& name : o.controls) orchestrator::require_micromechanical_param(name, "--controls");
+    for (const auto& [name, range] : bounds) check_control(start, {name, range.first, range.second});
+    if (o.sensitivity_file.empty()) {
+        if (o.study.params.empty() && !o.controls.empty()) o.study.params = o.controls;
+        check_study(start, o.study);
+    }
+    // a grid evaluates all of itself: grid-points ^ controls, whatever --max-evaluations says
+    const double control_count = static_cast<double>(o.controls.empty() ? targets.size() : o.controls.size());
+    const double evaluations = options.method == SearchMethod::grid ? std::pow(double(o.grid_points), control_count)
+                                                                    : double(o.max_evaluations);
+    check_run_count(evaluations * camp.normal_stresses.size() * camp.replicates, camp.exec.max_runs,
+                    "calibration: " + analytics::number_text(evaluations, 10) + " evaluations x " +
+                        std::to_string(camp.normal_stresses.size()) + " normal stresses x " +
+                        std::to_string(camp.replicates) + " replicates");
+    check_campaign(camp, start);
+}
+
+// The controls given (their bounds from --bounds or the study's range), or those the study chooses.
+std::vector<ControlParameter> pick_controls(const CalibrateCli& o, const SensitivityStudy& study,
+                                            const std::vector<MacroTarget>& targets, const RangeMap& bounds) {
+    if (o.controls.empty()) return choose_controls(study, targets, o.tol, {}, bounds);
+    std::vector<ControlParameter> picked;
+    for (const auto& name : o.controls) {
+        const auto* p = study.find(name);
+        auto b = bounds.find(name);
+        if (!p && b == bounds.end())
+            throw UserError("--controls: '" + name + "' is neither in the study nor given --bounds");
+        picked.push_back({name, b != bounds.end() ? b->second.first : p->low(),
+                          b != bounds.end() ? b->second.second : p->high()});
+    }
+    return picked;
+}
+
+SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json& start) {
+    SensitivityStudy study;
+    try {
+        study = SensitivityStudy::from_json(read_json_file(file, "sensitivity"));
+    } catch (const std::invalid_argument& e) {  // a field missing, of the wrong type or out of range
+        throw UserError("sensitivity = '" + file + "': " + e.what());
+    }
+    check_study_matches_start(study, start, file);
+    return study;
+}
+
+// One evaluation's console line.
+std::string iteration_line(const CalibrationIteration& it) {
+    std::ostringstream line;  // own stream: cout's format stays as it was
+    line << "  #" << std::setw(2) << it.evaluation << " " << std::left << std::setw(10) << it.phase << std::right;
+    for (const auto& [name, v] : it.values) line << " " << name << "=" << v;
+    line << std::fixed << std::setprecision(4) << "  mu_b " << it.mu_b << " +/- " << it.mu_b_half_width
+         << std::setprecision(1) << "  tau_c " << it.tau_c << " +/- " << it.tau_c_half_width << " Pa"
+         << std::setprecision(2) << "  miss " << it.mismatch
+         << (it.accepted ? "  ACCEPTED (" + it.accepted_by + ")" : "") << "  [" << it.simulations_run << " run, "
+         << it.simulations_reused << " reused]";
+    return line.str();
+}
+
+void print_calibration_plan(const CalibrateCli& o, const std::vector<MacroTarget>& targets,
+                            const std::vector<ControlParameter>& controls) {
+    std::cout << "calibrating";
+    for (std::size_t i = 0; i < targets.size(); ++i)
+        std::cout << (i ? ", " : " ") << targets[i].quantity << " = " << targets[i].value << " +/- "
+                  << targets[i].acceptance(o.tol) << " with " << controls[i].name << " in [" << controls[i].low
+                  << ", " << controls[i].high << "]";
+    std::cout << " (" << o.method << (o.sequential ? ", slope first" : "") << ")" << std::endl;
+}
+
+// calibration_<method>.json and the calibrated material; returns the material's path.
+fs::path write_calibration_results(const CalibrateCli& o, const fs::path& dir, const CalibrationResult& result,
+                                   const SensitivityStudy& study) {
+    auto summary = result.to_json();
+    summary["sensitivity"] = {{"evaluations", study.evaluations},
+                              {"simulations_run", study.simulations_run},
+                              {"simulations_reused", study.simulations_reused},
+                              {"cpu_s", study.cpu_s}};
+    write_result_file(dir / ("calibration_" + o.method + ".json"), summary.dump(2) + "\n");
+    // a baseline run over the same campaign must not overwrite the loop's material
+    const std::string default_name =
+        o.method == "surrogate" ? "calibrated_material.json" : "calibrated_material_" + o.method + ".json";
+    const fs::path out = o.output.empty() ? dir / default_name : fs::path(o.output);
+    nlohmann::json material = result.material;
+    material["description"] = "calibrated by demcal calibrate (" + to_string(result.status) + "): " + result.message;
+    write_result_file(out, material.dump(1) + "\n");
+    return out;
+}
+
+void print_calibration_summary(const CalibrateCli& o, const CalibrationResult& result, const SensitivityStudy& study,
+                               const fs::path& material) {
+    const auto& best = result.iterations[result.best];
+    std::cout << "\n" << to_string(result.status) << ": " << result.message << "\n"
+              << "final: mu_b = " << best.mu_b << " +/- " << best.mu_b_half_width << ", tau_c = " << best.tau_c
+              << " +/- " << best.tau_c_half_width << " Pa (95 % intervals)\n"
+              << "calibration: " << result.evaluations << " failure lines, " << result.simulations_run
+              << " simulations run, " << result.simulations_reused << " reused, CPU " << cpu_duration(result.cpu_s)
+              << "; sensitivity study: " << study.evaluations << " failure lines, "
+              << (o.sensitivity_file.empty() ? std::to_string(study.simulations_run) + " simulations run now"
+                                             : "read from " + o.sensitivity_file + " (not run now)")
+              << "\nmaterial: " << material.string() << "\n";
+}
+
+void run_calibrate(CalibrateCli& o) {
+    const auto& camp = o.study.campaign;
+    if (!o.output.empty()) check_output_file(o.output, "output");  // before hours of calibration, not after
+    check_paths_apart({{o.start_file, "start"}, {o.sensitivity_file, "sensitivity"}}, {{o.output, "output"}});
+    const auto start = orchestrator::validate_material(read_json_file(o.start_file, "start"), o.start_file);
+    const auto targets = targets_of(o);
+    const auto bounds = parse_ranges(o.bounds, "bounds");
+    const CalibrationOptions options = calibration_options(o);
+    check_calibrate_options(o, start, targets, bounds, options);
+    SensitivityStudy study;
+    std::vector<ControlParameter> controls;
+    if (!o.sensitivity_file.empty()) {
+        study = read_stored_study(o.sensitivity_file, start);
+        controls = pick_controls(o, study, targets, bounds);  // a study that cannot serve: refused before the campaign
+    }
+    CampaignSession session(camp, "calibrate");
+    const fs::path dir = camp.campaign_dir;
+    if (o.sensitivity_file.empty()) {
+        study = run_study(start, o.study, session.evaluate);
+        write_study(dir, study, camp.plot_format);
+        std::cout << "\n" << study.table() << std::endl;
+        controls = pick_controls(o, study, targets, bounds);
+    }
+    print_calibration_plan(o, targets, controls);
+
+    const fs::path log_path = dir / ("calibration_log_" + o.method + ".jsonl");
+    // Rewritten by every invocation, like calibration_<method>.json: a resumed calibration replays its finished
+    // evaluations from the store, so the log still holds all of them once, in order (appending repeated them).
+    // Opened at the first evaluation: a calibration refused before it leaves the previous log as it was.
+    std::ofstream log;
+    const auto result = calibrate(start, targets, controls, &study, session.evaluate, options,
+                                  [&](const CalibrationIteration& it) {
+                                      std::cout << iteration_line(it) << std::endl;
+                                      if (!log.is_open()) log.open(log_path, std::ios::trunc);
+                                      log << it.to_json().dump() << "\n" << std::flush;
+                                  });
+    const fs::path material = write_calibration_results(o, dir, result, study);
+    print_calibration_summary(o, result, study, material);
+    keep_results();  // what follows is the verdict on these results, not a failure to write them
+    if (result.status == CalibrationStatus::unreachable) throw UserError("calibration stopped: " + result.message);
+    if (result.status != CalibrationStatus::converged) throw std::runtime_error(result.message);
+}
+
 void add_calibrate(CLI::App& app) {
     auto o = std::make_shared<CalibrateCli>();
     auto* cmd = app.add_subcommand("calibrate", "find micro parameters whose simulated failure line matches a target");
@@ -258,130 +424,7 @@ void add_calibrate(CLI::App& app) {
     cmd->add_option("--span", o->study.span, "study: base * (1 -+ span)")->capture_default_str();
     cmd->add_option("--range", o->study.ranges, "study: explicit range NAME=LOW:HIGH");
     add_campaign_options(cmd, o->study.campaign);
-    cmd->callback([o] {
-        const auto& camp = o->study.campaign;
-        if (!o->output.empty()) check_output_file(o->output, "output");  // before hours of calibration, not after
-        check_paths_apart({{o->start_file, "start"}, {o->sensitivity_file, "sensitivity"}}, {{o->output, "output"}});
-        const auto start = orchestrator::validate_material(read_json_file(o->start_file, "start"), o->start_file);
-        const auto targets = targets_of(*o);
-        const auto bounds = parse_ranges(o->bounds, "bounds");
-        CalibrationOptions options;
-        options.tolerance = o->tol;
-        options.method = search_method_from_string(o->method);
-        options.sequential = o->sequential;
-        options.accept_simulated_interval = !o->strict;
-        options.max_evaluations = o->max_evaluations;
-        options.grid_points = o->grid_points;
-        options.line = line_kind_from_string(camp.line);
-        // every option checked before the study or the campaign runs, and before the log is rewritten
-        check_calibration_options(options);
-        if (!o->controls.empty() && o->controls.size() != targets.size())
-            throw UserError("--controls: " + std::to_string(o->controls.size()) + " given for " +
-                            std::to_string(targets.size()) + " targets");
-        for (const auto& name : o->controls) orchestrator::require_micromechanical_param(name, "--controls");
-        for (const auto& [name, range] : bounds) check_control(start, {name, range.first, range.second});
-        if (o->sensitivity_file.empty()) {
-            if (o->study.params.empty() && !o->controls.empty()) o->study.params = o->controls;
-            check_study(start, o->study);
-        }
-        // a grid evaluates all of itself: grid-points ^ controls, whatever --max-evaluations says
-        const double control_count = static_cast<double>(o->controls.empty() ? targets.size() : o->controls.size());
-        const double evaluations = options.method == SearchMethod::grid ? std::pow(double(o->grid_points), control_count)
-                                                                        : double(o->max_evaluations);
-        check_run_count(evaluations * camp.normal_stresses.size() * camp.replicates, camp.exec.max_runs,
-                        "calibration: " + analytics::number_text(evaluations, 10) + " evaluations x " +
-                            std::to_string(camp.normal_stresses.size()) + " normal stresses x " +
-                            std::to_string(camp.replicates) + " replicates");
-        check_campaign(camp, start);
-        SensitivityStudy study;
-        const auto pick_controls = [&] {
-            std::vector<ControlParameter> picked;
-            if (o->controls.empty()) return choose_controls(study, targets, o->tol, {}, bounds);
-            for (const auto& name : o->controls) {
-                const auto* p = study.find(name);
-                auto b = bounds.find(name);
-                if (!p && b == bounds.end())
-                    throw UserError("--controls: '" + name + "' is neither in the study nor given --bounds");
-                picked.push_back({name, b != bounds.end() ? b->second.first : p->low(),
-                                  b != bounds.end() ? b->second.second : p->high()});
-            }
-            return picked;
-        };
-        std::vector<ControlParameter> controls;
-        if (!o->sensitivity_file.empty()) {
-            try {
-                study = SensitivityStudy::from_json(read_json_file(o->sensitivity_file, "sensitivity"));
-            } catch (const std::invalid_argument& e) {  // a field missing, of the wrong type or out of range
-                throw UserError("sensitivity = '" + o->sensitivity_file + "': " + e.what());
-            }
-            check_study_matches_start(study, start, o->sensitivity_file);
-            controls = pick_controls();  // a study that cannot serve is refused before the campaign folder exists
-        }
-        CampaignSession session(camp, "calibrate");
-        const fs::path dir = camp.campaign_dir;
-
-        if (o->sensitivity_file.empty()) {
-            study = run_study(start, o->study, session.evaluate);
-            write_study(dir, study, camp.plot_format);
-            std::cout << "\n" << study.table() << std::endl;
-            controls = pick_controls();
-        }
-        std::cout << "calibrating";
-        for (std::size_t i = 0; i < targets.size(); ++i)
-            std::cout << (i ? ", " : " ") << targets[i].quantity << " = " << targets[i].value << " +/- "
-                      << targets[i].acceptance(o->tol) << " with " << controls[i].name << " in [" << controls[i].low
-                      << ", " << controls[i].high << "]";
-        std::cout << " (" << o->method << (o->sequential ? ", slope first" : "") << ")" << std::endl;
-
-        const fs::path log_path = dir / ("calibration_log_" + o->method + ".jsonl");
-        // Rewritten by every invocation, like calibration_<method>.json: a resumed calibration replays its finished
-        // evaluations from the store, so the log still holds all of them once, in order (appending repeated them).
-        // Opened at the first evaluation: a calibration refused before it leaves the previous log as it was.
-        std::ofstream log;
-        const auto result = calibrate(start, targets, controls, &study, session.evaluate, options,
-                                      [&](const CalibrationIteration& it) {
-                                          std::ostringstream line;  // own stream: cout's format stays as it was
-                                          line << "  #" << std::setw(2) << it.evaluation << " " << std::left
-                                               << std::setw(10) << it.phase << std::right;
-                                          for (const auto& [name, v] : it.values) line << " " << name << "=" << v;
-                                          line << std::fixed << std::setprecision(4) << "  mu_b " << it.mu_b
-                                               << " +/- " << it.mu_b_half_width << std::setprecision(1)
-                                               << "  tau_c " << it.tau_c << " +/- " << it.tau_c_half_width
-                                               << " Pa" << std::setprecision(2) << "  miss " << it.mismatch
-                                               << (it.accepted ? "  ACCEPTED (" + it.accepted_by + ")" : "")
-                                               << "  [" << it.simulations_run << " run, "
-                                               << it.simulations_reused << " reused]";
-                                          std::cout << line.str() << std::endl;
-                                          if (!log.is_open()) log.open(log_path, std::ios::trunc);
-                                          log << it.to_json().dump() << "\n" << std::flush;
-                                      });
-        auto summary = result.to_json();
-        summary["sensitivity"] = {{"evaluations", study.evaluations},
-                                  {"simulations_run", study.simulations_run},
-                                  {"simulations_reused", study.simulations_reused},
-                                  {"cpu_s", study.cpu_s}};
-        write_result_file(dir / ("calibration_" + o->method + ".json"), summary.dump(2) + "\n");
-        // a baseline run over the same campaign must not overwrite the loop's material
-        const std::string default_name =
-            o->method == "surrogate" ? "calibrated_material.json" : "calibrated_material_" + o->method + ".json";
-        const fs::path out = o->output.empty() ? dir / default_name : fs::path(o->output);
-        nlohmann::json material = result.material;
-        material["description"] = "calibrated by demcal calibrate (" + to_string(result.status) + "): " + result.message;
-        write_result_file(out, material.dump(1) + "\n");
-        const auto& best = result.iterations[result.best];
-        std::cout << "\n" << to_string(result.status) << ": " << result.message << "\n"
-                  << "final: mu_b = " << best.mu_b << " +/- " << best.mu_b_half_width << ", tau_c = " << best.tau_c
-                  << " +/- " << best.tau_c_half_width << " Pa (95 % intervals)\n"
-                  << "calibration: " << result.evaluations << " failure lines, " << result.simulations_run
-                  << " simulations run, " << result.simulations_reused << " reused, CPU " << cpu_duration(result.cpu_s)
-                  << "; sensitivity study: " << study.evaluations << " failure lines, "
-                  << (o->sensitivity_file.empty() ? std::to_string(study.simulations_run) + " simulations run now"
-                                                  : "read from " + o->sensitivity_file + " (not run now)")
-                  << "\nmaterial: " << out.string() << "\n";
-        keep_results();  // what follows is the verdict on these results, not a failure to write them
-        if (result.status == CalibrationStatus::unreachable) throw UserError("calibration stopped: " + result.message);
-        if (result.status != CalibrationStatus::converged) throw std::runtime_error(result.message);
-    });
+    cmd->callback([o] { run_calibrate(*o); });
 }
 
 // ---- enlarge ----
