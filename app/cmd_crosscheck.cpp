@@ -155,19 +155,13 @@ void write_plots(const fs::path& dir, const std::map<ShearEngine, calibration::F
     if (!first_curve) render_gnuplot(dir / ("crosscheck_curves." + format), c.str(), 1100, 650);
 }
 
-int run_crosscheck(const CrosscheckOptions& opt) {
+// Both engines' campaign specs for the same material, stresses and seeds; every input checked before a run.
+std::map<ShearEngine, ShearCampaignSpec> crosscheck_specs(const CrosscheckOptions& opt) {
     ShearCampaignSpec base;
     base.material = read_json_file(opt.material_file, "material");
-    try {
-        validate_material(base.material, opt.material_file);
-    } catch (const std::invalid_argument& e) {
-        throw UserError(e.what());
-    }
-    try {  // both lines are the point: a design that cannot give them is refused before a run
-        analytics::check_failure_line_design(opt.normal_stresses, opt.replicates);
-    } catch (const std::invalid_argument& e) {
-        throw UserError(e.what());
-    }
+    validate_material(base.material, opt.material_file);
+    // both lines are the point: a design that cannot give them is refused before a run
+    analytics::check_failure_line_design(opt.normal_stresses, opt.replicates);
     check_run_count(2.0 * static_cast<double>(opt.normal_stresses.size()) * opt.replicates, opt.exec.max_runs,
                     "crosscheck: 2 engines x " + std::to_string(opt.normal_stresses.size()) + " normal stresses x " +
                         std::to_string(opt.replicates) + " replicates");
@@ -179,82 +173,102 @@ int run_crosscheck(const CrosscheckOptions& opt) {
         specs[e] = base;
         specs[e].engine = e;
         specs[e].label = "crosscheck " + to_string(e);
-        try {
-            validate_shear_spec(specs[e]);
-        } catch (const std::invalid_argument& err) {
-            throw UserError(err.what());
-        }
+        validate_shear_spec(specs[e]);
     }
-    try {
-        find_yade(opt.exec.yade);
-    } catch (const std::invalid_argument& e) {
-        throw UserError(e.what());
-    }
+    find_yade(opt.exec.yade);
+    return specs;
+}
+
+fs::path crosscheck_dir(const CrosscheckOptions& opt) {
     const fs::path dir = opt.campaign_dir.empty()
                              ? fs::path("campaigns") / ("crosscheck-" + fs::path(opt.material_file).stem().string())
                              : fs::path(opt.campaign_dir);
-    const fs::path report = dir / "crosscheck.json";
     if (fs::exists(dir) && !fs::is_directory(dir))
         throw UserError("campaign = '" + dir.string() + "' exists and is not a folder");
-    ShearCampaignRunner runner(dir, opt.exec);
-    std::cout << "crosscheck in " << runner.dir().string() << ": " << opt.normal_stresses.size() << " normal stresses x "
-              << opt.replicates << " replicates on yade and on the kernel engine\n";
+    return dir;
+}
+
+// Each engine's failure lines and run costs, in kEngines' order; stops at an interruption.
+struct EngineRuns {
     std::map<ShearEngine, calibration::FailureLineEvaluation> ev;
     std::map<ShearEngine, RunCost> cost;
-    bool interrupted = false, failed = false, infra = false;
+    bool interrupted = false, failed = false, infrastructure_failure = false;
+};
+
+EngineRuns run_engines(ShearCampaignRunner& runner, const std::map<ShearEngine, ShearCampaignSpec>& specs) {
+    EngineRuns r;
     for (ShearEngine e : kEngines) {
         std::cout << "\n--- " << to_string(e) << " ---\n";
-        ev[e] = calibration::evaluate_failure_line(runner, specs[e], print_progress);
-        cost[e] = cost_of(ev[e].outcome);
-        interrupted = interrupted || ev[e].outcome.interrupted;
-        failed = failed || ev[e].outcome.failed > 0;
-        infra = infra || !ev[e].outcome.infrastructure_failure.empty();
-        if (interrupted) break;
+        r.ev[e] = calibration::evaluate_failure_line(runner, specs.at(e), print_progress);
+        r.cost[e] = cost_of(r.ev[e].outcome);
+        r.interrupted = r.interrupted || r.ev[e].outcome.interrupted;
+        r.failed = r.failed || r.ev[e].outcome.failed > 0;
+        r.infrastructure_failure = r.infrastructure_failure || !r.ev[e].outcome.infrastructure_failure.empty();
+        if (r.interrupted) break;
     }
-    if (interrupted) {
-        std::cout << "interrupted: run the same command again to continue\n";
-        return 130;
-    }
-    std::optional<analytics::FailureLineComparison> peak, residual;
-    const auto& y = ev[ShearEngine::yade];
-    const auto& k = ev[ShearEngine::kernel];
-    if (y.peak && k.peak) peak = analytics::compare_failure_lines(*y.peak, *k.peak);
-    if (y.residual && k.residual) residual = analytics::compare_failure_lines(*y.residual, *k.residual);
-    for (ShearEngine e : kEngines) {
-        std::cout << "\n";
-        if (ev[e].peak) print_line(("Peak failure line, " + to_string(e)).c_str(), *ev[e].peak);
-    }
-    const std::string md = markdown_table(ev, cost, peak, residual);
-    std::cout << "\n" << md;
-    if (peak)
-        std::cout << "\nthe two engines' peak failure lines " << (peak->agree() ? "agree" : "DIFFER")
-                  << " within their combined 95 % intervals\n";
-    nlohmann::json j = {{"material", base.material},
+    return r;
+}
+
+nlohmann::json crosscheck_json(const CrosscheckOptions& opt, const nlohmann::json& material, const EngineRuns& r,
+                               const std::optional<analytics::FailureLineComparison>& peak,
+                               const std::optional<analytics::FailureLineComparison>& residual) {
+    nlohmann::json j = {{"material", material},
                         {"normal_stresses", opt.normal_stresses},
                         {"replicates", opt.replicates},
                         {"base_seed", opt.seed}};
     for (ShearEngine e : kEngines) {
-        const std::string n = to_string(e);
-        j[n] = {{"campaign", ev[e].outcome.campaign.name},
-                {"peak_failure_line", ev[e].peak ? ev[e].peak->to_json() : nlohmann::json(nullptr)},
-                {"residual_failure_line", ev[e].residual ? ev[e].residual->to_json() : nlohmann::json(nullptr)},
-                {"runs_done", cost[e].runs},
-                {"runs_failed", ev[e].outcome.failed},
-                {"wall_s_per_run", cost[e].wall_s},
-                {"cpu_s_per_run", cost[e].cpu_s}};
+        const auto& ev = r.ev.at(e);
+        const auto& cost = r.cost.at(e);
+        j[to_string(e)] = {{"campaign", ev.outcome.campaign.name},
+                           {"peak_failure_line", ev.peak ? ev.peak->to_json() : nlohmann::json(nullptr)},
+                           {"residual_failure_line", ev.residual ? ev.residual->to_json() : nlohmann::json(nullptr)},
+                           {"runs_done", cost.runs},
+                           {"runs_failed", ev.outcome.failed},
+                           {"wall_s_per_run", cost.wall_s},
+                           {"cpu_s_per_run", cost.cpu_s}};
     }
     j["peak_comparison"] = peak ? peak->to_json() : nlohmann::json(nullptr);
     j["residual_comparison"] = residual ? residual->to_json() : nlohmann::json(nullptr);
-    write_result_file(report, j.dump(2) + "\n");
+    return j;
+}
+
+int run_crosscheck(const CrosscheckOptions& opt) {
+    const auto specs = crosscheck_specs(opt);
+    const fs::path dir = crosscheck_dir(opt);
+    const fs::path report = dir / "crosscheck.json";
+    ShearCampaignRunner runner(dir, opt.exec);
+    std::cout << "crosscheck in " << runner.dir().string() << ": " << opt.normal_stresses.size() << " normal stresses x "
+              << opt.replicates << " replicates on yade and on the kernel engine\n";
+    const EngineRuns r = run_engines(runner, specs);
+    if (r.interrupted) {
+        std::cout << "interrupted: run the same command again to continue\n";
+        return 130;
+    }
+    std::optional<analytics::FailureLineComparison> peak, residual;
+    const auto& y = r.ev.at(ShearEngine::yade);
+    const auto& k = r.ev.at(ShearEngine::kernel);
+    if (y.peak && k.peak) peak = analytics::compare_failure_lines(*y.peak, *k.peak);
+    if (y.residual && k.residual) residual = analytics::compare_failure_lines(*y.residual, *k.residual);
+    for (ShearEngine e : kEngines) {
+        std::cout << "\n";
+        if (r.ev.at(e).peak) print_line(("Peak failure line, " + to_string(e)).c_str(), *r.ev.at(e).peak);
+    }
+    const std::string md = markdown_table(r.ev, r.cost, peak, residual);
+    std::cout << "\n" << md;
+    if (peak)
+        std::cout << "\nthe two engines' peak failure lines " << (peak->agree() ? "agree" : "DIFFER")
+                  << " within their combined 95 % intervals\n";
+    write_result_file(report, crosscheck_json(opt, specs.at(ShearEngine::yade).material, r, peak, residual).dump(2) +
+                                  "\n");
     write_result_file(dir / "crosscheck.md", md);
     try {
-        write_plots(runner.dir(), ev, opt.plot_format);
+        write_plots(runner.dir(), r.ev, opt.plot_format);
     } catch (const std::exception& e) {
         std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
     }
     std::cout << "\nresults: " << report.string() << ", " << (dir / "crosscheck.md").string() << "\n";
-    if (infra) return kExitResumeLater;
-    return failed ? 1 : 0;
+    if (r.infrastructure_failure) return kExitResumeLater;
+    return r.failed ? 1 : 0;
 }
 
 }  // namespace

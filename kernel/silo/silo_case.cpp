@@ -279,9 +279,12 @@ void validate(const WheatMaterials& materials) {
                        "must lie in [1, 2.6] (length / width of the 3-sphere grain; the seed's 1.833)");
 }
 
-void validate(const SiloCaseSettings& s) {
-    validate(s.materials);  // first: the checks below derive masses and time steps from them
-    validate(s.geometry, grain_length(s.materials));
+namespace {
+
+double mass_of_grain(const WheatMaterials& m) { return m.wheat.density * wheat_grain_volume(); }
+
+// The bed: a fill mass or a particle count, many grains and not beyond memory.
+void validate_bed_size(const SiloCaseSettings& s) {
     if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
     // a bed is many grains: one grain has no bulk density, no flow pattern and no steady rate (`--particles 1` ran,
     // reported a bulk density of 0 and no rate, exit 0)
@@ -291,7 +294,7 @@ void validate(const SiloCaseSettings& s) {
                        "must be at least " + std::to_string(kMinGrains) + " (a bed, not a few grains)");
     constexpr double kMaxGrains = 5e6;  // 15e6 spheres: about 9 GB of state, beyond any machine this runs on
     if (s.particles > kMaxGrains) reject_setting("particles", double(s.particles), "more than 5,000,000 grains");
-    const double grain_mass = s.materials.wheat.density * wheat_grain_volume();
+    const double grain_mass = mass_of_grain(s.materials);
     if (s.fill_mass > 0 && s.fill_mass < (kMinGrains - 0.5) * grain_mass)  // (below one grain it was silently one)
         reject_setting("fill_mass", s.fill_mass,
                        "less than " + std::to_string(kMinGrains) + " grains of " + setting_text(grain_mass * 1e3) +
@@ -299,6 +302,10 @@ void validate(const SiloCaseSettings& s) {
     if (s.fill_mass / grain_mass > kMaxGrains)
         reject_setting("fill_mass", s.fill_mass,
                        "more than 5,000,000 grains of " + setting_text(grain_mass * 1e3) + " g");
+}
+
+// The stiffness and the time step: resolved, not needlessly fine.
+void validate_time_step(const SiloCaseSettings& s) {
     if (!(s.materials.stiffness_scale > 0) || s.materials.stiffness_scale > 100)
         reject_setting("stiffness_scale", s.materials.stiffness_scale, "must lie in (0, 100]");
     if (s.time_step < 0 || !std::isfinite(s.time_step)) reject_setting("dt", s.time_step, "must be >= 0 s (0: automatic)");
@@ -321,7 +328,10 @@ void validate(const SiloCaseSettings& s) {
                        "must lie in [" + setting_text(kMinTimeStepFraction) +
                            ", 1] (of the Rayleigh time step; smaller is no more accurate, and the run would take up "
                            "to a thousand times the steps)");
-    validate(s.vibration);
+}
+
+// The contact law and the discharge's options, and what the yade law cannot carry.
+void validate_contact_options(const SiloCaseSettings& s) {
     if (s.contact_law != SiloContactLaw::edem && s.contact_law != SiloContactLaw::yade)
         reject_setting("contact_law", static_cast<double>(s.contact_law), "must be edem (0) or yade (1)");
     if (s.discharge_wall_facets != 0) {
@@ -354,6 +364,10 @@ void validate(const SiloCaseSettings& s) {
         s.contacts_at_opening != ContactsAtOpening::yade_import)
         reject_setting("contacts_at_opening", static_cast<double>(s.contacts_at_opening),
                        "must be keep_history (0), forget_history (1) or yade_import (2)");
+}
+
+// The vibration against the run: resolved by the time step, started in time, above the removal plane.
+void validate_vibration_in_run(const SiloCaseSettings& s) {
     if (s.vibration.vibrates()) {
         // a period resolved by fewer steps would alias: the walls jump rather than oscillate
         constexpr double kStepsPerPeriod = 20;
@@ -374,6 +388,10 @@ void validate(const SiloCaseSettings& s) {
                                setting_text(s.removal_depth) + " m) of the plane below which grains count as "
                                "discharged: at most " + setting_text(0.5 * s.removal_depth) + " m along z");
     }
+}
+
+// Times, intervals, threads and the steady window.
+void validate_run_control(const SiloCaseSettings& s) {
     if (!(s.fill_time_max > 0) || !std::isfinite(s.fill_time_max)) reject_setting("fill_time", s.fill_time_max, "must be > 0 s");
     if (!(s.max_time > 0) || !std::isfinite(s.max_time)) reject_setting("max_time", s.max_time, "must be > 0 s");
     if (!(s.stop_fraction > 0 && s.stop_fraction <= 1))
@@ -390,11 +408,14 @@ void validate(const SiloCaseSettings& s) {
         reject_setting("wall_limit", s.wall_limit, "needs a checkpoint file: a run stopped at the limit resumes from it");
     if (!(s.steady_lower >= 0 && s.steady_lower < s.steady_upper && s.steady_upper <= 1))
         reject_setting("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
-    // Last (the checks above name a more specific cause first): contacts so soft that two grains meeting at the speed
-    // of a fall through the whole silo would overlap by more than the smallest sphere's radius pass through each other
-    // (a stiffness_scale of 1e-12 gave a 2 s time step and every grain fell through the walls). Hertz's impact
+}
+
+void validate_contact_softness(const SiloCaseSettings& s) {
+    // Contacts so soft that two grains meeting at the speed of a fall through the whole silo would overlap by more
+    // than the smallest sphere's radius pass through each other (a stiffness_scale of 1e-12 gave a 2 s time step and every grain fell through the walls). Hertz's impact
     // overlap, two grains head on: delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5), m* = m/2, R* = r/2, E* = E/(2(1-nu^2)).
     // The reduced cases' 1e-3 gives 0.6 r; 1e-4 would give 1.6 r.
+    const double grain_mass = mass_of_grain(s.materials);
     const double smallest_radius = smallest_sphere_radius(s.materials);
     const Material grain = s.materials.wheat_scaled();
     const double young = 2 * grain.shear_modulus * (1 + grain.poisson);
@@ -411,6 +432,20 @@ void validate(const SiloCaseSettings& s) {
                            setting_text(s.materials.stiffness_scale *
                                         std::pow(impact_overlap / smallest_radius, 2.5)) +
                            " for this material and silo");
+}
+
+}  // namespace
+
+void validate(const SiloCaseSettings& s) {
+    validate(s.materials);  // first: the checks below derive masses and time steps from them
+    validate(s.geometry, grain_length(s.materials));
+    validate_bed_size(s);
+    validate_time_step(s);
+    validate(s.vibration);
+    validate_contact_options(s);
+    validate_vibration_in_run(s);
+    validate_run_control(s);
+    validate_contact_softness(s);  // last: the checks above name a more specific cause first
 }
 
 namespace {
