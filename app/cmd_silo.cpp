@@ -555,12 +555,9 @@ std::unique_ptr<orchestrator::FolderLock> lock_output_folder(const fs::path& dir
     }
 }
 
-// A new run into `dir` (refused when dir holds the checkpoint of an unfinished run: it would be overwritten).
-void run_silo(const SiloCli& o, CLI::App& sub) {
-    ks::SiloCaseSettings s = settings_from(o, sub);
-    const fs::path dir =
-        o.out.empty() ? fs::path("silo_theta" + fixed(s.geometry.half_angle_deg, 0)) : fs::path(o.out);
-    check_output_folder(dir.string(), "--out");  // first: a path the file system refuses fails every look into it
+// Refuses an output folder that holds an unfinished run's checkpoint, a finished run's results, or (in a folder no
+// silo run has held) a file of the user's that a run would replace.
+void check_out_folder_free(const fs::path& dir) {
     if (fs::exists(dir / kCheckpointName))
         throw UserError("out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
@@ -577,17 +574,21 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
             (fs::is_regular_file(fs::symlink_status(dir / name)) || fs::is_symlink(fs::symlink_status(dir / name))))
             throw UserError("out = '" + dir.string() + "' already holds " + name + ", a file a silo run writes: give "
                             "another --out (a new or empty folder), or remove it");
-    if (!o.no_plots) require_gnuplot("--no-plots");
+}
+
+void check_checkpoint_options(const SiloCli& o, const CLI::App& sub) {
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
                         " needs the checkpoint that --no-checkpoint turns off");
     if (o.no_checkpoint && sub.count("--checkpoint-every"))
         throw UserError("--checkpoint-every " + ks::setting_text(o.checkpoint_every) +
                         ": --no-checkpoint turns the checkpoint off; give one of the two");
-    // every output place before the run (a run of hours into an unwritable folder failed at its end, and told the
-    // user to resume from a checkpoint it could never write): the output folder (results, plots, checkpoint), the
-    // VTK folder and the exported bed
-    check_output_folder(dir.string(), "--out");
+}
+
+// Every output place before the run (a run of hours into an unwritable folder failed at its end, and told the user
+// to resume from a checkpoint it could never write): the VTK folder, the run's files apart from its inputs, and the
+// exported beds, whose writers are attached to the run here.
+void prepare_outputs(const SiloCli& o, const fs::path& dir, ks::SiloCaseSettings& s) {
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk");
     std::vector<NamedPath> outputs{{dir.string(), "--out"}};
     for (const char* name : kRunFiles) outputs.push_back({(dir / name).string(), std::string("--out's ") + name});
@@ -612,30 +613,23 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
             write_silo_bed(file, bed, settings, BedMoment::generation, "export-cloud");
         };
     }
-    if (o.check_only) {
-        std::cout << "silo: the settings are valid (--check: nothing run, nothing written)\n";
-        return;
-    }
+}
+
+// The output folder and the VTK folder; on a failure nothing half-made is left behind.
+void create_output_folders(const fs::path& dir, const std::string& vtk_dir) {
     std::error_code ec;
     const bool created_out = fs::create_directories(dir, ec);
     if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
-    if (!s.vtk_dir.empty()) {
-        fs::create_directories(s.vtk_dir, ec);
-        if (ec) {
-            std::error_code ignored;
-            if (created_out) fs::remove(dir, ignored);  // nothing half-made left behind: it is empty
-            throw UserError("vtk = '" + s.vtk_dir + "': cannot create the directory: " + ec.message());
-        }
+    if (vtk_dir.empty()) return;
+    fs::create_directories(vtk_dir, ec);
+    if (ec) {
+        std::error_code ignored;
+        if (created_out) fs::remove(dir, ignored);  // it is empty
+        throw UserError("vtk = '" + vtk_dir + "': cannot create the directory: " + ec.message());
     }
-    // one demcal per output folder: a second one (a repeated command, a sweep started twice) stops here
-    const auto lock = lock_output_folder(dir);
-    if (fs::exists(dir / kCheckpointName) || fs::is_regular_file(dir / "summary.json"))
-        throw UserError("out = '" + dir.string() + "': another demcal has just run into this folder");
-    if (!o.no_checkpoint) {
-        s.checkpoint_file = (dir / kCheckpointName).string();
-        s.checkpoint_interval = o.checkpoint_every;
-    }
-    s.wall_limit = o.wall_limit;
+}
+
+void print_run_header(const ks::SiloCaseSettings& s, const fs::path& dir) {
     std::cout << "demcal silo: " << s.geometry.describe() << "\n  " << s.threads << " thread(s), seed " << s.seed
               << ", stiffness scale " << s.materials.stiffness_scale << ", output " << dir.string() << "\n  contact law: "
               << ks::contact_law_name(s);
@@ -649,6 +643,33 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
                   << " (continue an interrupted run with `demcal silo --resume " << dir.string() << "`)";
     std::cout << std::endl;
+}
+
+// A new run into `dir` (refused when dir holds the checkpoint of an unfinished run: it would be overwritten).
+void run_silo(const SiloCli& o, CLI::App& sub) {
+    ks::SiloCaseSettings s = settings_from(o, sub);
+    const fs::path dir =
+        o.out.empty() ? fs::path("silo_theta" + fixed(s.geometry.half_angle_deg, 0)) : fs::path(o.out);
+    check_output_folder(dir.string(), "--out");  // first: a path the file system refuses fails every look into it
+    check_out_folder_free(dir);
+    if (!o.no_plots) require_gnuplot("--no-plots");
+    check_checkpoint_options(o, sub);
+    prepare_outputs(o, dir, s);
+    if (o.check_only) {
+        std::cout << "silo: the settings are valid (--check: nothing run, nothing written)\n";
+        return;
+    }
+    create_output_folders(dir, s.vtk_dir);
+    // one demcal per output folder: a second one (a repeated command, a sweep started twice) stops here
+    const auto lock = lock_output_folder(dir);
+    if (fs::exists(dir / kCheckpointName) || fs::is_regular_file(dir / "summary.json"))
+        throw UserError("out = '" + dir.string() + "': another demcal has just run into this folder");
+    if (!o.no_checkpoint) {
+        s.checkpoint_file = (dir / kCheckpointName).string();
+        s.checkpoint_interval = o.checkpoint_every;
+    }
+    s.wall_limit = o.wall_limit;
+    print_run_header(s, dir);
     std::optional<StopOnSignal> stop_on_signal;  // without a checkpoint there is nothing to stop to
     if (!s.checkpoint_file.empty()) {
         stop_on_signal.emplace();

@@ -225,29 +225,27 @@ void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<doubl
     }
 }
 
-// Returns how many cells have a rate (a mean over at least one run whose rate was determined).
-int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
-    std::map<std::pair<double, long long>, RunResult> still_of;  // (theta, seed)
-    std::vector<RunResult> results;
-    json all = json::array();
-    int cells_with_rate = 0;
-    for (const RunSpec& r : runs) {
-        const RunResult res = read_run(dir, r);
-        results.push_back(res);
-        if (r.frequency == 0) still_of[{r.theta, r.seed}] = res;
-        json entry = {{"theta_deg", r.theta}, {"frequency_hz", r.frequency}, {"seed", r.seed}};
-        if (res.finished) {
-            entry["rate_g_s"] = res.rate;
-            entry["flow_pattern"] = res.pattern;
-            if (std::isfinite(res.outlet_density)) {
-                entry["outlet_solid_density_kg_m3"] = res.outlet_density;
-                entry["outlet_downward_speed_m_s"] = res.outlet_speed;
-            }
-        } else if (res.failed) {
-            entry["failed"] = true;
+json run_json(const RunSpec& r, const RunResult& res) {
+    json entry = {{"theta_deg", r.theta}, {"frequency_hz", r.frequency}, {"seed", r.seed}};
+    if (res.finished) {
+        entry["rate_g_s"] = res.rate;
+        entry["flow_pattern"] = res.pattern;
+        if (std::isfinite(res.outlet_density)) {
+            entry["outlet_solid_density_kg_m3"] = res.outlet_density;
+            entry["outlet_downward_speed_m_s"] = res.outlet_speed;
         }
-        all.push_back(entry);
+    } else if (res.failed) {
+        entry["failed"] = true;
     }
+    return entry;
+}
+
+// The runs by (theta, frequency), each beside the still run of its angle and seed (the same filled bed).
+std::map<std::pair<double, double>, Cell> cells_of(const std::vector<RunSpec>& runs,
+                                                   const std::vector<RunResult>& results) {
+    std::map<std::pair<double, long long>, RunResult> still_of;  // (theta, seed)
+    for (std::size_t i = 0; i < runs.size(); ++i)
+        if (runs[i].frequency == 0) still_of[{runs[i].theta, runs[i].seed}] = results[i];
     std::map<std::pair<double, double>, Cell> cells;
     for (std::size_t i = 0; i < runs.size(); ++i) {
         Cell& c = cells[{runs[i].theta, runs[i].frequency}];
@@ -255,6 +253,74 @@ int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec
         const auto still = still_of.find({runs[i].theta, runs[i].seed});
         c.still.push_back(still == still_of.end() ? RunResult{} : still->second);
     }
+    return cells;
+}
+
+// One cell's statistics: the rate's mean and spread, the most frequent flow pattern, and the paired changes of the
+// rate and of its two factors at the outlet against the still runs.
+struct CellSummary {
+    double mean = NAN, sd = NAN, outlet_density = NAN, outlet_speed = NAN;
+    std::size_t n = 0;  // runs with a rate
+    int failed = 0;
+    std::string pattern = "-";
+    PairedChange rate_change, density_change, speed_change;
+};
+
+CellSummary summarize(const Cell& c, bool vibrated) {
+    CellSummary s;
+    std::vector<double> rates, densities, speeds, still_rates, still_densities, still_speeds;
+    std::map<std::string, int> patterns;
+    for (std::size_t i = 0; i < c.runs.size(); ++i) {
+        const RunResult& r = c.runs[i];
+        s.failed += r.failed;
+        if (r.finished) ++patterns[r.pattern];
+        rates.push_back(r.rate), densities.push_back(r.outlet_density), speeds.push_back(r.outlet_speed);
+        still_rates.push_back(c.still[i].rate), still_densities.push_back(c.still[i].outlet_density);
+        still_speeds.push_back(c.still[i].outlet_speed);
+    }
+    std::tie(s.mean, s.sd) = mean_sd(rates);
+    for (double x : rates) s.n += std::isfinite(x);
+    s.outlet_density = mean_sd(densities).first;
+    s.outlet_speed = mean_sd(speeds).first;
+    if (vibrated) {  // a still cell is its own reference: no change to report
+        s.rate_change = paired_change(rates, still_rates);
+        s.density_change = paired_change(densities, still_densities);
+        s.speed_change = paired_change(speeds, still_speeds);
+    }
+    int most = 0;
+    for (const auto& [p, count] : patterns)
+        if (count > most) s.pattern = p, most = count;
+    return s;
+}
+
+json cell_json(double theta, double f, double g, const CellSummary& s) {
+    return {{"theta_deg", theta}, {"frequency_hz", f}, {"peak_acceleration_g", g},
+            {"rate_mean_g_s", s.mean}, {"rate_sd_g_s", s.sd}, {"n", s.n}, {"failed", s.failed},
+            {"flow_pattern", s.pattern}, {"rate_change_paired", change_json(s.rate_change)},
+            {"outlet_solid_density_mean_kg_m3", s.outlet_density},
+            {"outlet_density_change_paired", change_json(s.density_change)},
+            {"outlet_downward_speed_mean_m_s", s.outlet_speed},
+            {"outlet_speed_change_paired", change_json(s.speed_change)}};
+}
+
+std::string cell_row(double theta, double f, double g, const CellSummary& s) {
+    std::ostringstream md;
+    md << "| " << theta << " | " << f << " | " << number_text(g, 3) << " | " << number_text(s.mean, 5) << " | "
+       << number_text(s.sd, 3) << " | " << s.n << " | " << s.pattern << " | " << change_text(s.rate_change) << " | "
+       << number_text(s.outlet_density, 4) << " | " << change_text(s.density_change) << " | "
+       << number_text(s.outlet_speed, 3) << " | " << change_text(s.speed_change) << " |\n";
+    return md.str();
+}
+
+// Returns how many cells have a rate (a mean over at least one run whose rate was determined).
+int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
+    std::vector<RunResult> results;
+    json all = json::array();
+    for (const RunSpec& r : runs) {
+        results.push_back(read_run(dir, r));
+        all.push_back(run_json(r, results.back()));
+    }
+    int cells_with_rate = 0;
     json table = json::array();
     std::ostringstream md;
     md << "| theta [deg] | f [Hz] | peak acceleration [g] | rate mean [g/s] | SD [g/s] | n | flow pattern | rate change "
@@ -262,47 +328,16 @@ int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec
           "[%] |\n"
        << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     std::map<double, std::string> data_by_theta;
-    for (const auto& [key, c] : cells) {
+    for (const auto& [key, c] : cells_of(runs, results)) {
         const auto [theta, f] = key;
-        std::vector<double> rates, densities, speeds, still_rates, still_densities, still_speeds;
-        std::map<std::string, int> patterns;
-        int failed = 0;
-        for (std::size_t i = 0; i < c.runs.size(); ++i) {
-            const RunResult& r = c.runs[i];
-            failed += r.failed;
-            if (r.finished) ++patterns[r.pattern];
-            rates.push_back(r.rate), densities.push_back(r.outlet_density), speeds.push_back(r.outlet_speed);
-            still_rates.push_back(c.still[i].rate), still_densities.push_back(c.still[i].outlet_density);
-            still_speeds.push_back(c.still[i].outlet_speed);
-        }
-        const auto [mean, sd] = mean_sd(rates);
-        std::size_t n = 0;
-        for (double x : rates) n += std::isfinite(x);
-        cells_with_rate += n > 0;
-        const double outlet_density = mean_sd(densities).first, outlet_speed = mean_sd(speeds).first;
-        // a still cell is its own reference: no change to report
-        const PairedChange rate_change = f > 0 ? paired_change(rates, still_rates) : PairedChange{};
-        const PairedChange density_change = f > 0 ? paired_change(densities, still_densities) : PairedChange{};
-        const PairedChange speed_change = f > 0 ? paired_change(speeds, still_speeds) : PairedChange{};
-        std::string pattern = "-";
-        int most = 0;
-        for (const auto& [p, count] : patterns)
-            if (count > most) pattern = p, most = count;
+        const CellSummary s = summarize(c, f > 0);
+        cells_with_rate += s.n > 0;
         const double g = o.amplitude * std::pow(2 * M_PI * f, 2) / 9.81;
-        table.push_back({{"theta_deg", theta}, {"frequency_hz", f}, {"peak_acceleration_g", g},
-                         {"rate_mean_g_s", mean}, {"rate_sd_g_s", sd}, {"n", n}, {"failed", failed},
-                         {"flow_pattern", pattern}, {"rate_change_paired", change_json(rate_change)},
-                         {"outlet_solid_density_mean_kg_m3", outlet_density},
-                         {"outlet_density_change_paired", change_json(density_change)},
-                         {"outlet_downward_speed_mean_m_s", outlet_speed},
-                         {"outlet_speed_change_paired", change_json(speed_change)}});
-        md << "| " << theta << " | " << f << " | " << number_text(g, 3) << " | " << number_text(mean, 5) << " | "
-           << number_text(sd, 3) << " | " << n << " | " << pattern << " | " << change_text(rate_change) << " | "
-           << number_text(outlet_density, 4) << " | " << change_text(density_change) << " | "
-           << number_text(outlet_speed, 3) << " | " << change_text(speed_change) << " |\n";
-        if (std::isfinite(mean))
-            data_by_theta[theta] += std::to_string(f) + " " + std::to_string(mean) + " " +
-                                    std::to_string(std::isfinite(sd) ? sd : 0.0) + "\n";
+        table.push_back(cell_json(theta, f, g, s));
+        md << cell_row(theta, f, g, s);
+        if (std::isfinite(s.mean))
+            data_by_theta[theta] += std::to_string(f) + " " + std::to_string(s.mean) + " " +
+                                    std::to_string(std::isfinite(s.sd) ? s.sd : 0.0) + "\n";
     }
     md << "\nChanges are paired seed by seed against the still run of the same angle and seed (the same filled bed); "
           "SE: the standard error of the pairs' mean. d ln(rate) = d ln(density) + d ln(speed) at the outlet splits a "
