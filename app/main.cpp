@@ -34,11 +34,16 @@ int run_command(int argc, char** argv) {
     CLI::App app{"demcal: DEM calibration, YADE campaigns, discharge models and a native DEM kernel"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "demcal 0.1");
-    app.failure_message([](const CLI::App* a, const CLI::Error& e) {  // CLI11's own text, its message on one line
-        std::string text = CLI::FailureMessage::simple(a, e);
-        const std::string what = e.what();
-        if (text.compare(0, what.size(), what) == 0) text = one_line(what) + text.substr(what.size());
-        return text;
+    // A malformed command line is refused like any other bad input: one line, "demcal: error: ", the option and the
+    // rule, and where the options are listed (CLI11's own text took two lines without the prefix)
+    app.failure_message([](const CLI::App* a, const CLI::Error& e) {
+        std::string command = "demcal";
+        for (const CLI::App* sub = a; sub;) {  // the subcommands given so far: the help that lists the options
+            const auto given = sub->get_subcommands();
+            sub = given.empty() ? nullptr : given.front();
+            if (sub) command += " " + sub->get_name();
+        }
+        return "demcal: error: " + one_line(e.what()) + " (the options: " + command + " --help)\n";
     });
     demcal::add_shear_commands(app);
     demcal::add_shear_run_command(app);

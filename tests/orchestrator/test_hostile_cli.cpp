@@ -57,7 +57,8 @@ struct Case {
 
 void refused(const std::vector<Case>& cases, const fs::path& dir) {
     for (const auto& c : cases) {
-        INFO(c.args[0] + " " + (c.args.size() > 1 ? c.args[1] : "") + " ... expecting " + c.expect.front());
+        INFO((c.args.empty() ? std::string("(no arguments)") : c.args[0] + " " + (c.args.size() > 1 ? c.args[1] : ""))
+             << " ... expecting " << c.expect.front());
         const auto before = listing(dir);
         const int rc = test::run_demcal(c.args, dir.parent_path() / "hostile.log");
         const std::string log = test::read_file(dir.parent_path() / "hostile.log");
@@ -65,6 +66,11 @@ void refused(const std::vector<Case>& cases, const fs::path& dir) {
         CHECK(rc == 2);
         for (const auto& e : c.expect) CHECK_THAT(log, Contains(e));
         CHECK(log.size() < 2000);  // one message, the value shortened
+        // one line, the same prefix whoever found the fault (shear-run, the engine's worker, reports what it finds
+        // in its run's files in the simulator's failure protocol the orchestrator reads: orchestrator/executor.hpp)
+        const bool worker = !c.args.empty() && c.args[0] == "shear-run";
+        CHECK((log.rfind("demcal: error: ", 0) == 0 || (worker && log.rfind("DEMCAL_FAILURE ", 0) == 0)));
+        CHECK(std::count(log.begin(), log.end(), '\n') == 1);
         CHECK(listing(dir) == before);
     }
 }
@@ -90,6 +96,22 @@ TEST_CASE("every number and integer option follows the number rule, whatever its
              // hexadecimal passed where strtod read it (the JSON and CSV readers and the integer options refuse it)
              {{"cutoff", "--bracket", "0,0x1p9"}, {"--bracket", "give LO,HI in Hz"}},
              {{"shear", tiny, "-s", "5e3,1e4,2e4", "-j", "0x10", "--campaign", camp}, {"--jobs", "'0x10' is not a number"}}},
+            dir);
+    fs::remove_all(root);
+}
+
+TEST_CASE("a malformed command line is one line as any refusal, with the help that lists the command's options",
+          "[cli]") {
+    // CLI11's own messages took two lines, without demcal's prefix
+    const fs::path root = test::fresh_test_dir("hostile-parse"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string data = test::source_path("examples/diagnose/beverloo_hopper_angle.csv").string();
+    refused({{{"diagnose", "--model", "beverloo", "--data", data, "--wall-friction-deg", "20"},
+              {"--wall-friction-deg requires --effective-friction-deg", "(the options: demcal diagnose --help)"}},
+             {{"silo", "--particles", "many"}, {"--particles: 'many' is not an integer", "demcal silo --help"}},
+             {{"crosscheck", "silo", "--theta", "30", "--seed", "x"}, {"--seed", "demcal crosscheck silo --help"}},
+             {{"predict"}, {"GEOMETRY is required", "demcal predict --help"}},
+             {{}, {"subcommand is required", "(the options: demcal --help)"}}},
             dir);
     fs::remove_all(root);
 }
