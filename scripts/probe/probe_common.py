@@ -81,3 +81,9 @@ def setup(argv):
     os.makedirs(fixtures)
     make_fixtures(repo, fixtures)
     return demcal, repo, (argv[3] if len(argv) > 3 else None), work, fixtures
+
+
+def not_one_line(rc, out):
+    """True for a refusal (exit 2) whose output is not one line beginning "demcal: error: " (or, from shear-run, the
+    worker's DEMCAL_FAILURE protocol): the README's promise for every refusal."""
+    return rc == 2 and (out.strip().count("\n") > 0 or not out.startswith(("demcal: error: ", "DEMCAL_FAILURE ")))

@@ -7,7 +7,7 @@ Usage: python3 scripts/probe/probe_json_fields.py build/app/demcal . [KIND] > ou
 Not a test: a probe for a person to read; its findings become tests (tests/orchestrator/test_hostile_cli.cpp)."""
 import copy, json, os, shutil, subprocess, sys, tempfile, time, concurrent.futures as cf
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from probe_common import run_bounded, setup  # noqa: E402
+from probe_common import not_one_line, run_bounded, setup  # noqa: E402
 demcal, repo, only, WORK, FIX = setup(sys.argv)
 ex = repo + "/examples"
 kinds = {  # name: (source file, argv with FILE for the mutated copy)
@@ -65,6 +65,7 @@ with cf.ThreadPoolExecutor(int(os.environ.get("J", "2"))) as pool:
         if rc == 124: flags.append("RAN")
         if rc == 125 or out.startswith("ORPHANS"): flags.append("NOSTOP")
         if rc == 2 and path[-1] not in out and "bogus" not in out: flags.append("UNNAMED")
+        if not_one_line(rc, out): flags.append("NOTONELINE")
         if len(out) > 4000: flags.append("LONG")
         if rc not in (0, 2, 124): flags.append("RC%d" % rc)
         if rc == 2 and new: flags.append("WROTE:" + ",".join(new))

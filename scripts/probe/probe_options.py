@@ -4,13 +4,14 @@ command line in turn gets "", subnormal, huge, negative, NaN, inf, 0, -0, hex, p
 folders and devices, and paths holding a newline, shell quoting or UTF-8 (PROBE_VALUES='["a", "b"]' tries others,
 PROBE_OPTIONS=REGEX only the options it matches). Each case runs under a 4 s limit, then SIGTERM (a command that does not stop within 20 s, or that
 leaves processes behind, is flagged NOSTOP). One line per case: exit code, flags (SIGNAL, NOSTOP, RC<n> for an exit
-other than 0/2, UNNAMED for a refusal not naming the option, LONG for > 4 kB of output, WROTE for files left by a
+other than 0/2, UNNAMED for a refusal not naming the option, NOTONELINE for one that is not one line beginning
+"demcal: error: " (or the worker's DEMCAL_FAILURE), LONG for > 4 kB of output, WROTE for files left by a
 refusal, RAN for a value accepted and run until the limit: review those by hand), the last message line.
 Usage: python3 scripts/probe/probe_options.py build/app/demcal . [COMMAND] > out.txt   (J=2 parallel; about 25 min)
 Not a test: a probe for a person to read; its findings become tests (tests/orchestrator/test_hostile_cli.cpp)."""
 import time, json, os, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from probe_common import run_bounded, setup  # noqa: E402
+from probe_common import not_one_line, run_bounded, setup  # noqa: E402
 demcal, repo, only, WORK, FIX = setup(sys.argv)
 ex = repo + "/examples"
 base = {
@@ -81,6 +82,7 @@ with cf.ThreadPoolExecutor(int(os.environ.get("J", "2"))) as pool:
         if rc == 124: flags.append("RAN")
         if rc == 125 or err.startswith("ORPHANS"): flags.append("NOSTOP")
         if rc == 2 and opt.lstrip("-") not in err and opt not in err: flags.append("UNNAMED")
+        if not_one_line(rc, err): flags.append("NOTONELINE")
         if len(err) > 4000: flags.append("LONG")
         if rc not in (0, 2, 124): flags.append("RC%d" % rc)
         if rc != 0 and new and rc != 124: flags.append("WROTE:" + ",".join(new))
