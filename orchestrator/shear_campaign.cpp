@@ -53,8 +53,16 @@ ShearCampaignSpec ShearCampaignSpec::from_json(const nlohmann::json& j) {
     return s;
 }
 
+namespace {
+// DEMCAL_YADE_SCRIPTS, when set and not empty: another folder of demcal's YADE scripts (an installed copy).
+const char* scripts_folder_override() {
+    const char* d = std::getenv("DEMCAL_YADE_SCRIPTS");
+    return d && *d ? d : nullptr;
+}
+}  // namespace
+
 fs::path default_shear_template() {
-    if (const char* d = std::getenv("DEMCAL_YADE_SCRIPTS")) return fs::path(d) / "shear_box.py";
+    if (const char* d = scripts_folder_override()) return fs::path(d) / "shear_box.py";
     return fs::path(DEMCAL_YADE_SCRIPTS_DIR) / "shear_box.py";
 }
 
@@ -249,8 +257,15 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
         make_run_params(material, s, spec.base_seed + spec.replicates - 1,
                         "the run at --normal-stress " + analytics::number_text(s));
     const ShearCampaignSpec s = resolved(spec);
-    if (s.engine == ShearEngine::yade && !fs::is_regular_file(s.template_path))
-        throw std::invalid_argument("template = '" + s.template_path.string() + "' is not a file");
+    if (s.engine == ShearEngine::yade && !fs::is_regular_file(s.template_path)) {
+        const char* folder = scripts_folder_override();
+        throw std::invalid_argument(
+            "template = '" + s.template_path.string() + "' is not a file" +
+            (folder && s.template_path == default_shear_template()
+                 ? std::string(" (its folder is DEMCAL_YADE_SCRIPTS = '") + folder +
+                       "'; unset it to use demcal's own scripts)"
+                 : std::string()));
+    }
 }
 
 nlohmann::json read_shear_result(const fs::path& file, const nlohmann::json* run_params) {

@@ -107,6 +107,8 @@ struct ShearCampaignOutcome {
     bool complete() const { return !interrupted && failed == 0 && infrastructure_failure.empty(); }
 };
 
+// yade_scripts/shear_box.py of this build, or of the folder DEMCAL_YADE_SCRIPTS names when it is set and not empty
+// (an installed copy of demcal's YADE scripts).
 std::filesystem::path default_shear_template();
 // Throws std::invalid_argument when the YADE launcher cannot be found (naming it and how to install it).
 std::filesystem::path find_yade(const std::string& yade);

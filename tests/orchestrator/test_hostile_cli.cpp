@@ -1110,3 +1110,17 @@ TEST_CASE("probe 50: a local pool far beyond the machine's cores is refused, any
     CHECK_THAT(test::read_file(root / "slurm.log"), !Contains("local pool") && Contains("max-runs"));
     fs::remove_all(root);
 }
+
+TEST_CASE("a DEMCAL_YADE_SCRIPTS folder without demcal's scripts is refused by the variable's name, nothing written",
+          "[cli]") {
+    // it was refused as "template = '.../shear_box.py' is not a file", the variable that chose the folder unnamed
+    const fs::path root = test::fresh_test_dir("hostile-scripts-env"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    ::setenv("DEMCAL_YADE_SCRIPTS", root.c_str(), 1);
+    refused({{{"shear", tiny, "-s", "5e3,1e4,2e4", "--campaign", (dir / "c").string()},
+              {"DEMCAL_YADE_SCRIPTS = '" + root.string() + "'", "shear_box.py' is not a file"}}},
+            dir);
+    ::unsetenv("DEMCAL_YADE_SCRIPTS");
+    fs::remove_all(root);
+}
