@@ -157,6 +157,83 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
     return outcome.failed > 0 || !(ev.peak && ev.residual) ? 1 : 0;
 }
 
+// A shear campaign: every input checked before anything is written, the runs, the failure line.
+void run_shear(const ShearCliOptions& opt) {
+    ShearCampaignSpec spec;
+    spec.material = read_json_file(opt.material_file, "material");
+    validate_material(spec.material, opt.material_file);
+    check_run_count(static_cast<double>(opt.normal_stresses.size()) * opt.replicates, opt.exec.max_runs,
+                    "shear: " + std::to_string(opt.normal_stresses.size()) + " normal stresses x " +
+                        std::to_string(opt.replicates) + " replicates");
+    spec.normal_stresses = opt.normal_stresses;
+    spec.replicates = opt.replicates;
+    spec.base_seed = opt.seed;
+    spec.template_path = opt.template_path;
+    spec.engine = parse_shear_engine(opt.engine);
+    if (spec.engine == ShearEngine::kernel && !opt.template_path.empty())
+        throw UserError("template = '" + opt.template_path + "' is a YADE script: it applies to --engine yade only");
+    validate_shear_spec(spec);
+    if (spec.engine == ShearEngine::yade) find_yade(opt.exec.yade);
+    analytics::check_failure_line_design(spec.normal_stresses, spec.replicates);
+    const fs::path dir = opt.campaign_dir.empty() ? fs::path("campaigns") / fs::path(opt.material_file).stem()
+                                                  : fs::path(opt.campaign_dir);
+    ShearCampaignRunner runner(dir, opt.exec);
+    std::cout << "campaign directory " << runner.dir().string() << ": " << spec.normal_stresses.size()
+              << " normal stresses x " << spec.replicates << " replicates, " << to_string(spec.engine) << " engine, "
+              << opt.exec.executor << " executor\n";
+    const auto outcome = runner.run(spec, print_progress);
+    const int code = report_campaign(runner.dir(), outcome, opt.plot_format);
+    if (code == 130) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";
+    if (code != 0) throw CLI::RuntimeError(code);
+}
+
+// One campaign's line of `demcal status`: its runs by state, their time, its failures and its failure line.
+void print_campaign_status(const ShearCampaignOutcome& o, bool folder_held) {
+    std::map<std::string, int> by_state;
+    double wall = 0;
+    for (const auto& r : o.runs) {
+        ++by_state[to_string(r.state)];
+        wall += r.wall_s;
+    }
+    std::cout << o.campaign.name << " [" << to_string(o.campaign.status) << "] " << to_string(o.campaign.kind) << ": "
+              << o.runs.size() << " runs";
+    // runs marked running while no demcal holds the folder belong to one that died: the next resume reruns them
+    for (const auto& [s, n] : by_state)
+        std::cout << ", " << n << " "
+                  << (s == "running" && !folder_held ? "interrupted (no demcal holds the campaign: `demcal resume` "
+                                                       "reruns them)"
+                                                     : s);
+    std::cout << "; run time " << duration_text(wall) << ", CPU " << duration_text(o.cpu_s) << "\n";
+    const bool shear = o.campaign.kind == CampaignKind::shear;
+    for (const auto& r : o.runs)
+        if (r.state == RunState::failed)
+            std::cout << "  failed: "
+                      << (shear ? "sigma=" + r.label["normal_stress"].dump() + " rep " + r.label["replicate"].dump()
+                                : r.label.dump())
+                      << " after " << r.attempts << " attempt(s): " << r.cause << ": " << r.message << "\n";
+    if (!shear) return;  // other campaigns (a silo cross-check) report themselves
+    const auto ev = calibration::failure_lines_of(o);
+    if (ev.peak) print_line("  peak failure line", *ev.peak);
+}
+
+void print_status(const std::string& dir) {
+    const std::vector<ShearCampaignOutcome> outs = inspect_campaigns(dir);
+    for (const auto& o : outs) print_campaign_status(o, orchestrator::FolderLock::held(dir));
+    if (outs.empty()) std::cout << "no campaigns in " << dir << "\n";
+}
+
+void run_resume(const ShearCliOptions& opt) {
+    if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite"))
+        throw UserError("campaign = '" + opt.campaign_dir + "' holds no campaign.sqlite");
+    find_yade(opt.exec.yade);  // before the store is opened: a bad --yade costs nothing
+    ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
+    const auto outs = runner.resume(print_progress);
+    if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";
+    int code = 0;
+    for (const auto& o : outs) code = std::max(code, report_campaign(runner.dir(), o, opt.plot_format));
+    if (code != 0) throw CLI::RuntimeError(code);
+}
+
 }  // namespace
 
 void add_shear_commands(CLI::App& app) {
@@ -180,101 +257,19 @@ void add_shear_commands(CLI::App& app) {
     shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     shear->add_flag("--force", opt->exec.force, "recompute runs already in the store");
     add_execution_options(shear, opt->exec);
-    shear->callback([opt] {
-        ShearCampaignSpec spec;
-        spec.material = read_json_file(opt->material_file, "material");
-        try {
-            validate_material(spec.material, opt->material_file);
-        } catch (const std::invalid_argument& e) {
-            throw UserError(e.what());
-        }
-        check_run_count(static_cast<double>(opt->normal_stresses.size()) * opt->replicates, opt->exec.max_runs,
-                        "shear: " + std::to_string(opt->normal_stresses.size()) + " normal stresses x " +
-                            std::to_string(opt->replicates) + " replicates");
-        spec.normal_stresses = opt->normal_stresses;
-        spec.replicates = opt->replicates;
-        spec.base_seed = opt->seed;
-        spec.template_path = opt->template_path;
-        spec.engine = parse_shear_engine(opt->engine);
-        if (spec.engine == ShearEngine::kernel && !opt->template_path.empty())
-            throw UserError("template = '" + opt->template_path + "' is a YADE script: it applies to --engine yade only");
-        try {
-            validate_shear_spec(spec);  // everything is checked before anything is written
-            if (spec.engine == ShearEngine::yade) find_yade(opt->exec.yade);
-            analytics::check_failure_line_design(spec.normal_stresses, spec.replicates);
-        } catch (const std::invalid_argument& e) {
-            throw UserError(e.what());
-        }
-        const fs::path dir = opt->campaign_dir.empty()
-                                 ? fs::path("campaigns") / fs::path(opt->material_file).stem()
-                                 : fs::path(opt->campaign_dir);
-        ShearCampaignRunner runner(dir, opt->exec);
-        std::cout << "campaign directory " << runner.dir().string() << ": " << spec.normal_stresses.size()
-                  << " normal stresses x " << spec.replicates << " replicates, " << to_string(spec.engine)
-                  << " engine, " << opt->exec.executor << " executor\n";
-        const auto outcome = runner.run(spec, print_progress);
-        const int code = report_campaign(runner.dir(), outcome, opt->plot_format);
-        if (code == 130) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";
-        if (code != 0) throw CLI::RuntimeError(code);
-    });
+    shear->callback([opt] { run_shear(*opt); });
 
     auto status_dir = std::make_shared<std::string>();
     auto* status = app.add_subcommand("status", "summarise the campaigns of a directory");
     status->add_option("dir", *status_dir, "campaign directory")->required();
-    status->callback([status_dir] {
-        std::vector<ShearCampaignOutcome> outs;
-        try {
-            outs = inspect_campaigns(*status_dir);
-        } catch (const std::invalid_argument& e) {
-            throw UserError(e.what());
-        }
-        for (const auto& o : outs) {
-            std::map<std::string, int> by_state;
-            double wall = 0;
-            for (const auto& r : o.runs) {
-                ++by_state[to_string(r.state)];
-                wall += r.wall_s;
-            }
-            std::cout << o.campaign.name << " [" << to_string(o.campaign.status) << "] " << to_string(o.campaign.kind) << ": "
-                      << o.runs.size() << " runs";
-            // runs marked running while no demcal holds the folder belong to one that died: the next resume reruns them
-            const bool holder = orchestrator::FolderLock::held(*status_dir);
-            for (const auto& [s, n] : by_state)
-                std::cout << ", " << n << " "
-                          << (s == "running" && !holder ? "interrupted (no demcal holds the campaign: `demcal resume` "
-                                                          "reruns them)"
-                                                        : s);
-            std::cout << "; run time " << duration_text(wall) << ", CPU " << duration_text(o.cpu_s) << "\n";
-            const bool shear = o.campaign.kind == CampaignKind::shear;
-            for (const auto& r : o.runs)
-                if (r.state == RunState::failed)
-                    std::cout << "  failed: "
-                              << (shear ? "sigma=" + r.label["normal_stress"].dump() + " rep " + r.label["replicate"].dump()
-                                        : r.label.dump())
-                              << " after " << r.attempts << " attempt(s): " << r.cause << ": " << r.message << "\n";
-            if (!shear) continue;  // other campaigns (a silo cross-check) report themselves
-            const auto ev = calibration::failure_lines_of(o);
-            if (ev.peak) print_line("  peak failure line", *ev.peak);
-        }
-        if (outs.empty()) std::cout << "no campaigns in " << *status_dir << "\n";
-    });
+    status->callback([status_dir] { print_status(*status_dir); });
 
     auto resume_opt = std::make_shared<ShearCliOptions>();
     auto* resume = app.add_subcommand("resume", "continue the unfinished campaigns of a directory");
     resume->add_option("dir", resume_opt->campaign_dir, "campaign directory")->required();
     resume->add_option("--plot", resume_opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     add_execution_options(resume, resume_opt->exec);
-    resume->callback([resume_opt] {
-        if (!fs::exists(fs::path(resume_opt->campaign_dir) / "campaign.sqlite"))
-            throw UserError("campaign = '" + resume_opt->campaign_dir + "' holds no campaign.sqlite");
-        find_yade(resume_opt->exec.yade);  // before the store is opened: a bad --yade costs nothing
-        ShearCampaignRunner runner(resume_opt->campaign_dir, resume_opt->exec);
-        const auto outs = runner.resume(print_progress);
-        if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";
-        int code = 0;
-        for (const auto& o : outs) code = std::max(code, report_campaign(runner.dir(), o, resume_opt->plot_format));
-        if (code != 0) throw CLI::RuntimeError(code);
-    });
+    resume->callback([resume_opt] { run_resume(*resume_opt); });
 }
 
 }  // namespace demcal
