@@ -332,34 +332,9 @@ const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column"
                                               "--wall-friction-deg", "--outlier-alpha", "--drop-outliers",
                                               "--allow-undetermined"};
 
-// 0, or 1 when the diagnosis is not determined by the data (and not --allow-undetermined): results are written.
-int run_diagnose(const DiagnoseArgs& a) {
-    // outputs first (issue 23): a path that cannot be written is refused before any work
-    check_output_file_in_new_folders(a.json_out, "--json");
-    check_output_file_in_new_folders(a.report_out, "--report");
-    std::vector<NamedPath> outputs = {{a.json_out, "--json"}, {a.report_out, "--report"}};
-    std::vector<std::string> side_files;
-    if (!a.report_out.empty() && !a.no_plots)  // the report's plots and their data, beside it by its name
-        for (const auto& f : report_plot_files(a.report_out)) {
-            outputs.push_back({f.string(), "--report's plot file"});
-            side_files.push_back(f.string());
-        }
-    check_paths_apart({{a.data, "--data"}}, outputs);
-    check_side_files_free(a.report_out, side_files, "--report");
-    if (!a.report_out.empty() && !a.no_plots) require_gnuplot("--no-plots");
-    analytics::MeasuredData data;
-    analytics::DiagnoseResult r;
-    try {
-        const auto kind = analytics::data_kind_of(a.model);
-        data = analytics::read_measured_csv(a.data, kind, std::size_t(a.max_rows));
-        for (const auto& name : a.options.regime_columns) analytics::check_regime_column(data, name, "--regime-column");
-        auto options = a.options;
-        if (!std::isnan(a.effective_friction_deg)) options.effective_friction_deg = a.effective_friction_deg;
-        if (!std::isnan(a.wall_friction_deg)) options.wall_friction_deg = a.wall_friction_deg;
-        r = analytics::diagnose(data, a.model, options);
-    } catch (const std::invalid_argument& e) {
-        throw UserError(e.what());
-    }
+// The diagnosis on the console: the fit before, each effect added with its parameters and test, after, outliers,
+// warnings and what the data do not determine.
+void print_diagnosis(const analytics::DiagnoseResult& r) {
     std::cout << "model " << r.model << ": " << r.n << " rows, " << r.conditions << " conditions, " << r.folds
               << " CV folds\n"
               << "before: RMSE " << sci(r.before.rmse) << "  CV RMSE " << sci(r.before.cv_rmse) << "  MAPE "
@@ -386,6 +361,11 @@ int run_diagnose(const DiagnoseArgs& a) {
                   << "\n";
     for (const auto& w : r.warnings) std::cout << "warning: " << w << "\n";
     for (const auto& w : r.undetermined) std::cout << "not determined: " << w << "\n";
+}
+
+// --json and --report (with its residual plots unless --no-plots).
+void write_diagnosis_files(const DiagnoseArgs& a, const analytics::DiagnoseResult& r,
+                           const analytics::MeasuredData& data) {
     if (!a.json_out.empty()) write_result_file(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
         const std::filesystem::path report(a.report_out);
@@ -402,14 +382,67 @@ int run_diagnose(const DiagnoseArgs& a) {
         write_result_file(a.report_out, markdown_report(r, a.data, before_name, after_name));
         if (plots) plot_residuals(r, data, plots->data, plots->before, plots->after);
     }
+}
+
+// Every output place before any work (issue 23): a path that cannot be written is refused at once.
+void check_diagnosis_outputs(const DiagnoseArgs& a) {
+    check_output_file_in_new_folders(a.json_out, "--json");
+    check_output_file_in_new_folders(a.report_out, "--report");
+    std::vector<NamedPath> outputs = {{a.json_out, "--json"}, {a.report_out, "--report"}};
+    std::vector<std::string> side_files;
+    if (!a.report_out.empty() && !a.no_plots)  // the report's plots and their data, beside it by its name
+        for (const auto& f : report_plot_files(a.report_out)) {
+            outputs.push_back({f.string(), "--report's plot file"});
+            side_files.push_back(f.string());
+        }
+    check_paths_apart({{a.data, "--data"}}, outputs);
+    check_side_files_free(a.report_out, side_files, "--report");
+    if (!a.report_out.empty() && !a.no_plots) require_gnuplot("--no-plots");
+}
+
+// 0, or 1 when the diagnosis is not determined by the data (and not --allow-undetermined): results are written.
+int run_diagnose(const DiagnoseArgs& a) {
+    check_diagnosis_outputs(a);
+    const analytics::MeasuredData data =
+        analytics::read_measured_csv(a.data, analytics::data_kind_of(a.model), std::size_t(a.max_rows));
+    for (const auto& name : a.options.regime_columns) analytics::check_regime_column(data, name, "--regime-column");
+    auto options = a.options;
+    if (!std::isnan(a.effective_friction_deg)) options.effective_friction_deg = a.effective_friction_deg;
+    if (!std::isnan(a.wall_friction_deg)) options.wall_friction_deg = a.wall_friction_deg;
+    const analytics::DiagnoseResult r = analytics::diagnose(data, a.model, options);
+    print_diagnosis(r);
+    write_diagnosis_files(a, r, data);
     if (r.undetermined.empty() || a.allow_undetermined) return 0;
     std::cout << "the diagnosis is not determined by these data (exit 1; --allow-undetermined: exit 0)\n";
     return 1;
 }
 
-}  // namespace
+// The model decides the run: silo-dem (kernel runs), or an analytical model; the options of the other refused.
+void run_diagnose_command(const DiagnoseArgs& args, const CLI::App& diagnose) {
+    if (args.model == "silo-dem") {
+        for (const char* option : kAnalyticalOnlyOptions)
+            if (diagnose.count(option))
+                throw UserError(std::string(option) + ": the analytical models take it, not --model silo-dem");
+        SiloDemArgs dem = args.silo_dem;
+        dem.data = args.data;
+        dem.json_out = args.json_out;
+        dem.report_out = args.report_out;
+        dem.no_plots = args.no_plots;
+        dem.alpha = args.options.family_alpha;
+        dem.min_cv_gain = args.options.min_cv_improvement;
+        if (const int status = run_silo_dem_diagnosis(dem); status != 0) throw CLI::RuntimeError(status);
+        return;
+    }
+    for (const char* option : kSiloDemOptions)
+        if (diagnose.count(option))
+            throw UserError(std::string(option) + ": only --model silo-dem takes it (model '" + args.model + "')");
+    if (!args.silo_dem.silo_args.empty())
+        throw UserError("options after -- ('" + args.silo_dem.silo_args.front() +
+                        "'): only --model silo-dem runs demcal silo");
+    if (const int status = run_diagnose(args); status != 0) throw CLI::RuntimeError(status);
+}
 
-void add_discharge_commands(CLI::App& app) {
+void add_predict_command(CLI::App& app) {
     auto predict = app.add_subcommand("predict", "Discharge rate of a silo by every analytical model, with validity");
     auto geometry = std::make_shared<std::string>();
     auto predict_json = std::make_shared<std::string>();
@@ -417,7 +450,48 @@ void add_discharge_commands(CLI::App& app) {
     predict->add_option("--json", *predict_json, "also write the predictions as JSON to this file");
     predict->footer(geometry_keys_help);
     predict->callback([geometry, predict_json] { run_predict(*geometry, *predict_json); });
+}
 
+// --model silo-dem's options: the kernel campaign that predicts every measured condition.
+void add_silo_dem_options(CLI::App* diagnose, SiloDemArgs& dem) {
+    diagnose->add_option("--material", dem.material, "silo-dem: the declared silo material (JSON, as demcal silo's)");
+    diagnose->add_option("--campaign", dem.campaign,
+                         "silo-dem: campaign folder of the kernel runs (default silo_dem_<data stem>); the same "
+                         "command continues it and reruns nothing");
+    diagnose->add_option("--jobs", dem.jobs, "silo-dem: kernel runs at once")->capture_default_str()->check(
+        integer_in(1, 256));
+    diagnose->add_option("--executor", dem.executor, "silo-dem: local (processes) or slurm (job arrays)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"local", "slurm"}));
+    diagnose->add_option("--partition", dem.partition, "silo-dem: SLURM partition (--executor slurm)");
+    diagnose->add_option("--seeds", dem.seeds, "silo-dem: kernel runs (seeds) averaged per condition and material")
+        ->capture_default_str()
+        ->check(integer_in(1, 20));
+    diagnose->add_option("--first-seed", dem.first_seed, "silo-dem: seed of the first prediction run")
+        ->capture_default_str()
+        ->check(integer_in(0, 1LL << 62));
+    diagnose->add_option("--grid-points", dem.grid_points, "silo-dem: coarse bracket per candidate (values run)")
+        ->capture_default_str()
+        ->check(integer_in(3, 30));
+    diagnose->add_option("--refine-steps", dem.refine_steps, "silo-dem: refinement proposals after the bracket")
+        ->capture_default_str()
+        ->check(integer_in(0, 20));
+    diagnose->add_option("--max-runs", dem.max_runs,
+                         "silo-dem: most kernel runs the search may take (conditions x seeds x (1 + candidates x "
+                         "(grid points + refine steps)), at most; a guard against typos), refused before any run")
+        ->capture_default_str()
+        ->check(integer_in(1, 1000000000));
+    diagnose->add_option("--candidates", dem.candidates,
+                         "silo-dem: the DEM effects to try, by name (default: all of " + candidate_names() +
+                             "; e.g. wall_friction,cohesion)")
+        ->allow_extra_args(false)  // (one value, split at commas: not the silo options after --)
+        ->delimiter(',');
+    diagnose->add_option("silo_args", dem.silo_args,
+                         "silo-dem, after --: options of every demcal silo run (e.g. --geometry G --particles 2000 "
+                         "--stiffness-scale 0.001 --fill-time 0.5 --threads 1 --no-plots)");
+}
+
+void add_diagnose_command(CLI::App& app) {
     auto diagnose = app.add_subcommand("diagnose", "Fit a model to measured data, trace its residuals to the effect "
                                                    "it lacks, report the error before and after");
     auto args = std::make_shared<DiagnoseArgs>();
@@ -466,67 +540,16 @@ void add_discharge_commands(CLI::App& app) {
         ->check(number_in(1e-6, 0.5));
     diagnose->add_flag("--drop-outliers", args->options.drop_outliers,
                        "report the fits without the rows flagged as outliers (the search never uses them)");
-    SiloDemArgs& dem = args->silo_dem;
-    diagnose->add_option("--material", dem.material, "silo-dem: the declared silo material (JSON, as demcal silo's)");
-    diagnose->add_option("--campaign", dem.campaign,
-                         "silo-dem: campaign folder of the kernel runs (default silo_dem_<data stem>); the same "
-                         "command continues it and reruns nothing");
-    diagnose->add_option("--jobs", dem.jobs, "silo-dem: kernel runs at once")->capture_default_str()->check(
-        integer_in(1, 256));
-    diagnose->add_option("--executor", dem.executor, "silo-dem: local (processes) or slurm (job arrays)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"local", "slurm"}));
-    diagnose->add_option("--partition", dem.partition, "silo-dem: SLURM partition (--executor slurm)");
-    diagnose->add_option("--seeds", dem.seeds, "silo-dem: kernel runs (seeds) averaged per condition and material")
-        ->capture_default_str()
-        ->check(integer_in(1, 20));
-    diagnose->add_option("--first-seed", dem.first_seed, "silo-dem: seed of the first prediction run")
-        ->capture_default_str()
-        ->check(integer_in(0, 1LL << 62));
-    diagnose->add_option("--grid-points", dem.grid_points, "silo-dem: coarse bracket per candidate (values run)")
-        ->capture_default_str()
-        ->check(integer_in(3, 30));
-    diagnose->add_option("--refine-steps", dem.refine_steps, "silo-dem: refinement proposals after the bracket")
-        ->capture_default_str()
-        ->check(integer_in(0, 20));
-    diagnose->add_option("--max-runs", dem.max_runs,
-                         "silo-dem: most kernel runs the search may take (conditions x seeds x (1 + candidates x "
-                         "(grid points + refine steps)), at most; a guard against typos), refused before any run")
-        ->capture_default_str()
-        ->check(integer_in(1, 1000000000));
-    diagnose->add_option("--candidates", dem.candidates,
-                         "silo-dem: the DEM effects to try, by name (default: all of " + candidate_names() +
-                             "; e.g. wall_friction,cohesion)")
-        ->allow_extra_args(false)  // (one value, split at commas: not the silo options after --)
-        ->delimiter(',');
-    diagnose->add_option("silo_args", dem.silo_args,
-                         "silo-dem, after --: options of every demcal silo run (e.g. --geometry G --particles 2000 "
-                         "--stiffness-scale 0.001 --fill-time 0.5 --threads 1 --no-plots)");
+    add_silo_dem_options(diagnose, args->silo_dem);
     diagnose->footer(std::string(diagnose_help) + "\n\n" + silo_dem_help + candidate_help());
-    diagnose->callback([args, diagnose] {
-        if (args->model == "silo-dem") {
-            for (const char* option : kAnalyticalOnlyOptions)
-                if (diagnose->count(option))
-                    throw UserError(std::string(option) + ": the analytical models take it, not --model silo-dem");
-            SiloDemArgs dem = args->silo_dem;
-            dem.data = args->data;
-            dem.json_out = args->json_out;
-            dem.report_out = args->report_out;
-            dem.no_plots = args->no_plots;
-            dem.alpha = args->options.family_alpha;
-            dem.min_cv_gain = args->options.min_cv_improvement;
-            const int status = run_silo_dem_diagnosis(dem);
-            if (status != 0) throw CLI::RuntimeError(status);
-            return;
-        }
-        for (const char* option : kSiloDemOptions)
-            if (diagnose->count(option))
-                throw UserError(std::string(option) + ": only --model silo-dem takes it (model '" + args->model + "')");
-        if (!args->silo_dem.silo_args.empty())
-            throw UserError("options after -- ('" + args->silo_dem.silo_args.front() +
-                            "'): only --model silo-dem runs demcal silo");
-        if (const int status = run_diagnose(*args); status != 0) throw CLI::RuntimeError(status);
-    });
+    diagnose->callback([args, diagnose] { run_diagnose_command(*args, *diagnose); });
+}
+
+}  // namespace
+
+void add_discharge_commands(CLI::App& app) {
+    add_predict_command(app);
+    add_diagnose_command(app);
 }
 
 }  // namespace demcal
