@@ -330,6 +330,15 @@ class BasicSimulation {
   // remove_bodies_if: the loads of the contacts with the spheres about to go, out of their neighbours' forces and
   // the last half kick (forces stay valid)
   void take_out_removed_contacts(const std::vector<char>& drop_sphere, const std::vector<char>& drop_clump);
+  // remove_bodies_if's steps: the spheres and clumps of the bodies that go, the new index of each kept item (-1 for
+  // one that goes), and the per-sphere, per-clump and per-body arrays compacted over the kept ones
+  void mark_removed_spheres(const std::vector<char>& drop_body, std::vector<char>& drop_sphere,
+                            std::vector<char>& drop_clump) const;
+  static std::vector<std::int32_t> kept_numbering(const std::vector<char>& drop);
+  void compact_spheres(const std::vector<char>& drop_sphere, const std::vector<std::int32_t>& c_old2new);
+  void compact_clumps(const std::vector<char>& drop_clump, const std::vector<std::int32_t>& s_old2new);
+  void compact_bodies(const std::vector<char>& drop_body, const std::vector<std::int32_t>& s_old2new,
+                      const std::vector<std::int32_t>& c_old2new);
   void find_wall_candidate_lists(const std::vector<Vec3>& centres, double reach,
                                  const std::vector<Vec3>& wall_displacement);
   // wall_grid_ for the walls at these displacements from where they were built, spheres reaching r + reach

@@ -1055,7 +1055,6 @@ void BasicSimulation<Law>::set_body_velocity(std::size_t b, const Vec3& velocity
   }
   forces_valid_ = false;
   rekick_on_refresh_ = false;  // (the state itself changed)
-  rekick_on_refresh_ = false;  // (the state itself changed)
 }
 
 template <class Law>
@@ -1073,6 +1072,33 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   if (res.count == 0) return res;
   const std::size_t n = x_.size(), nc = cx_.size();
   std::vector<char> drop_sphere(n, 0), drop_clump(nc, 0);
+  mark_removed_spheres(drop_body, drop_sphere, drop_clump);
+  // With exact removals on, the bodies go as if they had gone before the last force evaluation (as a leapfrog code
+  // erasing them between two steps, YADE's silo.py): their contacts' loads leave their neighbours' forces and the
+  // half kick those loads gave is taken back, so the forces stay valid and nothing else changes. (Recomputing every
+  // force instead re-evaluated each damped contact with the on-step velocities and re-capped its spring: at every
+  // removal the whole bed moved otherwise, which slowed the silo's discharge by about 2 %, measured against YADE;
+  // examples/crosscheck/README.md.) Not with local damping (the forces then hold the damping's rescaling): those
+  // forces are evaluated again.
+  const bool loads_known = exact_removal_ && forces_valid_ && local_damping_ == 0 && pair_torques_i_known_ &&
+                           pair_load_.size() == nl_.num_pairs() && pair_torque_i_.size() == pair_load_.size() &&
+                           nl_.row.size() == n + 1;
+  if (loads_known) take_out_removed_contacts(drop_sphere, drop_clump);
+  const std::vector<std::int32_t> s_old2new = kept_numbering(drop_sphere), c_old2new = kept_numbering(drop_clump);
+  compact_spheres(drop_sphere, c_old2new);
+  compact_clumps(drop_clump, s_old2new);
+  compact_bodies(drop_body, s_old2new, c_old2new);
+  const std::size_t kept_spheres = std::size_t(std::count(drop_sphere.begin(), drop_sphere.end(), char(0)));
+  nl_.renumber(s_old2new, kept_spheres, &Law::swap_history);
+  // forces of the remaining spheres are still valid except for the contacts with removed ones; recompute
+  forces_valid_ = loads_known;
+  rekick_on_refresh_ = false;  // (the state itself changed)
+  return res;
+}
+
+template <class Law>
+void BasicSimulation<Law>::mark_removed_spheres(const std::vector<char>& drop_body, std::vector<char>& drop_sphere,
+                                                std::vector<char>& drop_clump) const {
   for (std::size_t b = 0; b < body_ref_.size(); ++b) {
     if (!drop_body[b]) continue;
     const std::int32_t ref = body_ref_[b];
@@ -1084,23 +1110,21 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
       for (std::uint32_t k = cmem_start_[c]; k < cmem_start_[c + 1]; ++k) drop_sphere[cmem_[k]] = 1;
     }
   }
-  // With exact removals on, the bodies go as if they had gone before the last force evaluation (as a leapfrog code
-  // erasing them between two steps, YADE's silo.py): their contacts' loads leave their neighbours' forces and the half kick those loads gave
-  // is taken back, so the forces stay valid and nothing else changes. (Recomputing every force instead re-evaluated
-  // each damped contact with the on-step velocities and re-capped its spring: at every removal the whole bed moved
-  // otherwise, which slowed the silo's discharge by about 2 %, measured against YADE; examples/crosscheck/README.md.)
-  // Not with local damping (the forces then hold the damping's rescaling): those forces are evaluated again.
-  const bool loads_known = exact_removal_ && forces_valid_ && local_damping_ == 0 && pair_torques_i_known_ &&
-                           pair_load_.size() == nl_.num_pairs() && pair_torque_i_.size() == pair_load_.size() &&
-                           nl_.row.size() == n + 1;
-  if (loads_known) take_out_removed_contacts(drop_sphere, drop_clump);
-  std::vector<std::int32_t> s_old2new(n, -1), c_old2new(nc, -1);
-  std::size_t ns = 0, ncn = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!drop_sphere[i]) s_old2new[i] = std::int32_t(ns++);
-  for (std::size_t c = 0; c < nc; ++c)
-    if (!drop_clump[c]) c_old2new[c] = std::int32_t(ncn++);
-  // compact per-sphere arrays
+}
+
+template <class Law>
+std::vector<std::int32_t> BasicSimulation<Law>::kept_numbering(const std::vector<char>& drop) {
+  std::vector<std::int32_t> old2new(drop.size(), -1);
+  std::int32_t kept = 0;
+  for (std::size_t i = 0; i < drop.size(); ++i)
+    if (!drop[i]) old2new[i] = kept++;
+  return old2new;
+}
+
+template <class Law>
+void BasicSimulation<Law>::compact_spheres(const std::vector<char>& drop_sphere,
+                                           const std::vector<std::int32_t>& c_old2new) {
+  const std::size_t n = drop_sphere.size();
   auto compact = [&](auto& vec, std::size_t per) {
     std::size_t o = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -1113,13 +1137,12 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   for_each_sphere_array(compact);
   for (auto& c : clump_)
     if (c >= 0) c = c_old2new[c];
-  // compact per-clump arrays
-  auto ccompact = [&](auto& vec) {
-    std::size_t o = 0;
-    for (std::size_t c = 0; c < nc; ++c)
-      if (!drop_clump[c]) vec[o++] = vec[c];
-    vec.resize(o);
-  };
+}
+
+template <class Law>
+void BasicSimulation<Law>::compact_clumps(const std::vector<char>& drop_clump,
+                                          const std::vector<std::int32_t>& s_old2new) {
+  const std::size_t nc = drop_clump.size();
   std::vector<std::uint32_t> mem_start{0}, mem;
   for (std::size_t c = 0; c < nc; ++c) {
     if (drop_clump[c]) continue;
@@ -1128,8 +1151,19 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   }
   cmem_start_ = std::move(mem_start);
   cmem_ = std::move(mem);
-  for_each_clump_array(ccompact);
-  // bodies
+  auto compact = [&](auto& vec) {
+    std::size_t o = 0;
+    for (std::size_t c = 0; c < nc; ++c)
+      if (!drop_clump[c]) vec[o++] = vec[c];
+    vec.resize(o);
+  };
+  for_each_clump_array(compact);
+}
+
+template <class Law>
+void BasicSimulation<Law>::compact_bodies(const std::vector<char>& drop_body,
+                                          const std::vector<std::int32_t>& s_old2new,
+                                          const std::vector<std::int32_t>& c_old2new) {
   std::vector<std::int32_t> refs;
   std::vector<BodyId> ids;
   for (std::size_t b = 0; b < body_ref_.size(); ++b) {
@@ -1141,11 +1175,6 @@ RemovalResult BasicSimulation<Law>::remove_bodies_if(const std::function<bool(co
   body_ref_ = std::move(refs);
   body_id_ = std::move(ids);
   rebuild_body_index();
-  nl_.renumber(s_old2new, ns, &Law::swap_history);
-  // forces of the remaining spheres are still valid except for the contacts with removed ones; recompute
-  forces_valid_ = loads_known;
-  rekick_on_refresh_ = false;  // (the state itself changed)
-  return res;
 }
 
 template <class Law>
