@@ -45,6 +45,11 @@ struct DiagnoseOptions {
     std::optional<double> effective_friction_deg, wall_friction_deg;
     double outlier_alpha = 0.01;  // chance of flagging any row of a set without outliers (Bonferroni), as family_alpha
     bool drop_outliers = false;   // report the fits without the flagged rows (else: with all rows)
+    // How refusals name the options above: as the caller's user gave them (a command line names its flags).
+    struct Names {
+        std::string regime_column = "regime column";
+        std::string effective_friction = "effective_friction_deg", wall_friction = "wall_friction_deg";
+    } names;
 };
 
 enum class FlowMode { mass, mixed, funnel };

@@ -279,10 +279,11 @@ std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const D
     if (options.effective_friction_deg.has_value() != options.wall_friction_deg.has_value())
         throw std::invalid_argument(
             "flow mode by Jenike's limit needs both friction angles: " +
-            (options.wall_friction_deg ? "wall_friction_deg=" + short_number(*options.wall_friction_deg) +
-                                             " given, effective_friction_deg missing"
-                                       : "effective_friction_deg=" + short_number(*options.effective_friction_deg) +
-                                             " given, wall_friction_deg missing"));
+            (options.wall_friction_deg
+                 ? options.names.wall_friction + "=" + short_number(*options.wall_friction_deg) + " given, " +
+                       options.names.effective_friction + " missing"
+                 : options.names.effective_friction + "=" + short_number(*options.effective_friction_deg) +
+                       " given, " + options.names.wall_friction + " missing"));
     double limit = seed_mass_flow_limit_deg;
     flow_mode_rule = "seed classes: mass below 30 deg, mixed 30-40 deg, funnel above 40 deg";
     if (options.wall_friction_deg) {
@@ -317,7 +318,7 @@ std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const D
         if (g.level_names.size() > 1) out.push_back(std::move(g));
     }
     for (const auto& name : options.regime_columns) {
-        check_regime_column(d, name);
+        check_regime_column(d, name, options.names.regime_column);
         const auto* col = d.find(name);
         Regime g{name, name, {}, nullptr};
         std::map<std::string, int> level_of;

@@ -138,7 +138,6 @@ void write_study(const fs::path& dir, const SensitivityStudy& study, const std::
 
 // Checks every level's material before anything is written or run: a bad range must not cost simulations.
 void check_study(const nlohmann::json& base, const SensitivityCli& o) {
-    for (const auto& name : o.params) orchestrator::require_micromechanical_param(name, "--params");
     // the count first: planning a billion levels would itself take the memory
     const std::size_t params = o.params.empty() ? orchestrator::micromechanical_param_names().size() : o.params.size();
     const auto& c = o.campaign;
@@ -146,6 +145,7 @@ void check_study(const nlohmann::json& base, const SensitivityCli& o) {
                     "sensitivity study: " + std::to_string(params) + " parameters x " + std::to_string(o.levels) +
                         " levels x " + std::to_string(c.normal_stresses.size()) + " normal stresses x " +
                         std::to_string(c.replicates) + " replicates");
+    for (const auto& name : o.params) orchestrator::require_micromechanical_param(name, "--params");
     sensitivity_plan(base, sensitivity_options(o));
     check_campaign(o.campaign, base);
 }
@@ -255,10 +255,14 @@ void check_calibrate_options(CalibrateCli& o, const nlohmann::json& start, const
     if (!o.controls.empty() && o.controls.size() != targets.size())
         throw UserError("--controls: " + std::to_string(o.controls.size()) + " given for " +
                         std::to_string(targets.size()) + " targets");
-    for (const auto& name : o.controls) orchestrator::require_micromechanical_param(name, "--controls");
     for (const auto& [name, range] : bounds) check_control(start, {name, range.first, range.second});
     if (o.sensitivity_file.empty()) {
-        if (o.study.params.empty() && !o.controls.empty()) o.study.params = o.controls;
+        if (o.study.params.empty() && !o.controls.empty()) {
+            // the controls become the study's parameters: named as the option that gave them (a control given
+            // --bounds with a stored study or other --params may be any material field check_control takes)
+            for (const auto& name : o.controls) orchestrator::require_micromechanical_param(name, "--controls");
+            o.study.params = o.controls;
+        }
         check_study(start, o.study);
     }
     // a grid evaluates all of itself: grid-points ^ controls, whatever --max-evaluations says

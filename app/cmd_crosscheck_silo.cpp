@@ -188,9 +188,8 @@ CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
     if (!(o.tolerance > 0 && o.tolerance < 1)) throw UserError("tolerance = " + g(o.tolerance) + " must lie in (0, 1)");
     check_output_folder(o.dir, "--campaign");
     CrosscheckInputs in;
-    in.script = orchestrator::default_shear_template().parent_path() / "silo.py";
-    in.wrapper = orchestrator::default_shear_template().parent_path() / "run_clean.py";
-    if (!fs::is_regular_file(in.script)) throw UserError("yade_scripts/silo.py not found at " + in.script.string());
+    in.script = orchestrator::yade_script("silo.py");
+    in.wrapper = orchestrator::yade_script("run_clean.py");
     in.yade = orchestrator::find_yade(o.yade).string();
     std::error_code ec;
     in.self = fs::read_symlink("/proc/self/exe", ec).string();

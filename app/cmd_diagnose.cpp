@@ -405,8 +405,8 @@ int run_diagnose(const DiagnoseArgs& a) {
     check_diagnosis_outputs(a);
     const analytics::MeasuredData data =
         analytics::read_measured_csv(a.data, analytics::data_kind_of(a.model), std::size_t(a.max_rows));
-    for (const auto& name : a.options.regime_columns) analytics::check_regime_column(data, name, "--regime-column");
     auto options = a.options;
+    options.names = {"--regime-column", "--effective-friction-deg", "--wall-friction-deg"};
     if (!std::isnan(a.effective_friction_deg)) options.effective_friction_deg = a.effective_friction_deg;
     if (!std::isnan(a.wall_friction_deg)) options.wall_friction_deg = a.wall_friction_deg;
     const analytics::DiagnoseResult r = analytics::diagnose(data, a.model, options);
@@ -524,16 +524,12 @@ void add_diagnose_command(CLI::App& app) {
     diagnose->add_option("--regime-column", args->options.regime_columns,
                          "a column whose values may change a covariate's effect (repeatable); the flow mode is "
                          "always tried for conical hoppers");
-    auto* effective_friction =
-        diagnose->add_option("--effective-friction-deg", args->effective_friction_deg,
-                             "effective angle of internal friction delta_e: with --wall-friction-deg, the flow mode "
-                             "comes from Jenike's mass-flow limit instead of the seed's classes")
-            ->check(number_in(0, 90));
-    auto* wall_friction =
-        diagnose->add_option("--wall-friction-deg", args->wall_friction_deg, "wall friction angle phi_w (see above)")
-            ->check(number_in(0, 90));
-    effective_friction->needs(wall_friction);  // Jenike's limit needs both angles
-    wall_friction->needs(effective_friction);
+    diagnose->add_option("--effective-friction-deg", args->effective_friction_deg,
+                         "effective angle of internal friction delta_e: with --wall-friction-deg, the flow mode "
+                         "comes from Jenike's mass-flow limit instead of the seed's classes")
+        ->check(number_in(0, 90));
+    diagnose->add_option("--wall-friction-deg", args->wall_friction_deg, "wall friction angle phi_w (see above)")
+        ->check(number_in(0, 90));
     diagnose->add_option("--outlier-alpha", args->options.outlier_alpha,
                          "chance of flagging any row of a set without outliers (Bonferroni over the rows)")
         ->capture_default_str()

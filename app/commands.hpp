@@ -1,5 +1,6 @@
 // Each demcal subcommand lives in its own cmd_*.cpp and registers itself on the CLI11 app here.
-// A subcommand's callback throws demcal::UserError for bad input; main() prints it and exits 2.
+// A subcommand's callback throws demcal::UserError for bad input it finds itself, and lets the libraries'
+// std::invalid_argument through; main() prints either on one line and exits 2.
 #pragma once
 #include <CLI/CLI.hpp>
 #include <stdexcept>

@@ -61,10 +61,22 @@ const char* scripts_folder_override() {
 }
 }  // namespace
 
-fs::path default_shear_template() {
-    if (const char* d = scripts_folder_override()) return fs::path(d) / "shear_box.py";
-    return fs::path(DEMCAL_YADE_SCRIPTS_DIR) / "shear_box.py";
+fs::path yade_scripts_folder() {
+    if (const char* d = scripts_folder_override()) return fs::path(d);
+    return fs::path(DEMCAL_YADE_SCRIPTS_DIR);
 }
+
+fs::path yade_script(const std::string& name) {
+    const fs::path file = yade_scripts_folder() / name;
+    if (fs::is_regular_file(file)) return file;
+    const char* folder = scripts_folder_override();
+    throw std::invalid_argument("YADE script '" + file.string() + "' is not a file" +
+                                (folder ? std::string(" (its folder is DEMCAL_YADE_SCRIPTS = '") + folder +
+                                              "'; unset it to use demcal's own scripts)"
+                                        : std::string(" (demcal's yade_scripts folder is incomplete)")));
+}
+
+fs::path default_shear_template() { return yade_scripts_folder() / "shear_box.py"; }
 
 namespace {
 // A program a process can start: a regular file (after symlinks) with execute permission. access(X_OK) alone also
@@ -188,7 +200,7 @@ EngineSetup engine_setup(const ShearCampaignSpec& spec, const ExecutionOptions& 
         return {o.kernel_engine, "", o.kernel_command, ""};
     }
     return {read_text_file(spec.template_path),
-            read_text_file(default_shear_template().parent_path() / kWrapperName),
+            read_text_file(yade_script(kWrapperName)),
             {find_yade(o.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py"},
             kYadeStartedMarker};
 }
@@ -256,16 +268,13 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
     for (double s : spec.normal_stresses)
         make_run_params(material, s, spec.base_seed + spec.replicates - 1,
                         "the run at --normal-stress " + analytics::number_text(s));
-    const ShearCampaignSpec s = resolved(spec);
-    if (s.engine == ShearEngine::yade && !fs::is_regular_file(s.template_path)) {
-        const char* folder = scripts_folder_override();
-        throw std::invalid_argument(
-            "template = '" + s.template_path.string() + "' is not a file" +
-            (folder && s.template_path == default_shear_template()
-                 ? std::string(" (its folder is DEMCAL_YADE_SCRIPTS = '") + folder +
-                       "'; unset it to use demcal's own scripts)"
-                 : std::string()));
-    }
+    if (spec.engine != ShearEngine::yade) return;
+    // the scripts YADE runs, each named with the folder it was looked for in (an installed copy may lack one)
+    if (spec.template_path.empty())
+        yade_script("shear_box.py");
+    else if (!fs::is_regular_file(spec.template_path))
+        throw std::invalid_argument("template = '" + spec.template_path.string() + "' is not a file");
+    yade_script(kWrapperName);
 }
 
 nlohmann::json read_shear_result(const fs::path& file, const nlohmann::json* run_params) {

@@ -107,8 +107,13 @@ struct ShearCampaignOutcome {
     bool complete() const { return !interrupted && failed == 0 && infrastructure_failure.empty(); }
 };
 
-// yade_scripts/shear_box.py of this build, or of the folder DEMCAL_YADE_SCRIPTS names when it is set and not empty
-// (an installed copy of demcal's YADE scripts).
+// The folder of demcal's YADE scripts: yade_scripts/ of this build, or the folder DEMCAL_YADE_SCRIPTS names when it
+// is set and not empty (an installed copy).
+std::filesystem::path yade_scripts_folder();
+// The script `name` of that folder; throws std::invalid_argument when it is not a file there, naming the file and,
+// when the folder came from DEMCAL_YADE_SCRIPTS, the variable and its value.
+std::filesystem::path yade_script(const std::string& name);
+// yade_scripts_folder() / "shear_box.py"
 std::filesystem::path default_shear_template();
 // Throws std::invalid_argument when the YADE launcher cannot be found (naming it and how to install it).
 std::filesystem::path find_yade(const std::string& yade);

@@ -48,8 +48,8 @@ TEST_CASE("diagnose CLI: bad regime and outlier options exit 2 naming the field 
     const std::vector<Case> cases{
         {"--regime-column flow_regime", "--regime-column 'flow_regime' is not in"},
         {"--regime-column run_order", "--regime-column 'run_order' has 84 values"},
-        {"--wall-friction-deg 20", "--wall-friction-deg requires --effective-friction-deg"},
-        {"--effective-friction-deg 30", "--effective-friction-deg requires --wall-friction-deg"},
+        {"--wall-friction-deg 20", "--wall-friction-deg=20 given, --effective-friction-deg missing"},
+        {"--effective-friction-deg 30", "--effective-friction-deg=30 given, --wall-friction-deg missing"},
         {"--wall-friction-deg 35 --effective-friction-deg 30", "phi_w_deg=35 is not below delta_e_deg=30"},
         {"--wall-friction-deg 95 --effective-friction-deg 30", "--wall-friction-deg: 95"},
         {"--outlier-alpha 0.9", "--outlier-alpha: 0.9"}};

@@ -23,6 +23,7 @@
 #include <functional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -106,8 +107,7 @@ TEST_CASE("a malformed command line is one line as any refusal, with the help th
     const fs::path root = test::fresh_test_dir("hostile-parse"), dir = root / "work";
     fs::create_directories(dir);
     const std::string data = test::source_path("examples/diagnose/beverloo_hopper_angle.csv").string();
-    refused({{{"diagnose", "--model", "beverloo", "--data", data, "--wall-friction-deg", "20"},
-              {"--wall-friction-deg requires --effective-friction-deg", "(the options: demcal diagnose --help)"}},
+    refused({{{"diagnose", "--data", data}, {"--model is required", "(the options: demcal diagnose --help)"}},
              {{"silo", "--particles", "many"}, {"--particles: 'many' is not an integer", "demcal silo --help"}},
              {{"crosscheck", "silo", "--theta", "30", "--seed", "x"}, {"--seed", "demcal crosscheck silo --help"}},
              {{"predict"}, {"GEOMETRY is required", "demcal predict --help"}},
@@ -1113,14 +1113,24 @@ TEST_CASE("probe 50: a local pool far beyond the machine's cores is refused, any
 
 TEST_CASE("a DEMCAL_YADE_SCRIPTS folder without demcal's scripts is refused by the variable's name, nothing written",
           "[cli]") {
-    // it was refused as "template = '.../shear_box.py' is not a file", the variable that chose the folder unnamed
-    const fs::path root = test::fresh_test_dir("hostile-scripts-env"), dir = root / "work";
+    // it was refused as "template = '.../shear_box.py' is not a file", the variable that chose the folder unnamed;
+    // a folder with the template but not the wrapper failed only once the campaign had started
+    const fs::path root = test::fresh_test_dir("hostile-scripts-env"), dir = root / "work", half = root / "half";
     fs::create_directories(dir);
+    fs::create_directories(half);
+    fs::copy_file(test::source_path("yade_scripts/shear_box.py"), half / "shear_box.py");
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
-    ::setenv("DEMCAL_YADE_SCRIPTS", root.c_str(), 1);
-    refused({{{"shear", tiny, "-s", "5e3,1e4,2e4", "--campaign", (dir / "c").string()},
-              {"DEMCAL_YADE_SCRIPTS = '" + root.string() + "'", "shear_box.py' is not a file"}}},
-            dir);
-    ::unsetenv("DEMCAL_YADE_SCRIPTS");
+    const std::vector<std::string> shear{"shear", tiny, "-s", "5e3,1e4,2e4", "--campaign", (dir / "c").string()};
+    const std::vector<std::string> crosscheck{"crosscheck", "silo", "--theta", "30", "--campaign",
+                                              (dir / "x").string()};
+    for (const auto& [folder, args, expect] :
+         {std::tuple{root.string(), shear, std::string("shear_box.py' is not a file")},
+          std::tuple{std::string("no-such-scripts"), shear, std::string("shear_box.py' is not a file")},
+          std::tuple{half.string(), shear, std::string("run_clean.py' is not a file")},
+          std::tuple{root.string(), crosscheck, std::string("silo.py' is not a file")}}) {
+        ::setenv("DEMCAL_YADE_SCRIPTS", folder.c_str(), 1);
+        refused({{args, {"DEMCAL_YADE_SCRIPTS = '" + folder + "'", expect}}}, dir);
+        ::unsetenv("DEMCAL_YADE_SCRIPTS");
+    }
     fs::remove_all(root);
 }
