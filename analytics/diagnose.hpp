@@ -148,10 +148,4 @@ MeasuredKind data_kind_of(const std::string& model);
 // suit the data (an unknown regime column, one friction angle without the other).
 DiagnoseResult diagnose(const MeasuredData& data, const std::string& model, const DiagnoseOptions& options = {});
 
-// Checks that column `name` of `data` can tell regimes apart: present, with at least two values and at most one per
-// three rows. Throws std::invalid_argument that begins "FIELD 'name'", FIELD being what the caller's user called it
-// (diagnose says "regime column"; a command line names its option).
-void check_regime_column(const MeasuredData& data, const std::string& name,
-                         const std::string& field = "regime column");
-
 }  // namespace demcal::analytics

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <set>
 #include <numeric>
 #include <stdexcept>
 
@@ -318,8 +317,13 @@ std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const D
         if (g.level_names.size() > 1) out.push_back(std::move(g));
     }
     for (const auto& name : options.regime_columns) {
-        check_regime_column(d, name, options.names.regime_column);
+        const std::string& field = options.names.regime_column;
         const auto* col = d.find(name);
+        if (!col) {
+            std::string known;
+            for (const auto& c : d.columns) known += (known.empty() ? "" : ", ") + c.name;
+            throw std::invalid_argument(field + " '" + name + "' is not in " + d.source + " (columns: " + known + ")");
+        }
         Regime g{name, name, {}, nullptr};
         std::map<std::string, int> level_of;
         std::vector<int> level(n);
@@ -328,6 +332,15 @@ std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const D
             if (added) g.level_names.push_back(col->text[r]);
             level[r] = it->second;
         }
+        if (g.level_names.size() < 2)
+            throw std::invalid_argument(
+                field + " '" + name + "' has " +
+                (g.level_names.empty() ? "no value" : "a single value '" + g.level_names[0] + "'") +
+                ": no regimes to compare");
+        if (g.level_names.size() > n / 3)
+            throw std::invalid_argument(field + " '" + name + "' has " + std::to_string(g.level_names.size()) +
+                                        " values for " + std::to_string(n) +
+                                        " rows: too many for a slope per value (at most a third of the rows)");
         g.level = std::make_shared<const std::vector<int>>(std::move(level));
         out.push_back(std::move(g));
     }
@@ -335,25 +348,3 @@ std::vector<Regime> regimes_of(const MeasuredData& d, MeasuredKind kind, const D
 }
 
 }  // namespace demcal::analytics::diagnosis
-
-namespace demcal::analytics {
-
-void check_regime_column(const MeasuredData& d, const std::string& name, const std::string& field) {
-    const auto* col = d.find(name);
-    if (!col) {
-        std::string known;
-        for (const auto& c : d.columns) known += (known.empty() ? "" : ", ") + c.name;
-        throw std::invalid_argument(field + " '" + name + "' is not in " + d.source + " (columns: " + known + ")");
-    }
-    const std::set<std::string> values(col->text.begin(), col->text.end());
-    if (values.size() < 2)
-        throw std::invalid_argument(field + " '" + name + "' has " +
-                                    (values.empty() ? "no value" : "a single value '" + *values.begin() + "'") +
-                                    ": no regimes to compare");
-    if (values.size() > d.rows() / 3)
-        throw std::invalid_argument(field + " '" + name + "' has " + std::to_string(values.size()) + " values for " +
-                                    std::to_string(d.rows()) +
-                                    " rows: too many for a slope per value (at most a third of the rows)");
-}
-
-}  // namespace demcal::analytics
