@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 
@@ -182,78 +183,115 @@ bool drift_like(const std::string& name) {
 
 // --- base models ------------------------------------------------------------------------------------------------
 
-Model base_model(const std::string& name, const MeasuredData& d, Setting& s) {
-    Model m;
-    m.name = name;
-    if (name == "failure-line") {
-        const auto& sigma = d.at("sigma_Pa").values;
-        const auto& tau = d.at("tau_Pa").values;
-        if (is_constant(d.at("sigma_Pa")))
-            throw std::invalid_argument("sigma_Pa: every row has the normal stress " + short_number(sigma.front()) +
-                                        " Pa: a failure line needs at least two different normal stresses");
-        m.relative = false;
-        m.param_names = {"mu_b", "tau_c_Pa"};
-        double c0 = 0, c1 = 0, c00, c01, c11, sse;
-        gsl_fit_linear(sigma.data(), 1, tau.data(), 1, sigma.size(), &c0, &c1, &c00, &c01, &c11, &sse);
-        m.start = {std::isfinite(c1) ? c1 : 0.5, std::isfinite(c0) ? c0 : 0.0};
-        m.base = [&sigma](std::size_t r, const double* p) { return p[0] * sigma[r] + p[1]; };
-        s.used = {"sigma_Pa"};
-        return m;
-    }
+namespace {
+
+// Every row of the data on silos of `shape`, or the row that is not, named.
+void require_shape(const std::string& model, const MeasuredData& d, const std::string& shape) {
     const auto& geometry = d.at("geometry").text;
+    for (std::size_t r = 0; r < d.rows(); ++r)
+        if (geometry[r] != shape)
+            throw std::invalid_argument(d.where(r, "geometry") + ": '" + geometry[r] + "', but model " + model +
+                                        " applies to " + shape + " silos only");
+}
+
+Model failure_line_model(const MeasuredData& d, Setting& s) {
+    Model m;
+    const auto& sigma = d.at("sigma_Pa").values;
+    const auto& tau = d.at("tau_Pa").values;
+    if (is_constant(d.at("sigma_Pa")))
+        throw std::invalid_argument("sigma_Pa: every row has the normal stress " + short_number(sigma.front()) +
+                                    " Pa: a failure line needs at least two different normal stresses");
+    m.relative = false;
+    m.param_names = {"mu_b", "tau_c_Pa"};
+    double c0 = 0, c1 = 0, c00, c01, c11, sse;
+    gsl_fit_linear(sigma.data(), 1, tau.data(), 1, sigma.size(), &c0, &c1, &c00, &c01, &c11, &sse);
+    m.start = {std::isfinite(c1) ? c1 : 0.5, std::isfinite(c0) ? c0 : 0.0};
+    m.base = [&sigma](std::size_t r, const double* p) { return p[0] * sigma[r] + p[1]; };
+    s.used = {"sigma_Pa"};
+    return m;
+}
+
+Model beverloo_model(const MeasuredData& d, Setting& s) {
+    require_shape("beverloo", d, "conical");
     const auto& outlet = d.at("outlet_m").values;
     const auto& dp = d.at("d_p_m").values;
     const auto& rho = d.at("rho_b_kg_m3").values;
-    const auto& theta = d.at("theta_deg").values;
-    auto require_shape = [&](const std::string& shape) {
-        for (std::size_t r = 0; r < d.rows(); ++r)
-            if (geometry[r] != shape)
-                throw std::invalid_argument(d.where(r, "geometry") + ": '" + geometry[r] + "', but model " + name +
-                                            " applies to " + shape + " silos only");
+    Model m;
+    m.param_names = {"C", "k"};
+    m.start = {0.58, 1.5};
+    m.base = [&outlet, &dp, &rho](std::size_t r, const double* p) {
+        const double e = outlet[r] - p[1] * dp[r];
+        return e > 0 ? p[0] * rho[r] * std::sqrt(standard_gravity) * std::pow(e, 2.5) : nan;
     };
-    if (name == "beverloo") {
-        require_shape("conical");
-        m.param_names = {"C", "k"};
-        m.start = {0.58, 1.5};
-        m.base = [&](std::size_t r, const double* p) {
-            const double e = outlet[r] - p[1] * dp[r];
-            return e > 0 ? p[0] * rho[r] * std::sqrt(standard_gravity) * std::pow(e, 2.5) : nan;
-        };
-        s.used = {"outlet_m", "d_p_m", "rho_b_kg_m3"};
-    } else if (name == "oldal") {
-        require_shape("conical");
-        m.param_names = {"delta"};
-        m.start = {0.5};
-        m.base = [&](std::size_t r, const double* p) {
-            return p[0] > 0 ? oldal_rate(outlet[r], dp[r], rho[r], p[0]) : nan;
-        };
-        s.used = {"outlet_m", "d_p_m", "rho_b_kg_m3"};
-    } else if (name == "oldal-rect") {
-        require_shape("rectangular");
-        const auto& depth = d.at("b_m").values;
-        m.param_names = {"delta"};
-        m.start = {0.5};
-        m.base = [&](std::size_t r, const double* p) {
-            return p[0] > 0 ? oldal_rectangular_rate(depth[r], outlet[r], dp[r], rho[r], p[0]) : nan;
-        };
-        s.used = {"b_m", "outlet_m", "d_p_m", "rho_b_kg_m3"};
-    } else if (name == "johanson") {
-        for (std::size_t r = 0; r < d.rows(); ++r)
-            if (theta[r] >= 90)
-                throw std::invalid_argument(d.where(r, "theta_deg") + ": 90 (flat bottom): Johanson's mass-flow "
-                                            "model needs a hopper");
-        const auto* depth = d.find("b_m");
-        m.param_names = {"scale"};
-        m.start = {1.0};
-        m.base = [&, depth](std::size_t r, const double* p) {
-            return p[0] * (geometry[r] == "conical"
-                               ? johanson_conical_rate(outlet[r], theta[r], rho[r])
-                               : johanson_wedge_rate(depth->values[r], outlet[r], theta[r], rho[r]));
-        };
-        s.used = {"outlet_m", "theta_deg", "rho_b_kg_m3", "b_m"};
-    } else {
-        throw std::invalid_argument("unknown model " + name);
-    }
+    s.used = {"outlet_m", "d_p_m", "rho_b_kg_m3"};
+    return m;
+}
+
+Model oldal_model(const MeasuredData& d, Setting& s) {
+    require_shape("oldal", d, "conical");
+    const auto& outlet = d.at("outlet_m").values;
+    const auto& dp = d.at("d_p_m").values;
+    const auto& rho = d.at("rho_b_kg_m3").values;
+    Model m;
+    m.param_names = {"delta"};
+    m.start = {0.5};
+    m.base = [&outlet, &dp, &rho](std::size_t r, const double* p) {
+        return p[0] > 0 ? oldal_rate(outlet[r], dp[r], rho[r], p[0]) : nan;
+    };
+    s.used = {"outlet_m", "d_p_m", "rho_b_kg_m3"};
+    return m;
+}
+
+Model oldal_rect_model(const MeasuredData& d, Setting& s) {
+    require_shape("oldal-rect", d, "rectangular");
+    const auto& depth = d.at("b_m").values;
+    const auto& outlet = d.at("outlet_m").values;
+    const auto& dp = d.at("d_p_m").values;
+    const auto& rho = d.at("rho_b_kg_m3").values;
+    Model m;
+    m.param_names = {"delta"};
+    m.start = {0.5};
+    m.base = [&depth, &outlet, &dp, &rho](std::size_t r, const double* p) {
+        return p[0] > 0 ? oldal_rectangular_rate(depth[r], outlet[r], dp[r], rho[r], p[0]) : nan;
+    };
+    s.used = {"b_m", "outlet_m", "d_p_m", "rho_b_kg_m3"};
+    return m;
+}
+
+Model johanson_model(const MeasuredData& d, Setting& s) {
+    const auto& geometry = d.at("geometry").text;
+    const auto& outlet = d.at("outlet_m").values;
+    const auto& rho = d.at("rho_b_kg_m3").values;
+    const auto& theta = d.at("theta_deg").values;
+    for (std::size_t r = 0; r < d.rows(); ++r)
+        if (theta[r] >= 90)
+            throw std::invalid_argument(d.where(r, "theta_deg") + ": 90 (flat bottom): Johanson's mass-flow "
+                                        "model needs a hopper");
+    const DataColumn* depth = d.find("b_m");
+    Model m;
+    m.param_names = {"scale"};
+    m.start = {1.0};
+    m.base = [&geometry, &outlet, &theta, &rho, depth](std::size_t r, const double* p) {
+        return p[0] * (geometry[r] == "conical" ? johanson_conical_rate(outlet[r], theta[r], rho[r])
+                                                : johanson_wedge_rate(depth->values[r], outlet[r], theta[r], rho[r]));
+    };
+    s.used = {"outlet_m", "theta_deg", "rho_b_kg_m3", "b_m"};
+    return m;
+}
+
+}  // namespace
+
+Model base_model(const std::string& name, const MeasuredData& d, Setting& s) {
+    using Builder = Model (*)(const MeasuredData&, Setting&);
+    static const std::map<std::string, Builder> builders = {{"failure-line", failure_line_model},
+                                                            {"beverloo", beverloo_model},
+                                                            {"oldal", oldal_model},
+                                                            {"oldal-rect", oldal_rect_model},
+                                                            {"johanson", johanson_model}};
+    const auto it = builders.find(name);
+    if (it == builders.end()) throw std::invalid_argument("unknown model " + name);
+    Model m = it->second(d, s);
+    m.name = name;
     return m;
 }
 

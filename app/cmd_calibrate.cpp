@@ -441,6 +441,121 @@ struct EnlargeCli {
     bool allow_unconverged = false;
 };
 
+// The output and the plot files beside it: checked, and apart from the inputs, before anything is read.
+void check_enlarge_outputs(const EnlargeCli& o) {
+    if (fs::path(o.output).extension() != ".json")  // the plot and its data take the same name
+        throw UserError("output = '" + o.output + "': must end in .json");
+    check_output_file(o.output, "output");
+    std::vector<NamedPath> inputs;
+    for (const auto& file : o.materials) inputs.push_back({file, "material"});
+    std::vector<NamedPath> outputs = {{o.output, "output"}};
+    std::vector<std::string> side_files;
+    if (!o.no_plot)  // the plot's files are written beside the output, by its name
+        for (const fs::path& f : enlargement_plot_files(o.output, o.plot_format)) {
+            outputs.push_back({f.string(), "output's plot file"});
+            side_files.push_back(f.string());
+        }
+    check_paths_apart(inputs, outputs);
+    check_side_files_free(o.output, side_files, "output");
+}
+
+// One material at several radii: every field but the radius, E, nu and the labels the same as in the first file
+// (friction, density, box ...), or the laws would mix materials and say nothing of enlargement.
+void check_same_material(const nlohmann::json& rest, const std::string& file, const nlohmann::json& first_rest,
+                         const std::string& first_file) {
+    for (const auto& [key, value] : first_rest.items())
+        if (!rest.contains(key) || rest[key] != value)
+            throw UserError("materials: " + key + " = " +
+                            (rest.contains(key) ? analytics::json_value_text(rest[key]) : "(absent)") + " in '" +
+                            analytics::shortened_text(file, 200) + "' but " + analytics::json_value_text(value) +
+                            " in '" + analytics::shortened_text(first_file, 200) +
+                            "': the laws are fitted to one material at several radii (only "
+                            "particle_radius, young_modulus and poisson_ratio may differ)");
+    for (const auto& [key, value] : rest.items())
+        if (!first_rest.contains(key))
+            throw UserError("materials: " + key + " is in '" + analytics::shortened_text(file, 200) +
+                            "' but not in '" + analytics::shortened_text(first_file, 200) + "'");
+}
+
+// (radius, E, nu) of each calibrated material, one per radius.
+struct EnlargementPoints {
+    std::vector<double> r, e, nu;
+};
+
+EnlargementPoints read_enlargement_points(const std::vector<std::string>& materials) {
+    EnlargementPoints p;
+    std::map<double, std::string> file_of_radius;
+    nlohmann::json first_rest;  // the first material without the fields the laws are about
+    std::string first_file;
+    for (const auto& file : materials) {
+        const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
+        nlohmann::json rest = m;
+        for (const char* k : {"particle_radius", "young_modulus", "poisson_ratio", "name", "description"})
+            rest.erase(k);
+        if (first_file.empty()) {
+            first_rest = rest;
+            first_file = file;
+        } else {
+            check_same_material(rest, file, first_rest, first_file);
+        }
+        const double radius = m.at("particle_radius").get<double>();
+        // the same radius twice (often the same file twice) is a point counted twice: it fakes the degrees of
+        // freedom the intervals stand on (two radii given three times fitted "exactly", +/- 1e-15)
+        if (const auto [it, fresh] = file_of_radius.emplace(radius, file); !fresh)
+            throw UserError("materials: '" + analytics::shortened_text(file, 200) + "' and '" +
+                            analytics::shortened_text(it->second, 200) + "' both have particle_radius = " +
+                            analytics::number_text(radius) + " m; give one calibrated material per radius");
+        p.r.push_back(radius);
+        p.e.push_back(m.at("young_modulus").get<double>());
+        p.nu.push_back(m.at("poisson_ratio").get<double>());
+    }
+    if (p.r.size() < 3) throw UserError("materials: " + std::to_string(p.r.size()) + " given, need at least 3 radii");
+    return p;
+}
+
+nlohmann::json enlargement_json(const EnlargementPoints& p, const analytics::ScalingLawFit& e_law,
+                                const analytics::ScalingLawFit& nu_law) {
+    nlohmann::json j = {{"young_modulus", e_law.to_json()},
+                        {"poisson_ratio", nu_law.to_json()},
+                        {"note", "r in m; poisson_ratio is YADE's ks/kn stiffness ratio, so nu(r) is a law for it"},
+                        {"points", nlohmann::json::array()}};
+    for (std::size_t i = 0; i < p.r.size(); ++i)
+        j["points"].push_back({{"particle_radius", p.r[i]}, {"young_modulus", p.e[i]}, {"poisson_ratio", p.nu[i]}});
+    return j;
+}
+
+void print_enlargement(const analytics::ScalingLawFit& e_law, const analytics::ScalingLawFit& nu_law,
+                       const std::string& output, const std::string& plot_file) {
+    std::cout << "E(r)  = A r + B:  A = " << e_law.params[0].value << " +/- " << e_law.params[0].std_error
+              << " Pa/m, B = " << e_law.params[1].value << " +/- " << e_law.params[1].std_error << " Pa (R^2 "
+              << e_law.r_squared << ")\n"
+              << "nu(r) = C r^-D:   C = " << nu_law.params[0].value << " +/- " << nu_law.params[0].std_error
+              << ", D = " << nu_law.params[1].value << " +/- " << nu_law.params[1].std_error << " (R^2 "
+              << nu_law.r_squared << "; nu is YADE's ks/kn)\nresults: " << output
+              << (plot_file.empty() ? "" : ", " + plot_file) << "\n";
+}
+
+void run_enlarge(const EnlargeCli& o) {
+    check_enlarge_outputs(o);
+    const EnlargementPoints p = read_enlargement_points(o.materials);
+    const auto e_law = analytics::fit_linear_law(p.r, p.e);
+    const auto nu_law = analytics::fit_power_law(p.r, p.nu);
+    for (const auto* law : {&e_law, &nu_law})  // e.g. nu equal at every radius: D is not identifiable
+        if (!law->determined() && !o.allow_unconverged)
+            throw std::runtime_error("enlarge: " + law->formula() + " is not determined by these " +
+                                     std::to_string(p.r.size()) + " points: " + law->undetermined +
+                                     "; nothing written (--allow-unconverged writes it anyway)");
+    write_result_file(o.output, enlargement_json(p, e_law, nu_law).dump(2) + "\n");
+    std::string plot_file;
+    if (!o.no_plot) try {  // the laws are written: a missing gnuplot costs only the picture
+            plot_enlargement(o.output, p.r, p.e, p.nu, e_law, nu_law, o.plot_format);
+            plot_file = fs::path(o.output).replace_extension("." + o.plot_format).string();
+        } catch (const std::exception& err) {
+            std::cerr << "demcal: warning: plot not written: " << err.what() << "\n";
+        }
+    print_enlargement(e_law, nu_law, o.output, plot_file);
+}
+
 void add_enlarge(CLI::App& app) {
     auto o = std::make_shared<EnlargeCli>();
     auto* cmd = app.add_subcommand("enlarge", "fit E(r_p) = A r_p + B and nu(r_p) = C r_p^-D (seed eqs. 3.1-3.2) to "
@@ -452,92 +567,7 @@ void add_enlarge(CLI::App& app) {
     cmd->add_flag("--no-plot", o->no_plot, "write no plot (no gnuplot needed)");
     cmd->add_flag("--allow-unconverged", o->allow_unconverged,
                   "write the laws even when the power-law fit did not converge (exit 0)");
-    cmd->callback([o] {
-        if (fs::path(o->output).extension() != ".json")  // the plot and its data take the same name
-            throw UserError("output = '" + o->output + "': must end in .json");
-        check_output_file(o->output, "output");
-        std::vector<NamedPath> inputs;
-        for (const auto& file : o->materials) inputs.push_back({file, "material"});
-        std::vector<NamedPath> outputs = {{o->output, "output"}};
-        std::vector<std::string> side_files;
-        if (!o->no_plot)  // the plot's files are written beside the output, by its name
-            for (const fs::path& f : enlargement_plot_files(o->output, o->plot_format)) {
-                outputs.push_back({f.string(), "output's plot file"});
-                side_files.push_back(f.string());
-            }
-        check_paths_apart(inputs, outputs);
-        check_side_files_free(o->output, side_files, "output");
-        std::vector<double> r, e, nu;
-        std::map<double, std::string> file_of_radius;
-        nlohmann::json first_rest;  // the first material without the fields the laws are about
-        std::string first_file;
-        for (const auto& file : o->materials) {
-            const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
-            // one material at several radii: every other field the same (friction, density, box ...), or the laws
-            // would mix materials and say nothing of enlargement
-            nlohmann::json rest = m;
-            for (const char* k : {"particle_radius", "young_modulus", "poisson_ratio", "name", "description"})
-                rest.erase(k);
-            if (first_file.empty()) {
-                first_rest = rest;
-                first_file = file;
-            } else {
-                for (const auto& [key, value] : first_rest.items())
-                    if (!rest.contains(key) || rest[key] != value)
-                        throw UserError("materials: " + key + " = " +
-                                        (rest.contains(key) ? analytics::json_value_text(rest[key]) : "(absent)") +
-                                        " in '" + analytics::shortened_text(file, 200) + "' but " +
-                                        analytics::json_value_text(value) + " in '" +
-                                        analytics::shortened_text(first_file, 200) +
-                                        "': the laws are fitted to one material at several radii (only "
-                                        "particle_radius, young_modulus and poisson_ratio may differ)");
-                for (const auto& [key, value] : rest.items())
-                    if (!first_rest.contains(key))
-                        throw UserError("materials: " + key + " is in '" + analytics::shortened_text(file, 200) +
-                                        "' but not in '" + analytics::shortened_text(first_file, 200) + "'");
-            }
-            const double radius = m.at("particle_radius").get<double>();
-            // the same radius twice (often the same file twice) is a point counted twice: it fakes the degrees of
-            // freedom the intervals stand on (two radii given three times fitted "exactly", +/- 1e-15)
-            if (const auto [it, fresh] = file_of_radius.emplace(radius, file); !fresh)
-                throw UserError("materials: '" + analytics::shortened_text(file, 200) + "' and '" +
-                                analytics::shortened_text(it->second, 200) + "' both have particle_radius = " +
-                                analytics::number_text(radius) + " m; give one calibrated material per radius");
-            r.push_back(radius);
-            e.push_back(m.at("young_modulus").get<double>());
-            nu.push_back(m.at("poisson_ratio").get<double>());
-        }
-        if (r.size() < 3) throw UserError("materials: " + std::to_string(r.size()) + " given, need at least 3 radii");
-        const auto e_law = analytics::fit_linear_law(r, e);
-        const auto nu_law = analytics::fit_power_law(r, nu);
-        for (const auto* law : {&e_law, &nu_law})  // e.g. nu equal at every radius: D is not identifiable
-            if (!law->determined() && !o->allow_unconverged)
-                throw std::runtime_error("enlarge: " + law->formula() + " is not determined by these " +
-                                         std::to_string(r.size()) + " points: " + law->undetermined +
-                                         "; nothing written (--allow-unconverged writes it anyway)");
-        nlohmann::json j = {{"young_modulus", e_law.to_json()},
-                            {"poisson_ratio", nu_law.to_json()},
-                            {"note", "r in m; poisson_ratio is YADE's ks/kn stiffness ratio, so nu(r) is a law for it"},
-                            {"points", nlohmann::json::array()}};
-        for (std::size_t i = 0; i < r.size(); ++i)
-            j["points"].push_back({{"particle_radius", r[i]}, {"young_modulus", e[i]}, {"poisson_ratio", nu[i]}});
-        write_result_file(o->output, j.dump(2) + "\n");
-        bool plotted = false;
-        if (!o->no_plot) try {  // the laws are written: a missing gnuplot costs only the picture
-                plot_enlargement(o->output, r, e, nu, e_law, nu_law, o->plot_format);
-                plotted = true;
-            } catch (const std::exception& err) {
-                std::cerr << "demcal: warning: plot not written: " << err.what() << "\n";
-            }
-        std::cout << "E(r)  = A r + B:  A = " << e_law.params[0].value << " +/- " << e_law.params[0].std_error
-                  << " Pa/m, B = " << e_law.params[1].value << " +/- " << e_law.params[1].std_error << " Pa (R^2 "
-                  << e_law.r_squared << ")\n"
-                  << "nu(r) = C r^-D:   C = " << nu_law.params[0].value << " +/- " << nu_law.params[0].std_error
-                  << ", D = " << nu_law.params[1].value << " +/- " << nu_law.params[1].std_error << " (R^2 "
-                  << nu_law.r_squared << "; nu is YADE's ks/kn)\nresults: " << o->output
-                  << (plotted ? ", " + fs::path(o->output).replace_extension("." + o->plot_format).string() : "")
-                  << "\n";
-    });
+    cmd->callback([o] { run_enlarge(*o); });
 }
 
 }  // namespace

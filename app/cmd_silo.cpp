@@ -900,8 +900,8 @@ void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     print_summary(dir, s, r, no_plots);
 }
 
-// Every option of `demcal silo`, into `o`.
-void add_silo_options(CLI::App* sub, SiloCli& o) {
+// The silo's shape and its grain: the geometry file or its options one by one, the material.
+void add_geometry_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--theta", o.theta, "hopper half angle from the vertical [deg], 0 < theta < 90 (required unless "
                                          "--geometry gives theta_deg)");
     sub->add_option("--material", o.material_file,
@@ -918,6 +918,10 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--a", o.a, "rectangular: outlet (slot) width a [m], default 0.03");
     sub->add_option("--b", o.b, "rectangular: silo depth b [m] (the slot's length)")->capture_default_str();
     sub->add_option("--c", o.c, "rectangular: silo width c [m]")->capture_default_str();
+}
+
+// How many grains, how the run fills and discharges them, and the numerics (time step, skin, threads).
+void add_run_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--particles", o.particles, "number of grains")->capture_default_str();
     sub->add_option("--fill-mass", o.fill_mass, "mass of grain [kg] (instead of --particles)");
     sub->add_option("--threads", o.threads, "OpenMP threads (default: every core)")->check(integer_in(1, 256));
@@ -940,6 +944,10 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
         ->capture_default_str();
     sub->add_option("--skin", o.skin, "Verlet skin of the neighbour list [m] (0: 40 dt x 1 m/s within 0.2-1 mm)")
         ->capture_default_str();
+}
+
+// The seed's vibrated bin: frequency, amplitude, direction, which walls, from when.
+void add_vibration_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--vibration-frequency", o.vibration_frequency,
                     "the bin (--vibration-part) vibrates at this frequency [Hz], 0-1000, from the opening (the "
                     "seed's eccentric vibrator; needs --vibration-amplitude)");
@@ -957,6 +965,10 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
                     "the vibration starts this many simulated seconds after the outlet opens; the bin is still "
                     "while it fills")
         ->capture_default_str();
+}
+
+// What a cross-check with yade_scripts/silo.py needs: the beds exported, and YADE's law, integrator and walls.
+void add_yade_crosscheck_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--export-bed", o.export_bed,
                     "write the filled bed at the opening (every grain's centre, orientation, velocities; the clump, "
                     "materials, geometry) to this JSON file, for yade_scripts/silo.py");
@@ -994,6 +1006,10 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
                     "yade_scripts/silo.py builds its walls; the filling runs on the exact walls, so the bed is the same "
                     "either way: for a cross-check that removes the walls' difference")
         ->capture_default_str();
+}
+
+// The session: plots, checkpoints, a check-only pass, a wall-clock limit and the resume of an interrupted run.
+void add_session_options(CLI::App* sub, SiloCli& o) {
     sub->add_flag("--no-plots", o.no_plots, "do not render section.png and discharge.png (no gnuplot needed)");
     sub->add_option("--checkpoint-every", o.checkpoint_every,
                     "wall-clock seconds between checkpoints of the whole run to OUT/checkpoint.bin (removed once "
@@ -1009,6 +1025,15 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--resume", o.resume,
                     "continue the interrupted run whose output directory (and checkpoint.bin) is DIR, bit for bit, "
                     "with the settings stored in its checkpoint");
+}
+
+// Every option of `demcal silo`, into `o`, in the order --help lists them.
+void add_silo_options(CLI::App* sub, SiloCli& o) {
+    add_geometry_options(sub, o);
+    add_run_options(sub, o);
+    add_vibration_options(sub, o);
+    add_yade_crosscheck_options(sub, o);
+    add_session_options(sub, o);
 }
 
 }  // namespace
