@@ -17,9 +17,18 @@ double deg(double rad) { return rad * 180.0 / pi; }
 
 // Smallest outlet-to-particle ratio for which Beverloo-type correlations hold (Mankoc et al. 2007: d > 5-6 d_p).
 constexpr double min_outlet_particle_ratio = 6.0;
+// Below it no model predicts a steady flow: the seed (2.1) needs d > 3.5-4 d_p for cohesionless grains to discharge
+// by gravity at all; smaller outlets clog with stable arches. The upper end, as the seed designed its silo by it.
+constexpr double min_free_flow_outlet_ratio = 4.0;
 constexpr double min_coarse_particle_size = 0.4e-3;  // [m] below it, a powder: air-retarded flow
 // Silo-to-outlet ratio below which wall effects matter (the seed: D/d > 2.5 is conventional).
 constexpr double min_silo_outlet_ratio = 2.5;
+
+// A ratio of two decimal inputs on a limit (a 70 mm outlet in a 100 mm silo: a/c = 0.7) lands a rounding error on
+// either side of it; the limits are inclusive, so a value within this relative slack of one is on it.
+constexpr double limit_slack = 1e-9;
+bool below(double value, double limit) { return value < limit * (1 - limit_slack); }
+bool above(double value, double limit) { return value > limit * (1 + limit_slack); }
 }  // namespace
 
 double beverloo_rate(double outlet, double particle_size, double bulk_density, double c, double k) {
@@ -96,8 +105,8 @@ double jenike_mass_flow_limit_deg(double effective_friction_deg, double wall_fri
 std::vector<std::string> oldal_rectangular_limit_violations(double depth, double width, double outlet) {
     std::vector<std::string> out;
     const double cb = width / depth, ac = outlet / width;
-    if (cb < 1.0 || cb > 4.0) out.push_back("c/b = " + number_text(cb) + " outside the validated range 1 <= c/b <= 4");
-    if (ac < 0.15 || ac > 0.7) out.push_back("a/c = " + number_text(ac) + " outside the validated range 0.15 <= a/c <= 0.7");
+    if (below(cb, 1.0) || above(cb, 4.0)) out.push_back("c/b = " + number_text(cb) + " outside the validated range 1 <= c/b <= 4");
+    if (below(ac, 0.15) || above(ac, 0.7)) out.push_back("a/c = " + number_text(ac) + " outside the validated range 0.15 <= a/c <= 0.7");
     return out;
 }
 
@@ -210,12 +219,24 @@ void check_model_flow(DischargePrediction& p, const FlowPatternCheck& flow, Mode
     }
 }
 
+// Beverloo-type correlations: fitted to outlets of more than 6 grains.
 void check_outlet_ratio(DischargePrediction& p, const SiloGeometry& g) {
-    if (g.outlet < min_outlet_particle_ratio * g.particle_size) {
+    if (below(g.outlet / g.particle_size, min_outlet_particle_ratio)) {
         p.valid = false;
         p.warnings.push_back("outlet/d_p = " + number_text(g.outlet / g.particle_size) + " < " +
                              number_text(min_outlet_particle_ratio) +
                              ": intermittent flow and clogging, correlation not valid");
+    }
+}
+
+// Every model: an outlet of fewer than 4 grains arches over, with no steady flow to predict.
+void check_free_flow(DischargePrediction& p, const SiloGeometry& g) {
+    if (below(g.outlet / g.particle_size, min_free_flow_outlet_ratio)) {
+        p.valid = false;
+        p.warnings.push_back("outlet/d_p = " + number_text(g.outlet / g.particle_size) + " < " +
+                             number_text(min_free_flow_outlet_ratio) +
+                             ": stable arches likely (the seed: d > 3.5-4 d_p for a gravity discharge), no steady "
+                             "flow to predict");
     }
 }
 
@@ -239,13 +260,14 @@ bool refuse_shape(DischargePrediction& p, const SiloGeometry& g, SiloShape appli
 }
 
 // One function per model: its rate where it applies, its warnings.
-DischargePrediction predict_beverloo(const SiloGeometry& g) {
+DischargePrediction predict_beverloo(const SiloGeometry& g, const FlowPatternCheck& flow) {
     DischargePrediction p;
     p.model = "beverloo";
     if (refuse_shape(p, g, SiloShape::conical)) return p;
     p.rate = beverloo_rate(g.outlet, g.particle_size, g.bulk_density, g.beverloo_c, g.beverloo_k);
     check_outlet_ratio(p, g);
-    if (g.silo_diameter < min_silo_outlet_ratio * g.outlet)
+    check_model_flow(p, flow, ModelFlow::funnel);  // the seed (2.3): Beverloo's correlation is for funnel flow
+    if (below(g.silo_diameter / g.outlet, min_silo_outlet_ratio))
         p.warnings.push_back("D/d = " + number_text(g.silo_diameter / g.outlet) + " < 2.5: wall effects likely");
     if (rose_tanaka_factor(g.half_angle_deg, g.stagnant_angle_deg) > 1.0)
         p.warnings.push_back("hopper steeper than the stagnant zone (theta < 90 - phi_d): Beverloo "
@@ -265,12 +287,13 @@ DischargePrediction predict_beverloo_rose_tanaka(const SiloGeometry& g) {
     return p;
 }
 
-DischargePrediction predict_beverloo_slot(const SiloGeometry& g) {
+DischargePrediction predict_beverloo_slot(const SiloGeometry& g, const FlowPatternCheck& flow) {
     DischargePrediction p;
     p.model = "beverloo-slot";
     if (refuse_shape(p, g, SiloShape::rectangular)) return p;
     p.rate = beverloo_slot_rate(g.depth, g.outlet, g.particle_size, g.bulk_density, g.slot_c, g.beverloo_k);
     check_outlet_ratio(p, g);
+    check_model_flow(p, flow, ModelFlow::funnel);
     check_coarse_particles(p, g);
     return p;
 }
@@ -287,6 +310,7 @@ DischargePrediction predict_johanson(const SiloGeometry& g, const FlowPatternChe
     }
     p.rate = conical ? johanson_conical_rate(g.outlet, theta, g.bulk_density)
                      : johanson_wedge_rate(g.depth, g.outlet, theta, g.bulk_density);
+    check_free_flow(p, g);
     check_model_flow(p, flow, ModelFlow::mass);
     check_coarse_particles(p, g);
     return p;
@@ -297,6 +321,7 @@ DischargePrediction predict_oldal(const SiloGeometry& g, const FlowPatternCheck&
     p.model = "oldal";
     if (refuse_shape(p, g, SiloShape::conical)) return p;
     p.rate = oldal_rate(g.outlet, g.particle_size, g.bulk_density, g.arch_delta);
+    check_free_flow(p, g);
     check_model_flow(p, flow, ModelFlow::funnel);
     check_coarse_particles(p, g);
     return p;
@@ -311,6 +336,7 @@ DischargePrediction predict_oldal_rectangular(const SiloGeometry& g, const FlowP
         p.valid = false;
         p.warnings.push_back(w);
     }
+    check_free_flow(p, g);
     check_model_flow(p, flow, ModelFlow::funnel);
     check_coarse_particles(p, g);
     return p;
@@ -321,7 +347,7 @@ DischargePrediction predict_oldal_rectangular(const SiloGeometry& g, const FlowP
 std::vector<DischargePrediction> predict_discharge(const SiloGeometry& g) {
     validate(g);
     const FlowPatternCheck flow = check_flow_pattern(g);
-    return {predict_beverloo(g), predict_beverloo_rose_tanaka(g), predict_beverloo_slot(g),
+    return {predict_beverloo(g, flow), predict_beverloo_rose_tanaka(g), predict_beverloo_slot(g, flow),
             predict_johanson(g, flow), predict_oldal(g, flow), predict_oldal_rectangular(g, flow)};
 }
 

@@ -60,7 +60,8 @@ void run_predict(const std::string& geometry_path, const std::string& json_out) 
     for (const auto& p : predictions) {
         std::string line = p.model;
         line.resize(22, ' ');
-        std::string rate = p.rate ? fixed(*p.rate, 4) : "-";
+        // four significant digits: a slot of a few grains discharges 2e-5 kg/s, which four decimals showed as 0
+        std::string rate = p.rate ? analytics::number_text(*p.rate, 4) : "-";
         rate.resize(10, ' ');
         std::cout << line << " " << rate << " " << (p.valid ? "yes  " : "NO   ") << "  ";
         for (size_t i = 0; i < p.warnings.size(); ++i) std::cout << (i ? "; " : "") << p.warnings[i];

@@ -89,18 +89,55 @@ TEST_CASE("the rectangular Oldal model says when it is used outside its limits",
     CHECK(seen);
 }
 
+TEST_CASE("a ratio typed on a validity limit is within it (the limits are inclusive)", "[discharge]") {
+    // the seed's 100 mm wide silo with a 70 mm outlet: 0.07 / 0.1 rounds to 0.7000000000000001 in doubles
+    CHECK(oldal_rectangular_limit_violations(0.025, 0.1, 0.07).empty());  // a/c = 0.7, c/b = 4
+    CHECK(oldal_rectangular_limit_violations(0.1, 0.1, 0.015).empty());   // a/c = 0.15, c/b = 1
+    CHECK(oldal_rectangular_limit_violations(0.025, 0.1, 0.0701).size() == 1);
+    // d = 24.6 mm, d_p = 4.1 mm: outlet/d_p = 6 exactly as typed (6 * 0.0041 rounds above 0.0246)
+    nlohmann::json j{{"geometry", "conical"}, {"D_m", 0.105},     {"outlet_m", 0.0246}, {"theta_deg", 60},
+                     {"d_p_m", 0.0041},      {"rho_b_kg_m3", 800}};
+    for (const auto& p : predict_discharge(geometry_from_json(j))) {
+        INFO(p.model);
+        if (p.model == "beverloo" || p.model == "beverloo+rose-tanaka") CHECK(p.valid);
+    }
+}
+
+TEST_CASE("an outlet of fewer than 4 grains arches: no model predicts a steady flow", "[discharge]") {
+    // 9 mm outlet, 5.5 mm grains (1.6 grains across), funnel flow: Oldal and Johanson were reported valid
+    nlohmann::json j{{"geometry", "conical"}, {"D_m", 0.105},      {"outlet_m", 0.009}, {"theta_deg", 60},
+                     {"d_p_m", 0.0055},      {"rho_b_kg_m3", 712}, {"delta_e_deg", 40}, {"phi_w_deg", 20}};
+    int evaluated = 0;
+    for (const auto& p : predict_discharge(geometry_from_json(j))) {
+        if (!p.rate) continue;
+        ++evaluated;
+        INFO(p.model);
+        CHECK_FALSE(p.valid);
+    }
+    CHECK(evaluated >= 4);
+    j["outlet_m"] = 0.023;  // 4.2 grains: free flow, Oldal's model (funnel flow here) holds; Beverloo needs 6
+    for (const auto& p : predict_discharge(geometry_from_json(j))) {
+        INFO(p.model);
+        if (p.model == "oldal") CHECK(p.valid);
+        if (p.model == "beverloo") CHECK_FALSE(p.valid);
+    }
+}
+
 TEST_CASE("predict marks flow-pattern and shape mismatches", "[discharge]") {
     nlohmann::json j{{"geometry", "conical"},   {"D_m", 0.105},     {"outlet_m", 0.035}, {"theta_deg", 20},
                      {"d_p_m", 0.0055},        {"rho_b_kg_m3", 800}, {"delta_e_deg", 50}, {"phi_w_deg", 20}};
     for (const auto& p : predict_discharge(geometry_from_json(j))) {
         if (p.model == "johanson-conical") CHECK(p.valid);       // 20 < 26.1: mass flow
         if (p.model == "oldal") CHECK_FALSE(p.valid);            // a funnel-flow model in mass flow
+        if (p.model == "beverloo") CHECK_FALSE(p.valid);         // so is Beverloo's (the seed, 2.3)
+        if (p.model == "beverloo+rose-tanaka") CHECK(p.valid);   // the hopper's correction
         if (p.model == "oldal-rect") CHECK_FALSE(p.rate.has_value());
     }
     j["theta_deg"] = 60;
     for (const auto& p : predict_discharge(geometry_from_json(j))) {
         if (p.model == "johanson-conical") CHECK_FALSE(p.valid);
         if (p.model == "oldal") CHECK(p.valid);
+        if (p.model == "beverloo") CHECK(p.valid);
     }
 }
 
