@@ -301,7 +301,7 @@ nlohmann::json seed_units(const std::optional<analytics::ScalingLawFit>& young,
     if (young) j["A_MPa_per_mm"] = young->params[0].value * 1e-9, j["B_MPa"] = young->params[1].value * 1e-6;
     if (poisson) {
         const double d = poisson->params[1].value;  // C_mm = C_m (1e-3)^-D
-        j["C_mm"] = poisson->params[0].value * std::pow(1e-3, d), j["D"] = d;
+        j["C_mm"] = poisson->params[0].value * std::pow(1e-3, -d), j["D"] = d;
     }
     return j;
 }
