@@ -15,6 +15,7 @@ struct ParameterComparison {
     double degrees_of_freedom = 0;    // Satterthwaite
     double p_value = 1;               // two-sided, H0: equal
     double combined_half_width = 0;   // sqrt(hw_a^2 + hw_b^2) of the two confidence intervals
+    double confidence = 0.95;         // the level of both lines' intervals (JSON: combined_half_width_<percent>)
     bool within_combined_intervals() const { return std::abs(difference) <= combined_half_width; }
     nlohmann::json to_json() const;
 };

@@ -57,7 +57,18 @@ TEST_CASE("the comparison's numbers are those of two independent estimates", "[a
     CHECK(c.mu_b.degrees_of_freedom <= a.n + b.n - 4 + 1e-9);
     CHECK(c.mu_b.p_value < 1e-6);  // 0.1 apart with SE ~0.01
     CHECK(c.to_json()["mu_b"]["within_combined_intervals"] == false);
+    CHECK(c.to_json()["mu_b"].contains("combined_half_width_95"));
     FailureLine two;
     two.n = 2;
     CHECK_THROWS_AS(compare_failure_lines(a, two), std::invalid_argument);
+}
+
+TEST_CASE("lines with intervals at different levels are not combined", "[analytics][failure_line_comparison]") {
+    const std::vector<double> sigma{5e3, 5e3, 10e3, 10e3, 15e3, 15e3};
+    const std::vector<double> tau{4.1e3, 3.9e3, 7.2e3, 6.9e3, 10.1e3, 9.8e3};
+    const auto at95 = fit_failure_line(sigma, tau, 0.95), at90 = fit_failure_line(sigma, tau, 0.90);
+    CHECK_THROWS_WITH(compare_failure_lines(at95, at90), Catch::Contains("95 %") && Catch::Contains("90 %"));
+    const auto c = compare_failure_lines(at90, at90);
+    CHECK(c.mu_b.confidence == 0.90);
+    CHECK(c.to_json()["mu_b"].contains("combined_half_width_90"));  // the key names the level it holds
 }
