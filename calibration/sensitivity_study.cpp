@@ -289,18 +289,12 @@ struct StudyFieldReader {
 };
 }  // namespace
 
-SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
-    using R = StudyFieldReader;
-    if (!j.is_object() || !j.contains("schema") || j["schema"] != "demcal.sensitivity/1")
-        throw std::invalid_argument("schema = " +
-                                    (j.is_object() && j.contains("schema") ? analytics::json_value_text(j["schema"])
-                                                                           : std::string("<missing>")) +
-                                    " is not demcal.sensitivity/1");
-    R::only_known_keys(j,
-                       {"schema", "base_material", "levels", "relative_span", "line", "criterion", "alpha",
-                        "evaluations", "simulations_run", "simulations_reused", "cpu_s", "parameters"},
-                       "");
-    SensitivityStudy s;
+namespace {
+using R = StudyFieldReader;
+constexpr double big = analytics::kLargestPlausibleNumber;
+
+// The study's own settings and counts (everything but its parameters).
+void read_study_settings(const nlohmann::json& j, SensitivityStudy& s) {
     s.base_material = R::at(j, "base_material", "");
     if (!s.base_material.is_object()) R::refuse("base_material", s.base_material, "must be a JSON object");
     s.options.levels = static_cast<int>(R::number(j, "levels", "", 3, kMaxLevels, "[3, 101]"));
@@ -313,57 +307,90 @@ SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
     s.simulations_run = R::optional_count(j, "simulations_run", "");
     s.simulations_reused = R::optional_count(j, "simulations_reused", "");
     s.cpu_s = R::optional_number(j, "cpu_s", "");
-    const nlohmann::json& parameters = R::array(j, "parameters", "", 1);
-    for (std::size_t i = 0; i < parameters.size(); ++i) {
-        const std::string where = "parameters[" + std::to_string(i) + "]";
-        const nlohmann::json& pj = parameters[i];
-        R::only_known_keys(pj, {"name", "base_value", "levels", "mu_b", "tau_c"}, where);
-        ParameterSensitivity p;
-        p.name = R::text(pj, "name", where);
-        const auto known = orchestrator::micromechanical_param_names();
-        if (std::find(known.begin(), known.end(), p.name) == known.end())
-            R::refuse(where + ".name", pj.at("name"), "not a micromechanical parameter of the shear box");
-        if (std::find(s.options.params.begin(), s.options.params.end(), p.name) != s.options.params.end())
-            R::refuse(where + ".name", pj.at("name"), "named by an earlier parameter too");
-        p.base_value = R::number(pj, "base_value", where, -analytics::kLargestPlausibleNumber,
-                                 analytics::kLargestPlausibleNumber, "[-1e100, 1e100]");
-        // the base material is the centre of every parameter's levels: an edited one no longer matches the runs
-        const auto base = s.base_material.find(p.name);
-        if (base == s.base_material.end() || !base->is_number() || base->get<double>() != p.base_value)
-            throw std::invalid_argument("base_material." + p.name + " = " +
-                                        (base == s.base_material.end() ? std::string("<missing>")
-                                                                       : analytics::json_value_text(*base)) +
-                                        ": differs from " + where + ".base_value = " +
-                                        analytics::number_text(p.base_value) + " (the value the study varied around)");
-        s.options.params.push_back(p.name);
-        const nlohmann::json& levels = R::array(pj, "levels", where, 3);
-        if (levels.size() != static_cast<std::size_t>(s.options.levels))
-            throw std::invalid_argument(where + ".levels has " + std::to_string(levels.size()) +
-                                        " entries, the study's levels = " + std::to_string(s.options.levels) +
-                                        ": every parameter is run at the same number of levels");
-        for (std::size_t k = 0; k < levels.size(); ++k) {
-            const std::string lw = where + ".levels[" + std::to_string(k) + "]";
-            const nlohmann::json& lj = levels[k];
-            R::only_known_keys(lj,
-                               {"value", "mu_b", "se_mu_b", "mu_b_half_width", "tau_c", "se_tau_c",
-                                "tau_c_half_width", "simulations_run", "simulations_reused", "cpu_s"},
-                               lw);
-            constexpr double big = analytics::kLargestPlausibleNumber;
-            p.levels.push_back({R::number(lj, "value", lw, -big, big, "[-1e100, 1e100]"),
-                                R::number(lj, "mu_b", lw, -big, big, "[-1e100, 1e100]"),
-                                R::number(lj, "se_mu_b", lw, 0, big, "[0, 1e100]"), R::optional_number(lj, "mu_b_half_width", lw),
-                                R::number(lj, "tau_c", lw, -big, big, "[-1e100, 1e100]"),
-                                R::number(lj, "se_tau_c", lw, 0, big, "[0, 1e100]"),
-                                R::optional_number(lj, "tau_c_half_width", lw), R::optional_count(lj, "simulations_run", lw),
-                                R::optional_count(lj, "simulations_reused", lw), R::optional_number(lj, "cpu_s", lw)});
-            if (k > 0 && !(p.levels[k].value > p.levels[k - 1].value))
-                R::refuse(lw + ".value", lj.at("value"),
-                          "not above the level before it (" + analytics::number_text(p.levels[k - 1].value) +
-                              "): a study's levels ascend");
-        }
-        fit_responses(p, s.options.shape);
-        s.parameters.push_back(std::move(p));
+}
+
+// One level's failure line; `lw` names it in a refusal.
+SensitivityLevel read_study_level(const nlohmann::json& lj, const std::string& lw) {
+    R::only_known_keys(lj,
+                       {"value", "mu_b", "se_mu_b", "mu_b_half_width", "tau_c", "se_tau_c", "tau_c_half_width",
+                        "simulations_run", "simulations_reused", "cpu_s"},
+                       lw);
+    // a braced list is evaluated left to right: the fields are checked in this order
+    return {R::number(lj, "value", lw, -big, big, "[-1e100, 1e100]"),
+            R::number(lj, "mu_b", lw, -big, big, "[-1e100, 1e100]"),
+            R::number(lj, "se_mu_b", lw, 0, big, "[0, 1e100]"),
+            R::optional_number(lj, "mu_b_half_width", lw),
+            R::number(lj, "tau_c", lw, -big, big, "[-1e100, 1e100]"),
+            R::number(lj, "se_tau_c", lw, 0, big, "[0, 1e100]"),
+            R::optional_number(lj, "tau_c_half_width", lw),
+            R::optional_count(lj, "simulations_run", lw),
+            R::optional_count(lj, "simulations_reused", lw),
+            R::optional_number(lj, "cpu_s", lw)};
+}
+
+// The parameter's name: a micromechanical one, not named before in the study.
+std::string read_parameter_name(const nlohmann::json& pj, const std::string& where, const SensitivityStudy& s) {
+    std::string name = R::text(pj, "name", where);
+    const auto known = orchestrator::micromechanical_param_names();
+    if (std::find(known.begin(), known.end(), name) == known.end())
+        R::refuse(where + ".name", pj.at("name"), "not a micromechanical parameter of the shear box");
+    if (std::find(s.options.params.begin(), s.options.params.end(), name) != s.options.params.end())
+        R::refuse(where + ".name", pj.at("name"), "named by an earlier parameter too");
+    return name;
+}
+
+// The base material is the centre of every parameter's levels: an edited one no longer matches the runs.
+void check_base_value(const SensitivityStudy& s, const ParameterSensitivity& p, const std::string& where) {
+    const auto base = s.base_material.find(p.name);
+    if (base == s.base_material.end() || !base->is_number() || base->get<double>() != p.base_value)
+        throw std::invalid_argument("base_material." + p.name + " = " +
+                                    (base == s.base_material.end() ? std::string("<missing>")
+                                                                   : analytics::json_value_text(*base)) +
+                                    ": differs from " + where + ".base_value = " +
+                                    analytics::number_text(p.base_value) + " (the value the study varied around)");
+}
+
+// One varied parameter: its name, base value and levels (as many as the study's, ascending), its responses fitted.
+ParameterSensitivity read_study_parameter(const nlohmann::json& pj, const std::string& where, SensitivityStudy& s) {
+    R::only_known_keys(pj, {"name", "base_value", "levels", "mu_b", "tau_c"}, where);
+    ParameterSensitivity p;
+    p.name = read_parameter_name(pj, where, s);
+    p.base_value = R::number(pj, "base_value", where, -big, big, "[-1e100, 1e100]");
+    check_base_value(s, p, where);
+    s.options.params.push_back(p.name);
+    const nlohmann::json& levels = R::array(pj, "levels", where, 3);
+    if (levels.size() != static_cast<std::size_t>(s.options.levels))
+        throw std::invalid_argument(where + ".levels has " + std::to_string(levels.size()) +
+                                    " entries, the study's levels = " + std::to_string(s.options.levels) +
+                                    ": every parameter is run at the same number of levels");
+    for (std::size_t k = 0; k < levels.size(); ++k) {
+        const std::string lw = where + ".levels[" + std::to_string(k) + "]";
+        p.levels.push_back(read_study_level(levels[k], lw));
+        if (k > 0 && !(p.levels[k].value > p.levels[k - 1].value))
+            R::refuse(lw + ".value", levels[k].at("value"),
+                      "not above the level before it (" + analytics::number_text(p.levels[k - 1].value) +
+                          "): a study's levels ascend");
     }
+    fit_responses(p, s.options.shape);
+    return p;
+}
+}  // namespace
+
+SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
+    if (!j.is_object() || !j.contains("schema") || j["schema"] != "demcal.sensitivity/1")
+        throw std::invalid_argument("schema = " +
+                                    (j.is_object() && j.contains("schema") ? analytics::json_value_text(j["schema"])
+                                                                           : std::string("<missing>")) +
+                                    " is not demcal.sensitivity/1");
+    R::only_known_keys(j,
+                       {"schema", "base_material", "levels", "relative_span", "line", "criterion", "alpha",
+                        "evaluations", "simulations_run", "simulations_reused", "cpu_s", "parameters"},
+                       "");
+    SensitivityStudy s;
+    read_study_settings(j, s);
+    const nlohmann::json& parameters = R::array(j, "parameters", "", 1);
+    for (std::size_t i = 0; i < parameters.size(); ++i)
+        s.parameters.push_back(read_study_parameter(parameters[i], "parameters[" + std::to_string(i) + "]", s));
     return s;
 }
 
