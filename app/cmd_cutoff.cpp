@@ -289,7 +289,8 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
                           {"window_s", o.base.window},
                           {"campaign", dir.string()},
                           {"criterion", "flows: at least half of the filled mass out within window_s of the opening, "
-                                        "in at least half of the seeds"},
+                                        "in at least half of the seeds (a run ends earlier once no grain has left "
+                                        "for 0.5 s of vibration: arched)"},
                           {"runs", runs}};
     return conclude(res, std::move(out), o.json);
 }
@@ -305,7 +306,7 @@ int run(const CutoffCli& o, CLI::App& sub) {
     nlohmann::json runs = nlohmann::json::array();
     auto report = [&](const kc::CohesiveHopperCase& c, const kc::CohesiveHopperOutcome& r) {
         std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% out in %.2f s -> %s  [%.1f s]\n", c.frequency,
-                    r.peak_acceleration_g, c.seed, 100 * r.discharged_fraction, c.window,
+                    r.peak_acceleration_g, c.seed, 100 * r.discharged_fraction, r.discharge_s,
                     r.flows() ? "flows" : "arched", r.wall_s);
         std::fflush(stdout);
         runs.push_back({{"frequency_hz", c.frequency}, {"seed", c.seed}, {"peak_acceleration_g", r.peak_acceleration_g},

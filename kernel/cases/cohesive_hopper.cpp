@@ -1,6 +1,7 @@
 #include "kernel/cases/cohesive_hopper.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -74,8 +75,13 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
       }
   sim.set_timestep(kTimestepFraction * sim.rayleigh_timestep());
   sim.set_exact_removal(true);  // the discharged spheres leave every 500 steps
-  while (sim.time() < c.settle) sim.step(100);
+  // the outlet opens at the step that reaches `settle`, when the shaker starts (100-step strides opened it up to 100
+  // steps, 0.7 of a 400 Hz period, after the bin had begun to shake)
+  const double dt = sim.timestep();
+  while (sim.time() < c.settle)
+    sim.step(std::clamp<long>(std::lround(std::ceil((c.settle - sim.time()) / dt)), 1, 100));
   sim.set_wall_enabled(plate, false);
+  const double t_open = sim.time();
   const double mass = sim.total_mass();
   double out = 0;
   while (sim.time() < c.settle + c.window && out < 0.5 * mass) {
@@ -84,6 +90,7 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
   }
   CohesiveHopperOutcome o;
   o.discharged_fraction = out / mass;
+  o.discharge_s = sim.time() - t_open;
   o.peak_acceleration_g = c.amplitude * std::pow(2 * M_PI * c.frequency, 2) / 9.81;
   o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return o;

@@ -31,6 +31,7 @@ void validate(const CohesiveHopperCase& c);
 
 struct CohesiveHopperOutcome {
   double discharged_fraction = 0;  ///< of the mass, within the window (the run stops once half has left)
+  double discharge_s = 0;          ///< simulated time from the opening to the run's end (the window, or earlier)
   double peak_acceleration_g = 0;  ///< A (2 pi f)^2 / g
   double wall_s = 0;
   bool flows() const { return discharged_fraction >= 0.5; }  ///< the stated criterion: half the mass out in the window

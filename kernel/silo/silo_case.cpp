@@ -935,6 +935,9 @@ private:
     bool discharge() {
         const long frame_every = std::max(1L, std::lround(s_.frame_interval / r_.time_step));
         const double stall_time = 0.5;  // no grain discharged for this long with grains left: the flow has stopped
+        // a bin still to be shaken has not had its chance: the stall counts from the vibration's start at the earliest
+        // (a bed arched over a closed-looking outlet stopped at 0.5 s before a vibration set to start at 0.6 s)
+        const double quiet_from = s_.vibration.vibrates() ? s_.vibration.start_after_opening : 0.0;
         auto below = [this](const BodyState& b) { return is_below_outlet(b); };
         while (true) {
             if (!advance_record_interval()) return false;
@@ -975,7 +978,7 @@ private:
                 r_.stop_reason = "stop fraction " + setting_text(s_.stop_fraction) + " of the filled mass discharged";
                 break;
             }
-            if (t - last_out_time_ > stall_time) {
+            if (t - std::max(last_out_time_, quiet_from) > stall_time) {
                 r_.stop_reason = "flow stopped: no grain left for " + setting_text(stall_time) + " s, " +
                                  std::to_string(sim_.num_bodies()) + " grains remain";
                 break;

@@ -240,6 +240,28 @@ TEST_CASE("demcal silo: a tiny vibrating run records the vibration and its peak 
     fs::remove_all(dir);
 }
 
+TEST_CASE("demcal silo: a bed arched before a late vibration starts is not stopped before it is shaken",
+          "[silo][cli]") {
+    // meal arches over the outlet at 50 deg: nothing leaves in the first 0.5 s. The run used to end there ("flow
+    // stopped") with the vibration set to start at 0.6 s never run, and the summary still reported a 400 Hz bin.
+    require_demcal();
+    const fs::path dir = fs::temp_directory_path() / "demcal_test_silo_cli_late_vibration";
+    fs::remove_all(dir);
+    const Run r = run_silo("--material '" + std::string(DEMCAL_SOURCE_DIR) +
+                               "/examples/materials/silo_meal.json' --theta 50 --particles 600 --stiffness-scale 0.01 "
+                               "--vibration-frequency 400 --vibration-amplitude 1.1e-4 --vibration-start 0.6 "
+                               "--max-time 1.5 --threads 1 --no-plots --out '" + (dir / "out").string() + "'",
+                           dir);
+    INFO(r.err);
+    REQUIRE(r.rc == 0);
+    const auto summary = nlohmann::json::parse(read_file(dir / "out" / "summary.json"));
+    const auto& discharge = summary.at("discharge");
+    INFO(discharge.dump());
+    CHECK(discharge.at("time_s").get<double>() > 0.6);  // ran into the vibration
+    CHECK(discharge.at("discharged_mass_kg").get<double>() > 0);
+    fs::remove_all(dir);
+}
+
 TEST_CASE("demcal silo: results that cannot be written keep the checkpoint, and resuming writes them",
           "[silo][cli]") {
     require_demcal();
