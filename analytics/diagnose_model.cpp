@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <numeric>
+#include <set>
 #include <stdexcept>
 
 namespace demcal::analytics::diagnosis {
@@ -227,19 +229,23 @@ Model beverloo_model(const MeasuredData& d, Setting& s) {
     return m;
 }
 
+// Oldal's arch model, one parameter: the arch's height over the outlet delta (> 0), from its usual 0.5.
+Model arch_model(std::function<double(std::size_t row, double delta)> rate, std::set<std::string> used, Setting& s) {
+    Model m;
+    m.param_names = {"delta"};
+    m.start = {0.5};
+    m.base = [rate = std::move(rate)](std::size_t r, const double* p) { return p[0] > 0 ? rate(r, p[0]) : nan; };
+    s.used = std::move(used);
+    return m;
+}
+
 Model oldal_model(const MeasuredData& d, Setting& s) {
     require_shape("oldal", d, "conical");
     const auto& outlet = d.at("outlet_m").values;
     const auto& dp = d.at("d_p_m").values;
     const auto& rho = d.at("rho_b_kg_m3").values;
-    Model m;
-    m.param_names = {"delta"};
-    m.start = {0.5};
-    m.base = [&outlet, &dp, &rho](std::size_t r, const double* p) {
-        return p[0] > 0 ? oldal_rate(outlet[r], dp[r], rho[r], p[0]) : nan;
-    };
-    s.used = {"outlet_m", "d_p_m", "rho_b_kg_m3"};
-    return m;
+    return arch_model([&outlet, &dp, &rho](std::size_t r, double delta) { return oldal_rate(outlet[r], dp[r], rho[r], delta); },
+                      {"outlet_m", "d_p_m", "rho_b_kg_m3"}, s);
 }
 
 Model oldal_rect_model(const MeasuredData& d, Setting& s) {
@@ -248,14 +254,11 @@ Model oldal_rect_model(const MeasuredData& d, Setting& s) {
     const auto& outlet = d.at("outlet_m").values;
     const auto& dp = d.at("d_p_m").values;
     const auto& rho = d.at("rho_b_kg_m3").values;
-    Model m;
-    m.param_names = {"delta"};
-    m.start = {0.5};
-    m.base = [&depth, &outlet, &dp, &rho](std::size_t r, const double* p) {
-        return p[0] > 0 ? oldal_rectangular_rate(depth[r], outlet[r], dp[r], rho[r], p[0]) : nan;
-    };
-    s.used = {"b_m", "outlet_m", "d_p_m", "rho_b_kg_m3"};
-    return m;
+    return arch_model(
+        [&depth, &outlet, &dp, &rho](std::size_t r, double delta) {
+            return oldal_rectangular_rate(depth[r], outlet[r], dp[r], rho[r], delta);
+        },
+        {"b_m", "outlet_m", "d_p_m", "rho_b_kg_m3"}, s);
 }
 
 Model johanson_model(const MeasuredData& d, Setting& s) {

@@ -89,6 +89,24 @@ TEST_CASE("the rectangular Oldal model says when it is used outside its limits",
     CHECK(seen);
 }
 
+namespace {
+// Checks that every model predict gives a rate for `geometry` is invalid (with a warning holding `warning`, when
+// given); returns how many were checked.
+int every_rated_model_invalid(const nlohmann::json& geometry, const std::string& warning = "") {
+    int evaluated = 0;
+    for (const auto& p : predict_discharge(geometry_from_json(geometry))) {
+        if (!p.rate) continue;
+        ++evaluated;
+        INFO(p.model);
+        CHECK_FALSE(p.valid);
+        if (!warning.empty())
+            CHECK(std::any_of(p.warnings.begin(), p.warnings.end(),
+                              [&](const std::string& w) { return w.find(warning) != std::string::npos; }));
+    }
+    return evaluated;
+}
+}  // namespace
+
 TEST_CASE("a ratio typed on a validity limit is within it (the limits are inclusive)", "[discharge]") {
     // the seed's 100 mm wide silo with a 70 mm outlet: 0.07 / 0.1 rounds to 0.7000000000000001 in doubles
     CHECK(oldal_rectangular_limit_violations(0.025, 0.1, 0.07).empty());  // a/c = 0.7, c/b = 4
@@ -107,14 +125,7 @@ TEST_CASE("an outlet of fewer than 4 grains arches: no model predicts a steady f
     // 9 mm outlet, 5.5 mm grains (1.6 grains across), funnel flow: Oldal and Johanson were reported valid
     nlohmann::json j{{"geometry", "conical"}, {"D_m", 0.105},      {"outlet_m", 0.009}, {"theta_deg", 60},
                      {"d_p_m", 0.0055},      {"rho_b_kg_m3", 712}, {"delta_e_deg", 40}, {"phi_w_deg", 20}};
-    int evaluated = 0;
-    for (const auto& p : predict_discharge(geometry_from_json(j))) {
-        if (!p.rate) continue;
-        ++evaluated;
-        INFO(p.model);
-        CHECK_FALSE(p.valid);
-    }
-    CHECK(evaluated >= 4);
+    CHECK(every_rated_model_invalid(j) >= 4);
     j["outlet_m"] = 0.023;  // 4.2 grains: free flow, Oldal's model (funnel flow here) holds; Beverloo needs 6
     for (const auto& p : predict_discharge(geometry_from_json(j))) {
         INFO(p.model);
@@ -198,14 +209,5 @@ TEST_CASE("predict marks every model invalid for a fine powder", "[discharge]") 
         if (p.rate) CHECK(std::none_of(p.warnings.begin(), p.warnings.end(),
                                        [](const std::string& w) { return w.find("fine powder") != std::string::npos; }));
     j["d_p_m"] = 1e-4;  // 100 um: air-retarded flow
-    int evaluated = 0;
-    for (const auto& p : predict_discharge(geometry_from_json(j))) {
-        if (!p.rate) continue;
-        ++evaluated;
-        INFO(p.model);
-        CHECK_FALSE(p.valid);
-        CHECK(std::any_of(p.warnings.begin(), p.warnings.end(),
-                          [](const std::string& w) { return w.find("fine powder") != std::string::npos; }));
-    }
-    CHECK(evaluated >= 3);
+    CHECK(every_rated_model_invalid(j, "fine powder") >= 3);
 }
