@@ -29,6 +29,11 @@ constexpr double min_silo_outlet_ratio = 2.5;
 constexpr double limit_slack = 1e-9;
 bool below(double value, double limit) { return value < limit * (1 - limit_slack); }
 bool above(double value, double limit) { return value > limit * (1 + limit_slack); }
+
+// The outlet's narrowest side: a slot's width a, or its length b where the slot is longer than the silo is deep.
+double narrowest_opening(const SiloGeometry& g) {
+    return g.shape == SiloShape::rectangular ? std::min(g.outlet, g.depth) : g.outlet;
+}
 }  // namespace
 
 double beverloo_rate(double outlet, double particle_size, double bulk_density, double c, double k) {
@@ -161,7 +166,7 @@ void validate(const SiloGeometry& g) {
     plausible("slot_C", g.slot_c, 0, 5, "", "Myers and Sellers' C' is about 1");
     plausible("delta", g.arch_delta, 0, 10, "", "Oldal's arch height over the outlet is about 0.5");
     // Beverloo's empty annulus k d_p must leave an opening, or its rate is 0 for any silo (k is 1-3 in the literature)
-    const double opening = g.shape == SiloShape::rectangular ? std::min(g.outlet, g.depth) : g.outlet;
+    const double opening = narrowest_opening(g);
     if (g.beverloo_k * g.particle_size >= opening)
         throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + ": k d_p = " +
                                     number_text(g.beverloo_k * g.particle_size) + " m is not smaller than the outlet (" +
@@ -190,8 +195,13 @@ struct FlowPatternCheck {
 
 FlowPatternCheck check_flow_pattern(const SiloGeometry& g) {
     FlowPatternCheck c;
-    if (!g.effective_friction_deg) return c;
     const double theta = g.half_angle_deg;
+    if (theta >= 90) {  // a flat bottom: no hopper wall to slide along, funnel flow whatever the frictions
+        c.mass_flow = false;
+        c.note = "funnel flow (flat bottom, theta = 90)";
+        return c;
+    }
+    if (!g.effective_friction_deg) return c;
     const double limit = jenike_mass_flow_limit_deg(*g.effective_friction_deg, *g.wall_friction_deg);
     if (theta < limit) {
         c.mass_flow = true;
@@ -221,9 +231,10 @@ void check_model_flow(DischargePrediction& p, const FlowPatternCheck& flow, Mode
 
 // Beverloo-type correlations: fitted to outlets of more than 6 grains.
 void check_outlet_ratio(DischargePrediction& p, const SiloGeometry& g) {
-    if (below(g.outlet / g.particle_size, min_outlet_particle_ratio)) {
+    const double opening = narrowest_opening(g);
+    if (below(opening / g.particle_size, min_outlet_particle_ratio)) {
         p.valid = false;
-        p.warnings.push_back("outlet/d_p = " + number_text(g.outlet / g.particle_size) + " < " +
+        p.warnings.push_back("outlet/d_p = " + number_text(opening / g.particle_size) + " < " +
                              number_text(min_outlet_particle_ratio) +
                              ": intermittent flow and clogging, correlation not valid");
     }
@@ -231,9 +242,10 @@ void check_outlet_ratio(DischargePrediction& p, const SiloGeometry& g) {
 
 // Every model: an outlet of fewer than 4 grains arches over, with no steady flow to predict.
 void check_free_flow(DischargePrediction& p, const SiloGeometry& g) {
-    if (below(g.outlet / g.particle_size, min_free_flow_outlet_ratio)) {
+    const double opening = narrowest_opening(g);
+    if (below(opening / g.particle_size, min_free_flow_outlet_ratio)) {
         p.valid = false;
-        p.warnings.push_back("outlet/d_p = " + number_text(g.outlet / g.particle_size) + " < " +
+        p.warnings.push_back("outlet/d_p = " + number_text(opening / g.particle_size) + " < " +
                              number_text(min_free_flow_outlet_ratio) +
                              ": stable arches likely (the seed: d > 3.5-4 d_p for a gravity discharge), no steady "
                              "flow to predict");

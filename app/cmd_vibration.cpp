@@ -287,12 +287,13 @@ CellSummary summarize(const Cell& c, bool vibrated) {
         s.density_change = paired_change(densities, still_densities);
         s.speed_change = paired_change(speeds, still_speeds);
     }
-    // the most frequent pattern; a tie names every pattern tied (a 1-1 cell said "mass" by alphabetical order)
+    // the most frequent pattern; a tie names every pattern tied, mass/mixed (a 1-1 cell said "mass" by alphabetical
+    // order; not '|', which would split the cell of vibration.md's table)
     int most = 0;
     for (const auto& [p, count] : patterns) most = std::max(most, count);
     std::string tied;
     for (const auto& [p, count] : patterns)
-        if (count == most) tied += (tied.empty() ? "" : "|") + p;
+        if (count == most) tied += (tied.empty() ? "" : "/") + p;
     if (most > 0) s.pattern = tied;
     return s;
 }

@@ -122,15 +122,40 @@ TEST_CASE("a ratio typed on a validity limit is within it (the limits are inclus
 }
 
 TEST_CASE("an outlet of fewer than 4 grains arches: no model predicts a steady flow", "[discharge]") {
-    // 9 mm outlet, 5.5 mm grains (1.6 grains across), funnel flow: Oldal and Johanson were reported valid
+    // 9 mm outlet, 5.5 mm grains (1.6 grains across), funnel flow: Oldal was reported valid
     nlohmann::json j{{"geometry", "conical"}, {"D_m", 0.105},      {"outlet_m", 0.009}, {"theta_deg", 60},
                      {"d_p_m", 0.0055},      {"rho_b_kg_m3", 712}, {"delta_e_deg", 40}, {"phi_w_deg", 20}};
     CHECK(every_rated_model_invalid(j) >= 4);
+    auto mass_flow = j;  // 20 deg, below Jenike's 27: Johanson's mass-flow model was reported valid
+    mass_flow["theta_deg"] = 20;
+    CHECK(every_rated_model_invalid(mass_flow, "outlet/d_p = 1.6") >= 3);
+    // a slot of 3 grains (a 15 mm slot, 5 mm grains) in a wedge inside Oldal's limits: oldal-rect was reported valid
+    const nlohmann::json slot{{"geometry", "rectangular"}, {"b_m", 0.05},      {"c_m", 0.1},     {"outlet_m", 0.015},
+                              {"theta_deg", 60},           {"d_p_m", 0.005}, {"rho_b_kg_m3", 712}};
+    CHECK(every_rated_model_invalid(slot) >= 3);
+    // the slot's length counts too: a 70 mm slot across a silo 25 mm deep, 7.5 mm grains (3.3 along its length)
+    const nlohmann::json short_slot{{"geometry", "rectangular"}, {"b_m", 0.025},      {"c_m", 0.1},
+                                    {"outlet_m", 0.07},          {"theta_deg", 60},   {"d_p_m", 0.0075},
+                                    {"rho_b_kg_m3", 712}};
+    CHECK(every_rated_model_invalid(short_slot, "outlet/d_p = 3.33") >= 3);
     j["outlet_m"] = 0.023;  // 4.2 grains: free flow, Oldal's model (funnel flow here) holds; Beverloo needs 6
     for (const auto& p : predict_discharge(geometry_from_json(j))) {
         INFO(p.model);
         if (p.model == "oldal") CHECK(p.valid);
         if (p.model == "beverloo") CHECK_FALSE(p.valid);
+    }
+}
+
+TEST_CASE("a flat-bottomed silo is in funnel flow without the friction angles", "[discharge]") {
+    const nlohmann::json j{{"geometry", "conical"}, {"D_m", 0.105},     {"outlet_m", 0.035}, {"theta_deg", 90},
+                           {"d_p_m", 0.0055},      {"rho_b_kg_m3", 800}};
+    for (const auto& p : predict_discharge(geometry_from_json(j))) {
+        INFO(p.model);
+        if (p.model == "beverloo" || p.model == "oldal") {
+            CHECK(p.valid);
+            CHECK(std::none_of(p.warnings.begin(), p.warnings.end(),
+                               [](const std::string& w) { return w.find("unknown") != std::string::npos; }));
+        }
     }
 }
 

@@ -126,7 +126,7 @@ TEST_CASE("the enlargement study recovers known laws, and their materials restor
     CHECK(j.at("per_radius").size() == 4);
     const double saved_by_doubling = j.at("cost").at("saved_by_doubling").at("value").get<double>();
     CHECK(saved_by_doubling == Approx(1 - std::pow(2.0, -cost_p)).margin(0.03));
-    // the seed's units (eqs. 3.1-3.2: E in MPa, r in mm): C_mm was C_m 1e-3^+D before 2026-12-06, 1e-31 here
+    // the seed's units (eqs. 3.1-3.2: E in MPa, r in mm): C_mm was C_m 1e-3^+D before 2026-12-06, about 5e-9 here
     const auto& seed = j.at("laws_in_seed_units");
     CHECK(seed.at("A_MPa_per_mm").get<double>() == Approx(91.52).epsilon(0.15));
     CHECK(seed.at("B_MPa").get<double>() == Approx(148.86).epsilon(0.15));
