@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <set>
@@ -55,6 +56,32 @@ struct Search {
 };
 
 // The rounds of candidate tests on s.rows (F test, Holm, cross-validation), from the base model.
+// x by regime (or x * z) is named only where its extra slopes explain more than x's plain term does, by a nested F
+// test of the two fits at the family's alpha; otherwise x's plain term, when it is significant and predicts better
+// than the model without it. Each candidate is tested against the current model only, where x's plain part carries
+// the regime form too: an independent audit named a plain moisture effect "by regime" in 115-128 of 500 sets, of
+// which 7-22 had slopes that differed significantly. Returns the index chosen.
+int plain_unless_slopes_differ(const std::vector<CandidateTest>& tests, const std::vector<LeastSquaresFit>& fits,
+                               int best, std::size_t n, std::size_t model_size, double alpha, double cv_now) {
+    const CandidateTest& by_regime = tests[best];
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+        const CandidateTest& plain = tests[i];
+        if (plain.variable != by_regime.variable || !plain.regime.empty() || plain.kind == "physical") continue;
+        const int extra = by_regime.extra_params - plain.extra_params;
+        const int dof = static_cast<int>(n) - static_cast<int>(model_size) - by_regime.extra_params;
+        const double sse_plain = fits[i].sse, sse_regime = fits[best].sse;
+        if (extra <= 0 || dof <= 0 || !std::isfinite(sse_plain) || !std::isfinite(sse_regime)) return best;
+        const double f = sse_regime > 0 ? ((sse_plain - sse_regime) / extra) / (sse_regime / dof)
+                                        : std::numeric_limits<double>::infinity();
+        const double p = f > 0 ? gsl_cdf_fdist_Q(f, extra, dof) : 1.0;
+        if (p < alpha) return best;  // the slopes differ: the regime form stands
+        const bool plain_helps = plain.p_holm < alpha && std::isfinite(plain.cv_rmse) && plain.cv_rmse > 0 &&
+                                 plain.cv_rmse < cv_now;
+        return plain_helps ? static_cast<int>(i) : best;
+    }
+    return best;
+}
+
 Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions& options,
                       std::vector<std::string>& warnings, std::vector<std::string>& undetermined) {
     Search out{base, fit_base(s, base, undetermined), {}, 0, {}, {}};
@@ -124,6 +151,8 @@ Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions
                 return c.variable == x && c.regime.empty() && c.kind != "physical";
             });
         }
+        if (best >= 0 && !tests[best].regime.empty())
+            best = plain_unless_slopes_differ(tests, fits, best, n, m.size(), options.family_alpha, cv_now);
         if (best >= 0 && tests[best].kind != "physical")
             prefer([](const CandidateTest& c) { return c.kind == "physical"; });
         if (best >= 0) tests[best].accepted = true;
