@@ -213,17 +213,24 @@ Model failure_line_model(const MeasuredData& d, Setting& s) {
     return m;
 }
 
+// The columns every discharge model reads (validate_measured has checked they are there), by reference into the data.
+struct DischargeColumns {
+    const std::vector<double>& outlet;
+    const std::vector<double>& dp;
+    const std::vector<double>& rho;
+};
+DischargeColumns discharge_columns(const MeasuredData& d) {
+    return {d.at("outlet_m").values, d.at("d_p_m").values, d.at("rho_b_kg_m3").values};
+}
+
 Model beverloo_model(const MeasuredData& d, Setting& s) {
     require_shape("beverloo", d, "conical");
-    const auto& outlet = d.at("outlet_m").values;
-    const auto& dp = d.at("d_p_m").values;
-    const auto& rho = d.at("rho_b_kg_m3").values;
+    const DischargeColumns c = discharge_columns(d);
     Model m;
     m.param_names = {"C", "k"};
     m.start = {0.58, 1.5};
-    m.base = [&outlet, &dp, &rho](std::size_t r, const double* p) {
-        const double e = outlet[r] - p[1] * dp[r];
-        return e > 0 ? p[0] * rho[r] * std::sqrt(standard_gravity) * std::pow(e, 2.5) : nan;
+    m.base = [c](std::size_t r, const double* p) {  // an outlet the annulus fills: no rate to fit (beverloo_rate: 0)
+        return c.outlet[r] - p[1] * c.dp[r] > 0 ? beverloo_rate(c.outlet[r], c.dp[r], c.rho[r], p[0], p[1]) : nan;
     };
     s.used = {"outlet_m", "d_p_m", "rho_b_kg_m3"};
     return m;
@@ -241,22 +248,18 @@ Model arch_model(std::function<double(std::size_t row, double delta)> rate, std:
 
 Model oldal_model(const MeasuredData& d, Setting& s) {
     require_shape("oldal", d, "conical");
-    const auto& outlet = d.at("outlet_m").values;
-    const auto& dp = d.at("d_p_m").values;
-    const auto& rho = d.at("rho_b_kg_m3").values;
-    return arch_model([&outlet, &dp, &rho](std::size_t r, double delta) { return oldal_rate(outlet[r], dp[r], rho[r], delta); },
+    const DischargeColumns c = discharge_columns(d);
+    return arch_model([c](std::size_t r, double delta) { return oldal_rate(c.outlet[r], c.dp[r], c.rho[r], delta); },
                       {"outlet_m", "d_p_m", "rho_b_kg_m3"}, s);
 }
 
 Model oldal_rect_model(const MeasuredData& d, Setting& s) {
     require_shape("oldal-rect", d, "rectangular");
     const auto& depth = d.at("b_m").values;
-    const auto& outlet = d.at("outlet_m").values;
-    const auto& dp = d.at("d_p_m").values;
-    const auto& rho = d.at("rho_b_kg_m3").values;
+    const DischargeColumns c = discharge_columns(d);
     return arch_model(
-        [&depth, &outlet, &dp, &rho](std::size_t r, double delta) {
-            return oldal_rectangular_rate(depth[r], outlet[r], dp[r], rho[r], delta);
+        [&depth, c](std::size_t r, double delta) {
+            return oldal_rectangular_rate(depth[r], c.outlet[r], c.dp[r], c.rho[r], delta);
         },
         {"b_m", "outlet_m", "d_p_m", "rho_b_kg_m3"}, s);
 }

@@ -229,27 +229,26 @@ void check_model_flow(DischargePrediction& p, const FlowPatternCheck& flow, Mode
     }
 }
 
+// An outlet of fewer than `min_grains` grains across its narrowest side: not valid, with what then happens.
+void check_outlet_grains(DischargePrediction& p, const SiloGeometry& g, double min_grains, const char* consequence) {
+    const double grains = narrowest_opening(g) / g.particle_size;
+    if (below(grains, min_grains)) {
+        p.valid = false;
+        p.warnings.push_back("outlet/d_p = " + number_text(grains) + " < " + number_text(min_grains) + ": " +
+                             consequence);
+    }
+}
+
 // Beverloo-type correlations: fitted to outlets of more than 6 grains.
 void check_outlet_ratio(DischargePrediction& p, const SiloGeometry& g) {
-    const double opening = narrowest_opening(g);
-    if (below(opening / g.particle_size, min_outlet_particle_ratio)) {
-        p.valid = false;
-        p.warnings.push_back("outlet/d_p = " + number_text(opening / g.particle_size) + " < " +
-                             number_text(min_outlet_particle_ratio) +
-                             ": intermittent flow and clogging, correlation not valid");
-    }
+    check_outlet_grains(p, g, min_outlet_particle_ratio, "intermittent flow and clogging, correlation not valid");
 }
 
 // Every model: an outlet of fewer than 4 grains arches over, with no steady flow to predict.
 void check_free_flow(DischargePrediction& p, const SiloGeometry& g) {
-    const double opening = narrowest_opening(g);
-    if (below(opening / g.particle_size, min_free_flow_outlet_ratio)) {
-        p.valid = false;
-        p.warnings.push_back("outlet/d_p = " + number_text(opening / g.particle_size) + " < " +
-                             number_text(min_free_flow_outlet_ratio) +
-                             ": stable arches likely (the seed: d > 3.5-4 d_p for a gravity discharge), no steady "
-                             "flow to predict");
-    }
+    check_outlet_grains(p, g, min_free_flow_outlet_ratio,
+                        "stable arches likely (the seed: d > 3.5-4 d_p for a gravity discharge), no steady flow to "
+                        "predict");
 }
 
 // Every model here is for coarse, free-flowing grains: below about 0.4 mm the interstitial air's pressure gradient
