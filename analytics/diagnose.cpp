@@ -55,7 +55,6 @@ struct Search {
     std::vector<std::vector<CandidateTest>> rounds;
 };
 
-// The rounds of candidate tests on s.rows (F test, Holm, cross-validation), from the base model.
 // x by regime (or x * z) is named only where its extra slopes explain more than x's plain term does, by a nested F
 // test of the two fits at the family's alpha; otherwise x's plain term, when it is significant and predicts better
 // than the model without it. Each candidate is tested against the current model only, where x's plain part carries
@@ -82,6 +81,7 @@ int plain_unless_slopes_differ(const std::vector<CandidateTest>& tests, const st
     return best;
 }
 
+// The rounds of candidate tests on s.rows (F test, Holm, cross-validation), from the base model.
 Search search_effects(const Setting& s, const Model& base, const DiagnoseOptions& options,
                       std::vector<std::string>& warnings, std::vector<std::string>& undetermined) {
     Search out{base, fit_base(s, base, undetermined), {}, 0, {}, {}};
