@@ -38,6 +38,7 @@ namespace fs = std::filesystem;
 struct CutoffCli {
     kc::CohesiveHopperCase base;
     std::string bracket = "0,400";
+    std::string criterion{kc::flow_criterion_name(kc::FlowCriterion::flow_stops)};
     double tol = 25;
     std::vector<long long> seeds{1};
     std::string json;
@@ -59,7 +60,8 @@ constexpr const char* kHopperOptions[] = {"--bond-number", "--theta", "--grains"
 // The silo search's own options (its campaign), which the small hopper (run in this process) does not use.
 constexpr const char* kSiloSearchOptions[] = {"--campaign", "--jobs", "--executor", "--partition"};
 
-// The stated criterion, as for the small hopper: the bed flows when half of its mass leaves within the window.
+// Every run of a search ends once this fraction of the filled mass is out (by either criterion it has flowed then),
+// when its flow stops, or at the window's end.
 constexpr double kFlowingFraction = 0.5;
 
 std::pair<double, double> parse_bracket(const std::string& text) {
@@ -97,6 +99,8 @@ kc::CutoffSearch search_from(const CutoffCli& o) {
     kc::CutoffSearch search;
     std::tie(search.lo, search.hi) = parse_bracket(o.bracket);
     search.tol = o.tol;
+    for (const auto& [criterion, name] : kc::kFlowCriterionNames)
+        if (name == o.criterion) search.criterion = criterion;  // the option's check admits the names only
     search.seeds.assign(o.seeds.begin(), o.seeds.end());
     // a seed twice is one bed counted twice in the majority (and one run folder for two runs)
     for (std::size_t i = 0; i < o.seeds.size(); ++i)
@@ -144,6 +148,19 @@ void report_seed_brackets(const kc::CutoffResult& res, nlohmann::json& out) {
     if (!all_overlap)
         std::printf("note: the seeds' own brackets do not all meet the cut-off's: it is the majority's (at least half "
                     "of the seeds flowing), and the cut-off differs from bed to bed by more than the tolerance\n");
+}
+
+// The runs that were still discharging at the window's end, counted and named in a note: by the flow-stops criterion
+// they flow (their flow had not stopped), and a longer window would decide them.
+void report_window_end_runs(kc::FlowCriterion criterion, double window, nlohmann::json& out) {
+    long undecided = 0;
+    for (const auto& run : out.at("runs"))
+        undecided += run.at("end") == kernel::silo::discharge_end_name(kernel::silo::DischargeEnd::time_limit);
+    out["runs_at_window_end"] = undecided;
+    if (undecided > 0 && criterion == kc::FlowCriterion::flow_stops)
+        std::printf("note: %ld run(s) still discharging at the window's end (%g s) counted as flowing; a longer "
+                    "--window decides whether their flow stops\n",
+                    undecided, window);
 }
 
 // The search's result, printed and added to the JSON report; the exit status.
@@ -204,7 +221,7 @@ struct SearchStopped {};  // a signal or a suspended run stopped the campaign: t
 // flows. A run that failed ends the search (its log named).
 // `run`: its settings (silo_run_settings), whose vibration gives the peak acceleration.
 bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double frequency,
-                     const kernel::silo::SiloCaseSettings& run, nlohmann::json& runs) {
+                     const kernel::silo::SiloCaseSettings& run, kc::FlowCriterion criterion, nlohmann::json& runs) {
     const unsigned seed = static_cast<unsigned>(run.seed);
     const auto summary = silo_run_summary(dir, plan.name);
     if (!summary)
@@ -212,7 +229,11 @@ bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double freque
                                  (dir / "runs" / plan.name / "silo.log").string());
     const double filled = summary->number("filled_mass_kg");
     const double fraction = filled > 0 ? summary->number("discharge/discharged_mass_kg") / filled : 0;
-    const bool flows = fraction >= kFlowingFraction * (1 - 1e-12);
+    const std::string end_name = summary->text("discharge/end");
+    const auto end = kernel::silo::discharge_end_from_name(end_name);
+    if (!end || *end == kernel::silo::DischargeEnd::running || *end == kernel::silo::DischargeEnd::suspended)
+        summary->fail("discharge/end", "= '" + analytics::shortened_text(end_name, 40) + "': not how a finished run ends");
+    const bool flows = kc::flows(criterion, *end);
     const double peak_g = run.vibration.peak_acceleration() / run.gravity;
     const std::string stop_reason = summary->text("discharge/stop_reason");
     const double cpu = summary->number("cpu_s"), discharge_time = summary->number("discharge/time_s");
@@ -223,7 +244,8 @@ bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double freque
     runs.push_back({{"frequency_hz", frequency}, {"seed", seed}, {"run", plan.name}, {"peak_acceleration_g", peak_g},
                     {"discharged_fraction", fraction}, {"filled_mass_kg", filled},
                     {"bulk_density_kg_m3", summary->number("bulk_density_kg_m3")}, {"discharge_time_s", discharge_time},
-                    {"stop_reason", stop_reason}, {"flows", flows}, {"cpu_s", cpu}, {"wall_s", summary->number("wall_s")}});
+                    {"end", end_name}, {"stop_reason", stop_reason}, {"flows", flows}, {"cpu_s", cpu},
+                    {"wall_s", summary->number("wall_s")}});
     return flows;
 }
 
@@ -241,6 +263,7 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
         kc::validate(search);
         for (double f : {search.lo, search.hi})  // every frequency of the search lies in the bracket
             ks::validate(silo_run_settings(base, f, search.seeds.front(), o.base.amplitude, o.base.window));
+        kc::validate_window(o.base.window, search.criterion);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
@@ -255,10 +278,11 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     const std::string amount = base.fill_mass > 0 ? ks::setting_text(base.fill_mass) + " kg of grain"
                                                    : std::to_string(base.particles) + " grains";
     std::printf("cut-off search in the silo: %s, %s, stiffness scale %g; %s; A = %g m along x; bracket "
-                "[%g, %g] Hz to %g Hz, %zu seed(s); flows = half the mass out within %g s of the opening; runs in %s\n",
+                "[%g, %g] Hz to %g Hz, %zu seed(s); %s; window %g s; runs in %s\n",
                 base.geometry.describe().c_str(), amount.c_str(), base.materials.stiffness_scale,
                 ks::contact_law_name(base).c_str(), o.base.amplitude, search.lo, search.hi, search.tol,
-                search.seeds.size(), o.base.window, dir.string().c_str());
+                search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(), o.base.window,
+                dir.string().c_str());
     std::fflush(stdout);
     nlohmann::json runs = nlohmann::json::array();
     kc::CutoffResult res;
@@ -271,8 +295,9 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
             if (outcome.stopped) throw SearchStopped{};
             std::vector<bool> answers;
             for (std::size_t k = 0; k < seeds.size(); ++k)
-                answers.push_back(read_search_run(
-                    dir, plans[k], f, silo_run_settings(base, f, seeds[k], o.base.amplitude, o.base.window), runs));
+                answers.push_back(read_search_run(dir, plans[k], f,
+                                                  silo_run_settings(base, f, seeds[k], o.base.amplitude, o.base.window),
+                                                  search.criterion, runs));
             return answers;
         });
     } catch (const SearchStopped&) {
@@ -288,10 +313,11 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
                           {"direction", "x"},
                           {"window_s", o.base.window},
                           {"campaign", dir.string()},
-                          {"criterion", "flows: at least half of the filled mass out within window_s of the opening, "
-                                        "in at least half of the seeds (a run ends earlier once no grain has left "
-                                        "for 0.5 s of vibration: arched)"},
+                          {"criterion", kc::flow_criterion_name(search.criterion)},
+                          {"criterion_text", kc::flow_criterion_text(search.criterion) +
+                                                 "; a frequency flows when at least half of the seeds flow"},
                           {"runs", runs}};
+    report_window_end_runs(search.criterion, o.base.window, out);
     return conclude(res, std::move(out), o.json);
 }
 
@@ -305,29 +331,34 @@ int run(const CutoffCli& o, CLI::App& sub) {
     const kc::CutoffSearch search = search_from(o);
     nlohmann::json runs = nlohmann::json::array();
     auto report = [&](const kc::CohesiveHopperCase& c, const kc::CohesiveHopperOutcome& r) {
-        std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% out in %.2f s -> %s  [%.1f s]\n", c.frequency,
+        const bool flows = r.flows(search.criterion);
+        const std::string_view end = kernel::silo::discharge_end_name(r.end);
+        std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% out in %.2f s, %s -> %s  [%.1f s]\n", c.frequency,
                     r.peak_acceleration_g, c.seed, 100 * r.discharged_fraction, r.discharge_s,
-                    r.flows() ? "flows" : "arched", r.wall_s);
+                    std::string(end).c_str(), flows ? "flows" : "arched", r.wall_s);
         std::fflush(stdout);
         runs.push_back({{"frequency_hz", c.frequency}, {"seed", c.seed}, {"peak_acceleration_g", r.peak_acceleration_g},
-                        {"discharged_fraction", r.discharged_fraction}, {"flows", r.flows()}, {"wall_s", r.wall_s}});
+                        {"discharged_fraction", r.discharged_fraction}, {"discharge_time_s", r.discharge_s},
+                        {"end", end}, {"flows", flows}, {"wall_s", r.wall_s}});
     };
     kc::CutoffResult res;
     try {
         kc::validate(o.base, search);  // before the first run
         std::printf("cut-off search: Bo = %g, theta = %g deg, A = %g m, bracket [%g, %g] Hz to %g Hz, %zu seed(s); "
-                    "flows = half the mass out within %g s of the opening\n",
+                    "%s; window %g s\n",
                     o.base.bond_number, o.base.theta_deg, o.base.amplitude, search.lo, search.hi, search.tol,
-                    search.seeds.size(), o.base.window);
+                    search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(), o.base.window);
         res = kc::find_cutoff(o.base, search, report);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
     nlohmann::json out = {{"case", "small hopper"}, {"bond_number", o.base.bond_number}, {"theta_deg", o.base.theta_deg},
                           {"amplitude_m", o.base.amplitude}, {"grains", o.base.grains}, {"window_s", o.base.window},
-                          {"criterion", "flows: at least half of the mass out within window_s of the opening, "
-                                        "in at least half of the seeds"},
+                          {"criterion", kc::flow_criterion_name(search.criterion)},
+                          {"criterion_text", kc::flow_criterion_text(search.criterion) +
+                                                 "; a frequency flows when at least half of the seeds flow"},
                           {"runs", runs}};
+    report_window_end_runs(search.criterion, o.base.window, out);
     return conclude(res, std::move(out), o.json);
 }
 
@@ -353,8 +384,21 @@ void add_cutoff_command(CLI::App& app) {
         ->delimiter(',')
         ->check(integer_in(0, 4294967295LL));
     sub->add_option("--grains", o->base.grains, "number of grains")->check(integer_in(10, 20000))->capture_default_str();
-    sub->add_option("--window", o->base.window, "time after the opening for half the mass to leave [s]")
+    sub->add_option("--window", o->base.window,
+                    "longest time a run lasts after the opening [s] (it ends once half the mass is out or its flow "
+                    "stops); at least " +
+                        kernel::silo::setting_text(kc::shortest_window(kc::FlowCriterion::flow_stops)) +
+                        " s with --criterion flow-stops")
         ->check(number_in(0.05, 10))
+        ->capture_default_str();
+    std::vector<std::string> criteria;
+    for (const auto& named : kc::kFlowCriterionNames) criteria.emplace_back(named.second);
+    sub->add_option("--criterion", o->criterion,
+                    "what flows means: flow-stops (arched: the flow stopped, no grain out for " +
+                        kernel::silo::setting_text(kernel::silo::kFlowStallTime) +
+                        " s, before half the mass was out) or half-within-window (half the mass out within --window; "
+                        "the criterion before 2026-12-06, which depends on the window)")
+        ->check(CLI::IsMember(criteria))
         ->capture_default_str();
     sub->add_option("--json", o->json, "write the search and its runs to this JSON file");
     sub->add_option("--max-runs", o->max_runs, "most runs the search may make (a guard against typos)")

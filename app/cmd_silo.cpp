@@ -772,6 +772,7 @@ nlohmann::json summary_json(const ks::SiloCaseSettings& s, const ks::SiloCaseRes
                       {"grains_discharged", r.grains_discharged},
                       {"grains_left", r.grains_in_silo},
                       {"emptied", r.emptied},
+                      {"end", ks::discharge_end_name(r.end)},
                       {"stop_reason", r.stop_reason}};
     nlohmann::json fit{{"ok", r.fit.ok},
                        {"window", "discharged mass between " + fixed(100 * r.fit.lower_fraction, 0) + " % and " +

@@ -84,11 +84,27 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
   const double t_open = sim.time();
   const double mass = sim.total_mass();
   double out = 0;
-  while (sim.time() < c.settle + c.window && out < 0.5 * mass) {
-    sim.step(500);
-    out += sim.remove_bodies_if([](const BodyState& b) { return b.position.z() < -0.02; }).mass;
-  }
+  silo::FlowStallClock stall;  // the bin shakes from the opening: the stall counts from it
   CohesiveHopperOutcome o;
+  while (true) {
+    sim.step(500);
+    const RemovalResult gone = sim.remove_bodies_if([](const BodyState& b) { return b.position.z() < -0.02; });
+    out += gone.mass;
+    const double t = sim.time() - t_open;
+    if (gone.count) stall.grains_left_at(t);
+    if (out >= 0.5 * mass) {
+      o.end = silo::DischargeEnd::stop_fraction;
+      break;
+    }
+    if (stall.stopped_at(t)) {
+      o.end = silo::DischargeEnd::flow_stopped;
+      break;
+    }
+    if (t >= c.window) {
+      o.end = silo::DischargeEnd::time_limit;
+      break;
+    }
+  }
   o.discharged_fraction = out / mass;
   o.discharge_s = sim.time() - t_open;
   o.peak_acceleration_g = c.amplitude * std::pow(2 * M_PI * c.frequency, 2) / 9.81;
@@ -98,6 +114,7 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
 
 void validate(const CohesiveHopperCase& base, const CutoffSearch& s) {
   validate(s);
+  validate_window(base.window, s.criterion);
   CohesiveHopperCase c = base;
   for (double f : {s.lo, s.hi}) {  // every frequency of the search lies in the bracket: both ends checked
     c.frequency = f;
@@ -113,7 +130,7 @@ CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,
     c.seed = seed;
     const CohesiveHopperOutcome o = run_cohesive_hopper(c);
     if (report) report(c, o);
-    return o.flows();
+    return o.flows(s.criterion);
   });
 }
 

@@ -23,7 +23,8 @@ struct CohesiveHopperCase {
   int grains = 800;
   unsigned seed = 1;             ///< seed of the jitter of the initial lattice
   double settle = 0.4;           ///< time with the outlet closed [s]
-  double window = 1.0;           ///< time after the opening within which half the mass must leave to "flow" [s]
+  double window = 2.0;           ///< longest time after the opening a run lasts [s] (it ends earlier once half the
+                                 ///< mass is out or its flow stops: cutoff_search.hpp's FlowCriterion)
 };
 
 /// Throws std::invalid_argument naming the field and the value when a setting is out of range.
@@ -32,14 +33,17 @@ void validate(const CohesiveHopperCase& c);
 struct CohesiveHopperOutcome {
   double discharged_fraction = 0;  ///< of the mass, within the window (the run stops once half has left)
   double discharge_s = 0;          ///< simulated time from the opening to the run's end (the window, or earlier)
+  /// stop_fraction (half the mass out), flow_stopped (silo::kFlowStallTime without a grain) or time_limit (the window)
+  silo::DischargeEnd end = silo::DischargeEnd::running;
   double peak_acceleration_g = 0;  ///< A (2 pi f)^2 / g
   double wall_s = 0;
-  bool flows() const { return discharged_fraction >= 0.5; }  ///< the stated criterion: half the mass out in the window
+  bool flows(FlowCriterion c) const { return cases::flows(c, end); }
 };
 
 CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c);
 
-/// Throws std::invalid_argument naming the setting when the search or the case at either end of the bracket is invalid.
+/// Throws std::invalid_argument naming the setting when the search or the case at either end of the bracket is invalid,
+/// or the window is too short for the search's criterion to see an arch (shortest_window).
 void validate(const CohesiveHopperCase& c, const CutoffSearch& s);
 /// The lowest frequency at which this bed flows (cutoff_search.hpp), every seed at each frequency; `report` sees
 /// every run.

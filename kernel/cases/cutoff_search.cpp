@@ -10,6 +10,42 @@
 
 namespace demcal::kernel::cases {
 
+std::string_view flow_criterion_name(FlowCriterion c) {
+  for (const auto& [criterion, name] : kFlowCriterionNames)
+    if (criterion == c) return name;
+  return "?";
+}
+
+std::string flow_criterion_text(FlowCriterion c) {
+  return c == FlowCriterion::flow_stops
+             ? "arched: the flow stopped (no grain out for " + silo::setting_text(silo::kFlowStallTime) +
+                   " s of vibration) before half of the mass was out; flows otherwise (half the mass out, or still "
+                   "discharging at the window's end)"
+             : "flows: at least half of the mass out within window_s of the opening";
+}
+
+double shortest_window(FlowCriterion c) { return c == FlowCriterion::flow_stops ? 2 * silo::kFlowStallTime : 0.05; }
+
+void validate_window(double window, FlowCriterion c) {
+  if (!(window >= shortest_window(c)))
+    throw std::invalid_argument("window = " + silo::setting_text(window) + " s: shorter than " +
+                                silo::setting_text(shortest_window(c)) + " s, in which the criterion " +
+                                std::string(flow_criterion_name(c)) + " can see an arch");
+}
+
+bool flows(FlowCriterion c, silo::DischargeEnd end) {
+  using silo::DischargeEnd;
+  switch (end) {
+    case DischargeEnd::emptied:
+    case DischargeEnd::stop_fraction: return true;
+    case DischargeEnd::flow_stopped: return false;
+    case DischargeEnd::time_limit: return c == FlowCriterion::flow_stops;
+    case DischargeEnd::running:
+    case DischargeEnd::suspended: break;
+  }
+  throw std::logic_error("flows: a run that has not ended (" + std::string(silo::discharge_end_name(end)) + ")");
+}
+
 void validate(const CutoffSearch& s) {
   if (!(s.lo >= 0 && s.lo < s.hi && s.hi <= 1000))
     throw std::invalid_argument("bracket = [" + silo::setting_text(s.lo) + ", " + silo::setting_text(s.hi) +

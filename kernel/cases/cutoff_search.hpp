@@ -4,13 +4,45 @@
 #pragma once
 #include <functional>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
+#include "kernel/silo/discharge_end.hpp"
+
 namespace demcal::kernel::cases {
+
+/// What "the bed flows" means for one run, fixed before any run. Every run ends once half the mass is out, when its
+/// flow stops (no grain out for silo::kFlowStallTime) or at the window's end.
+enum class FlowCriterion {
+  /// The seed's 3.6: an arch is a flow that stopped. Arched: the flow stopped before half the mass was out; flows
+  /// otherwise, a run still discharging at the window's end included (its flow had not stopped; the search counts
+  /// such runs: a longer window decides them). Does not depend on the window once no run reaches its end.
+  flow_stops,
+  /// Flows: half the mass out within the window (the criterion until 2026-12-06). A rate: a broken arch that drains
+  /// slowly counts as arched, and the cut-off depends on the window.
+  half_within_window,
+};
+
+inline constexpr std::pair<FlowCriterion, std::string_view> kFlowCriterionNames[] = {
+    {FlowCriterion::flow_stops, "flow-stops"}, {FlowCriterion::half_within_window, "half-within-window"}};
+std::string_view flow_criterion_name(FlowCriterion c);
+/// The criterion in words, for reports.
+std::string flow_criterion_text(FlowCriterion c);
+/// The shortest window in which the criterion can see an arch [s]: a flow-stops run needs kFlowStallTime without a
+/// grain after the opening's first grains; twice that leaves the bed as long again to arch.
+double shortest_window(FlowCriterion c);
+/// Throws std::invalid_argument naming the window when it is shorter than shortest_window(c).
+void validate_window(double window, FlowCriterion c);
+
+/// Whether a run that ended so flows by the criterion; a run that has not ended (running, suspended) is a caller's
+/// error (std::logic_error).
+bool flows(FlowCriterion c, silo::DischargeEnd end);
 
 struct CutoffSearch {
   double lo = 0, hi = 400, tol = 25;  ///< the bracket and the final width [Hz]
   std::vector<unsigned> seeds{1};     ///< repeats: each frequency runs once per seed
+  FlowCriterion criterion = FlowCriterion::flow_stops;
 };
 
 /// One run of the search: a frequency, a seed and its answer.

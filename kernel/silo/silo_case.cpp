@@ -934,7 +934,6 @@ private:
     // False: stopped at the session's wall limit.
     bool discharge() {
         const long frame_every = std::max(1L, std::lround(s_.frame_interval / r_.time_step));
-        const double stall_time = 0.5;  // no grain discharged for this long with grains left: the flow has stopped
         // a bin still to be shaken has not had its chance: the stall counts from the vibration's start at the earliest
         // (a bed arched over a closed-looking outlet stopped at 0.5 s before a vibration set to start at 0.6 s)
         const double quiet_from = s_.vibration.vibrates() ? s_.vibration.start_after_opening : 0.0;
@@ -971,19 +970,23 @@ private:
             }
             if (sim_.num_bodies() == 0) {
                 r_.emptied = true;
+                r_.end = DischargeEnd::emptied;
                 r_.stop_reason = "empty";
                 break;
             }
             if (mass_out_ >= s_.stop_fraction * r_.filled_mass * (1 - 1e-12)) {
+                r_.end = DischargeEnd::stop_fraction;
                 r_.stop_reason = "stop fraction " + setting_text(s_.stop_fraction) + " of the filled mass discharged";
                 break;
             }
-            if (t - std::max(last_out_time_, quiet_from) > stall_time) {
-                r_.stop_reason = "flow stopped: no grain left for " + setting_text(stall_time) + " s, " +
+            if (FlowStallClock{quiet_from, last_out_time_}.stopped_at(t)) {
+                r_.end = DischargeEnd::flow_stopped;
+                r_.stop_reason = "flow stopped: no grain left for " + setting_text(kFlowStallTime) + " s, " +
                                  std::to_string(sim_.num_bodies()) + " grains remain";
                 break;
             }
             if (t >= s_.max_time) {
+                r_.end = DischargeEnd::time_limit;
                 r_.stop_reason = "time limit " + setting_text(s_.max_time) + " s";
                 break;
             }
@@ -1004,6 +1007,7 @@ private:
                                      ", is the one to resume from)");
         }
         r_.suspended = true;
+        r_.end = DischargeEnd::suspended;
         r_.stop_reason = suspend_reason_;
         record_state();
         report("suspended", r_.stop_reason);

@@ -3,6 +3,7 @@
 // discharged mass against time, the rate from its steady part, the flow pattern and the mid-plane velocity section.
 #pragma once
 #include "kernel/silo/bin_vibration.hpp"
+#include "kernel/silo/discharge_end.hpp"
 #include "kernel/silo/discharge_fit.hpp"
 #include "kernel/silo/flow_pattern.hpp"
 #include "kernel/silo/outlet_flow.hpp"
@@ -205,6 +206,7 @@ struct SiloCaseResult {
     long grains_discharged = 0;
     long grains_in_silo = 0;           // at the end
     bool emptied = false;
+    DischargeEnd end = DischargeEnd::running;  // how the discharge ended (stop_reason: the same in words)
     std::string stop_reason;
     std::vector<DischargeRow> discharge;  // time since the opening, mass, grains
     DischargeFit fit;

@@ -18,19 +18,32 @@ namespace fs = std::filesystem;
 
 TEST_CASE("cohesive hopper: a cohesionless bed flows, a cohesive one arches, strong vibration breaks the arch",
           "[kernel][cohesion][vibration]") {
+  using demcal::kernel::silo::DischargeEnd;
   CohesiveHopperCase c;
   c.grains = 400;
-  c.window = 0.5;
+  c.window = 1;
   c.amplitude = 1e-4;
   c.bond_number = 0;
   const CohesiveHopperOutcome free = run_cohesive_hopper(c);
-  CHECK(free.flows());
+  CHECK(free.end == DischargeEnd::stop_fraction);  // half the mass out: the run ends there
+  CHECK(free.discharged_fraction >= 0.5);
+  CHECK(free.flows(FlowCriterion::flow_stops));
+  CHECK(free.flows(FlowCriterion::half_within_window));
   c.bond_number = 10;
   const CohesiveHopperOutcome arched = run_cohesive_hopper(c);
+  INFO("arched: " << arched.discharged_fraction << " out in " << arched.discharge_s << " s");
   CHECK(arched.discharged_fraction < 0.05);
+  // its flow stopped: no grain for the stall time, ended well before the window (its last grain within the stall
+  // time of the opening plus the check interval of 500 steps)
+  CHECK(arched.end == DischargeEnd::flow_stopped);
+  CHECK(arched.discharge_s < c.window);
+  CHECK(arched.discharge_s > demcal::kernel::silo::kFlowStallTime);
+  CHECK_FALSE(arched.flows(FlowCriterion::flow_stops));
   c.frequency = 400;  // 64 g at 0.1 mm
   const CohesiveHopperOutcome shaken = run_cohesive_hopper(c);
   CHECK(shaken.discharged_fraction > 5 * arched.discharged_fraction + 0.05);
+  CHECK(shaken.end != DischargeEnd::flow_stopped);
+  CHECK(shaken.flows(FlowCriterion::flow_stops));
   CHECK(shaken.peak_acceleration_g == Approx(1e-4 * std::pow(2 * M_PI * 400, 2) / 9.81));
 }
 
@@ -56,6 +69,12 @@ TEST_CASE("cohesive hopper: bad settings and searches name the field and the val
   s = {};
   s.seeds.clear();
   CHECK_THROWS_WITH(validate(c, s), Catch::Matchers::Contains("seeds"));
+  // a window in which no stall can be seen would call every arch flowing
+  s = {};
+  c.window = 0.6;
+  CHECK_THROWS_WITH(validate(c, s), Catch::Matchers::Contains("window = 0.6 s: shorter than 1 s"));
+  s.criterion = FlowCriterion::half_within_window;
+  CHECK_NOTHROW(validate(c, s));
 }
 
 TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or file", "[kernel][cohesion][cli]") {
@@ -66,6 +85,8 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
       {"--bracket 400,0", "bracket"},     {"--bracket 0,x", "--bracket"}, {"--tol 1000", "tol"},
       {"--bond-number nan", "--bond-number"}, {"--seeds -1", "--seeds"},   {"--amplitude 1", "--amplitude"},
       {"--json " + dir.string(), "--json"},
+      {"--window 0.5", "window = 0.5 s: shorter than 1 s"},  {"--criterion half", "--criterion"},
+      {"--window 0.5 -- --theta 30", "window = 0.5 s"},
       // the silo case (options after --): its own options stay with demcal silo, the search's with cutoff
       {"--bond-number 5 -- --theta 30", "--bond-number applies to the small hopper"},
       {"-- --theta 30 --seed 3", "silo option --seed after --: demcal cutoff sets it"},

@@ -100,3 +100,43 @@ TEST_CASE("cut-off search: each seed's own bracket from the runs, and whether it
     CHECK(overlaps(never[0], 25, 60));
     CHECK_FALSE(overlaps(never[0], 10, 40));
 }
+
+TEST_CASE("cut-off criteria: how a run ended decides whether it flows, the same in both names",
+          "[kernel][cohesion][cutoff]") {
+    using demcal::kernel::silo::DischargeEnd;
+    for (FlowCriterion c : {FlowCriterion::flow_stops, FlowCriterion::half_within_window}) {
+        INFO(flow_criterion_name(c));
+        CHECK(flows(c, DischargeEnd::stop_fraction));
+        CHECK(flows(c, DischargeEnd::emptied));
+        CHECK_FALSE(flows(c, DischargeEnd::flow_stopped));
+        CHECK_THROWS_AS(flows(c, DischargeEnd::running), std::logic_error);
+        CHECK_THROWS_AS(flows(c, DischargeEnd::suspended), std::logic_error);
+    }
+    // still discharging at the window's end: its flow had not stopped, but half the mass was not out
+    CHECK(flows(FlowCriterion::flow_stops, DischargeEnd::time_limit));
+    CHECK_FALSE(flows(FlowCriterion::half_within_window, DischargeEnd::time_limit));
+    // the names a user types and reports show are the enum's, both ways
+    for (const auto& [end, name] : demcal::kernel::silo::kDischargeEndNames)
+        CHECK(demcal::kernel::silo::discharge_end_from_name(name) == end);
+    CHECK_FALSE(demcal::kernel::silo::discharge_end_from_name("flow stopped"));
+    CHECK(flow_criterion_name(FlowCriterion::flow_stops) == "flow-stops");
+    // a window shorter than twice the stall time cannot see an arch by flow-stops
+    CHECK_THROWS_WITH(validate_window(0.99, FlowCriterion::flow_stops), Catch::Matchers::Contains("window = 0.99 s"));
+    CHECK_NOTHROW(validate_window(1, FlowCriterion::flow_stops));
+    CHECK_NOTHROW(validate_window(0.3, FlowCriterion::half_within_window));
+}
+
+TEST_CASE("flow stall clock: the stall counts from the last grain out, not before the vibration starts",
+          "[kernel][cohesion][cutoff]") {
+    using demcal::kernel::silo::FlowStallClock;
+    using demcal::kernel::silo::kFlowStallTime;
+    FlowStallClock still;
+    CHECK_FALSE(still.stopped_at(kFlowStallTime));  // exactly the stall time: not yet
+    CHECK(still.stopped_at(kFlowStallTime + 1e-9));
+    still.grains_left_at(0.25);  // binary fractions: the sums below are exact
+    CHECK_FALSE(still.stopped_at(0.25 + kFlowStallTime));
+    CHECK(still.stopped_at(0.26 + kFlowStallTime));
+    FlowStallClock late{.quiet_from = 0.6};  // a vibration from 0.6 s: a bed that let nothing out is not stopped at 0.5 s
+    CHECK_FALSE(late.stopped_at(1.0));
+    CHECK(late.stopped_at(1.11));
+}

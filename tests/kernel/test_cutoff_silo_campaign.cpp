@@ -38,6 +38,9 @@ TEST_CASE("demcal cutoff in the silo: runs kept in a campaign, the same command 
     REQUIRE(first["runs"].size() == 2);
     CHECK(first["runs"][0]["run"] == "f0_seed1");
     CHECK(first["runs"][0]["discharged_fraction"].get<double>() >= 0.5);
+    CHECK(first["runs"][0]["end"] == "stop_fraction");  // read from the run's summary as a state
+    CHECK(first["criterion"] == "flow-stops");
+    CHECK(first["runs_at_window_end"] == 0);
     CHECK(first["seeds"].size() == 2);
     CHECK(first["campaign"] == (dir / "c").string());
 

@@ -37,12 +37,14 @@ TEST_CASE("silo case: a cohesive material arches over the outlet its cohesionles
     const SiloCaseResult dry = run_silo_case(tiny_case(0));
     CHECK(dry.contact_law.find("JKR") == std::string::npos);
     CHECK(fraction_out(dry) >= 0.5);  // half out within 0.4 s: the stop fraction ended it
+    CHECK(dry.end == DischargeEnd::stop_fraction);
 
     // gamma = 0.5 J/m^2: pull-off 3 pi gamma R* ~ 3e-3 N between two end spheres (R* = 0.625 mm), 9 grain weights
     const SiloCaseResult wet = run_silo_case(tiny_case(0.5));
     CHECK(wet.contact_law.find("JKR") != std::string::npos);
     INFO("cohesive: " << fraction_out(wet) << " out, " << wet.stop_reason);
     CHECK(fraction_out(wet) < 0.1);
+    CHECK(wet.end == DischargeEnd::time_limit);  // 0.4 s: shorter than the stall time
 
     // the same arch shaken hard (the whole bin, 1 mm along x at 100 Hz: 40 g) from the opening
     SiloCaseSettings shaken = tiny_case(0.5);
