@@ -19,7 +19,7 @@ std::string_view flow_criterion_name(FlowCriterion c) {
 std::string flow_criterion_text(FlowCriterion c) {
   return c == FlowCriterion::flow_stops
              ? "arched: the flow stopped (no grain out for " + silo::setting_text(silo::kFlowStallTime) +
-                   " s of vibration) before half of the mass was out; flows otherwise (half the mass out, or still "
+                   " s) before half of the mass was out; flows otherwise (half the mass out, or still "
                    "discharging at the window's end)"
              : "flows: at least half of the mass out within window_s of the opening";
 }
