@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "kernel/silo/discharge_end.hpp"
 #include "orchestrator/folder_lock.hpp"
 #include <nlohmann/json.hpp>
 
@@ -259,6 +260,11 @@ TEST_CASE("demcal silo: a bed arched before a late vibration starts is not stopp
     INFO(discharge.dump());
     CHECK(discharge.at("time_s").get<double>() > 0.6);  // ran into the vibration
     CHECK(discharge.at("discharged_mass_kg").get<double>() > 0);
+    // how it ended, as a state a search reads (not the stop reason's words)
+    const auto end = demcal::kernel::silo::discharge_end_from_name(discharge.at("end").get<std::string>());
+    REQUIRE(end);
+    CHECK((*end == demcal::kernel::silo::DischargeEnd::time_limit || *end == demcal::kernel::silo::DischargeEnd::emptied ||
+           *end == demcal::kernel::silo::DischargeEnd::flow_stopped));
     fs::remove_all(dir);
 }
 
