@@ -178,8 +178,8 @@ int conclude(const kc::CutoffResult& res, nlohmann::json out, const std::string&
     return res.found ? 0 : 1;
 }
 
-// One silo run of the search: the base settings with this seed and frequency, stopped once half the mass is out or
-// at the window's end.
+// One silo run of the search: the base settings with this seed and frequency, stopped once half the mass is out, when
+// its flow stops (the silo's stall rule) or at the window's end.
 kernel::silo::SiloCaseSettings silo_run_settings(kernel::silo::SiloCaseSettings s, double frequency, unsigned seed,
                                                  double amplitude, double window) {
     s.seed = seed;
