@@ -731,7 +731,7 @@ std::string cpu_text(const ks::SiloCaseResult& r) {
     std::string t = duration_text(r.cpu_s) + " CPU";
     if (r.cpu_sessions < r.sessions)
         t += " (the last " + std::to_string(r.cpu_sessions) + " of " + std::to_string(r.sessions) + " sessions)";
-    if (!r.suspended && std::isfinite(r.fill_cpu_s)) t += ", of which the discharge " + duration_text(r.cpu_s - r.fill_cpu_s);
+    if (!r.suspended() && std::isfinite(r.fill_cpu_s)) t += ", of which the discharge " + duration_text(r.cpu_s - r.fill_cpu_s);
     return t;
 }
 
@@ -771,7 +771,7 @@ nlohmann::json summary_json(const ks::SiloCaseSettings& s, const ks::SiloCaseRes
                       {"discharged_mass_kg", r.discharge.empty() ? 0.0 : r.discharge.back().mass},
                       {"grains_discharged", r.grains_discharged},
                       {"grains_left", r.grains_in_silo},
-                      {"emptied", r.emptied},
+                      {"emptied", r.emptied()},
                       {"end", ks::discharge_end_name(r.end)},
                       {"stop_reason", r.stop_reason}};
     nlohmann::json fit{{"ok", r.fit.ok},
@@ -895,7 +895,7 @@ void print_summary(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
 }
 
 void write_outputs(const fs::path& dir, const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r, bool no_plots) {
-    if (r.suspended) report_suspension(dir, s, r);  // nothing final to write: the checkpoint holds the run
+    if (r.suspended()) report_suspension(dir, s, r);  // nothing final to write: the checkpoint holds the run
     write_results(dir, s, r, summary_json(s, r));
     if (!no_plots) write_plots(dir, s, r);  // after the results: a plot that fails loses no data
     print_summary(dir, s, r, no_plots);

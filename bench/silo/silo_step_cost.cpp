@@ -56,7 +56,7 @@ int run(int argc, char** argv) {
     });
     const double s = std::chrono::duration<double>(t1 - t0).count();
     const long steps = step1 - step0;
-    if (!r.suspended || steps <= 0) {
+    if (!r.suspended() || steps <= 0) {
         std::cerr << "silo_step_cost: the run did not stop at the wall limit (" << r.stop_reason << ")\n";
         return 1;
     }

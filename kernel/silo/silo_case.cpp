@@ -969,7 +969,6 @@ private:
                 next_progress_ += progress_every();
             }
             if (sim_.num_bodies() == 0) {
-                r_.emptied = true;
                 r_.end = DischargeEnd::emptied;
                 r_.stop_reason = "empty";
                 break;
@@ -1006,7 +1005,6 @@ private:
                                      " (the previous checkpoint, " + std::to_string(r_.checkpoints - 1) +
                                      ", is the one to resume from)");
         }
-        r_.suspended = true;
         r_.end = DischargeEnd::suspended;
         r_.stop_reason = suspend_reason_;
         record_state();

@@ -205,8 +205,8 @@ struct SiloCaseResult {
     double discharge_time = 0;         // simulated time since the opening at the end [s]
     long grains_discharged = 0;
     long grains_in_silo = 0;           // at the end
-    bool emptied = false;
     DischargeEnd end = DischargeEnd::running;  // how the discharge ended (stop_reason: the same in words)
+    bool emptied() const { return end == DischargeEnd::emptied; }
     std::string stop_reason;
     std::vector<DischargeRow> discharge;  // time since the opening, mass, grains
     DischargeFit fit;
@@ -224,8 +224,8 @@ struct SiloCaseResult {
     // checkpoint older than format 12): cpu_s - fill_cpu_s is the discharge's, the work a code that starts from the
     // filled bed (YADE importing it) does.
     double fill_cpu_s = 0;
-    bool suspended = false;  // stopped at SiloCaseSettings::wall_limit or stop_request (stop_reason says which):
-                             // resume it from its checkpoint
+    // stopped at SiloCaseSettings::wall_limit or stop_request (stop_reason says which): resume it from its checkpoint
+    bool suspended() const { return end == DischargeEnd::suspended; }
     std::string contact_law;             // the law the run was on (contact_law_name)
     long checkpoints = 0;                // written over the whole run
     long vtk_files = 0;

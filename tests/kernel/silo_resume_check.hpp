@@ -78,7 +78,7 @@ inline kernel::silo::SiloCaseSettings check_resumes_bit_for_bit(kernel::silo::Si
         {.threads = 2, .checkpoint_interval = 0, .wall_limit = 0,
          .stop_request = [&] { return past && ++asked_after == 7 ? std::string("test stop") : std::string(); }},
         [&](const SiloProgress& p) { past = past || p.discharge_time > second_kill_after; });
-    CHECK(second.suspended);
+    CHECK(second.suspended());
     CHECK(second.stop_reason == "test stop");
     CHECK(second.steps % std::lround(s.record_interval / whole.time_step) != 0);
     const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}});

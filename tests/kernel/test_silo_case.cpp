@@ -93,7 +93,7 @@ TEST_CASE("reduced silo case, 10 deg hopper: mass flow, linear discharge", "[sil
     check_common(s, r);
     INFO("wall/axis velocity ratio " << r.flow.ratio);
     CHECK(r.flow.pattern == FlowPattern::mass);
-    CHECK(r.emptied);
+    CHECK(r.emptied());
 }
 
 TEST_CASE("reduced silo case, 70 deg hopper: funnel flow, linear discharge", "[silo][slow]") {
@@ -208,7 +208,7 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
     const SiloCaseResult suspended =
         resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 1e6, .wall_limit = 1e-6, .stop_request = {}},
                          [&](const SiloProgress& p) { steps_reported = p.step; });
-    CHECK(suspended.suspended);
+    CHECK(suspended.suspended());
     CHECK(suspended.steps == steps_reported);
     CHECK(suspended.steps < whole.steps);
     CHECK_THAT(suspended.stop_reason, Catch::Matchers::Contains("wall limit"));
@@ -222,7 +222,7 @@ TEST_CASE("silo case: a run killed at a checkpoint and resumed gives the uninter
     }
     // fourth session: to the end
     const SiloCaseResult resumed = resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 0, .wall_limit = 0, .stop_request = {}});
-    CHECK_FALSE(resumed.suspended);
+    CHECK_FALSE(resumed.suspended());
     CHECK(resumed.sessions == 4);
     CHECK(resumed.cpu_sessions == 4);
     CHECK(resumed.cpu_s > 0);
@@ -276,7 +276,7 @@ TEST_CASE("silo case: a stop within a record interval ends the session after its
     long asked = 0;
     s.stop_request = [&asked] { return ++asked == 1000 ? std::string("test stop") : std::string(); };
     const SiloCaseResult first = run_silo_case(s);
-    CHECK(first.suspended);
+    CHECK(first.suspended());
     CHECK(first.stop_reason == "test stop");
     CHECK(first.steps % interval_steps != 0);  // within an interval
     CHECK(first.steps < whole.fill_steps);
@@ -288,14 +288,14 @@ TEST_CASE("silo case: a stop within a record interval ends the session after its
         {.threads = 2, .checkpoint_interval = 1e6, .wall_limit = 0,
          .stop_request = [&] { return discharging && ++asked_in_discharge == 7 ? std::string("stop 2") : std::string(); }},
         [&](const SiloProgress& p) { discharging = discharging || p.phase == "filled"; });
-    CHECK(second.suspended);
+    CHECK(second.suspended());
     CHECK(second.stop_reason == "stop 2");
     CHECK(second.steps > whole.fill_steps);
     CHECK(second.steps % interval_steps != 0);
     // third session: to the end, the uninterrupted run's result to the last bit
     const SiloCaseResult resumed =
         resume_silo_case(s.checkpoint_file, {.threads = 1, .checkpoint_interval = 1e6, .wall_limit = 0, .stop_request = {}});
-    CHECK_FALSE(resumed.suspended);
+    CHECK_FALSE(resumed.suspended());
     CHECK(resumed.sessions == 3);
     CHECK(resumed.steps == whole.steps);
     CHECK(resumed.fill_steps == whole.fill_steps);
