@@ -97,12 +97,14 @@ void refuse_empty_values(CLI::App& app) {
     any_integer.description("");
     for (CLI::Option* opt : app.get_options()) {
         if (opt->get_type_size_max() <= 0) continue;  // a flag takes no value
-        opt->check(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); }, ""));
         const std::string type = opt->get_type_name();
         // (a type name carries the descriptions of the option's own checks after a ':': "FLOAT:between 0 and 90")
         if (type == "FLOAT" || type.rfind("FLOAT:", 0) == 0) opt->transform(any_number);  // a transform: -0 becomes 0
         else if (type == "INT" || type == "UINT") opt->check(any_integer);
         if (opt->check_lname("partition")) opt->check(slurm_partition);  // every command's SLURM partition
+        // First of all the option's checks (a transform goes before the others): the option's own check named an
+        // empty value by its rule ("--criterion:  not in {...}") instead of as empty.
+        opt->transform(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); }, ""));
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
 }

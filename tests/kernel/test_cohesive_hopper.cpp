@@ -86,6 +86,8 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
       {"--bond-number nan", "--bond-number"}, {"--seeds -1", "--seeds"},   {"--amplitude 1", "--amplitude"},
       {"--json " + dir.string(), "--json"},
       {"--window 0.5", "window = 0.5 s: shorter than 1 s"},  {"--criterion half", "--criterion"},
+      // an empty value is named as one, before the option's list of names ("--criterion:  not in {...}")
+      {"--criterion ''", "--criterion: an empty value"},
       {"--window 0.5 -- --theta 30", "window = 0.5 s"},
       // the silo case (options after --): its own options stay with demcal silo, the search's with cutoff
       {"--bond-number 5 -- --theta 30", "--bond-number applies to the small hopper"},
