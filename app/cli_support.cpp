@@ -202,6 +202,11 @@ CLI::Validator number_in(double lo, double hi) {
                         [lo, hi](double v) { return v >= lo && v <= hi; });
 }
 
+CLI::Validator run_timeout() {
+    return number_check("a positive number of seconds up to " + analytics::number_text(kMaxRunTimeout),
+                        [](double v) { return v > 0 && v <= kMaxRunTimeout; });
+}
+
 CLI::Validator positive_number() {
     return number_check("a positive number", [](double v) { return v > 0; });
 }

@@ -20,6 +20,12 @@ CLI::Validator positive_number();                // x > 0
 CLI::Validator non_negative_number();            // x >= 0
 CLI::Validator integer_in(long long lo, long long hi);  // a whole integer, lo <= x <= hi (never clamped)
 
+// A per-run wall-clock limit (--timeout) [s]: positive and at most kMaxRunTimeout (about 4 months): 1e99 passed, and
+// SLURM's --time, the longest limit in minutes as a long, overflowed. (A short one is allowed: its runs end as
+// timeouts, which a resume with a longer --timeout runs again.)
+inline constexpr double kMaxRunTimeout = 1e7;
+CLI::Validator run_timeout();  // 0 < x <= kMaxRunTimeout
+
 // Adds to every option of `app` and its subcommands that takes a value a check refusing an empty one (CLI11 read
 // `--replicates ""` as 0), to every number option the number rule (analytics::number_defect) and to every integer
 // option the integer rule (integer_in, never clamped). Call once every command is registered.

@@ -379,7 +379,7 @@ void add_crosscheck_silo_subcommand(CLI::App& crosscheck) {
     silo->add_option("--max-time", o->max_time, "discharge time limit [s]")->check(positive_number())->capture_default_str();
     silo->add_option("--campaign,-c", o->dir, "output directory (runs reused from it)")->capture_default_str();
     silo->add_option("--jobs,-j", o->jobs, "runs in parallel (0 = one per core)")->check(non_negative_number());
-    silo->add_option("--timeout", o->timeout_s, "per-run wall-clock limit [s]")->check(positive_number());
+    silo->add_option("--timeout", o->timeout_s, "per-run wall-clock limit [s]")->check(run_timeout());
     silo->add_option("--executor", o->executor, "local (processes of this machine) or slurm (job arrays)")
         ->check(CLI::IsMember({"local", "slurm"}))
         ->capture_default_str();
