@@ -419,8 +419,8 @@ void add_cutoff_command(CLI::App& app) {
                     "after --: search in the silo case instead, with these demcal silo options (a cohesive --material, "
                     "--theta, --geometry, --particles, --stiffness-scale, ...)");
     sub->footer("Silo (the measured search of examples/cohesive_arch/README.md): demcal cutoff --amplitude 1.1e-4 "
-                "--bracket 0,400 --tol 25 --seeds 1,2 -- --material examples/materials/silo_meal.json --theta 30 "
-                "--particles 2000 --stiffness-scale 0.01 --fill-time 0.5");
+                "--bracket 0,400 --tol 25 --seeds 1,2,3 --jobs 2 -- --material examples/materials/silo_meal_g04.json "
+                "--theta 30 --particles 2000 --stiffness-scale 0.01 --fill-time 0.5");
     sub->callback([o, sub] {
         const int status = run(*o, *sub);
         if (status != 0) throw CLI::RuntimeError(status);
