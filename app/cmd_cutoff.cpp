@@ -389,7 +389,7 @@ void add_cutoff_command(CLI::App& app) {
                     "stops); at least " +
                         kernel::silo::setting_text(kc::shortest_window(kc::FlowCriterion::flow_stops)) +
                         " s with --criterion flow-stops")
-        ->check(number_in(0.05, 10))
+        ->check(number_in(kc::kWindowMin, kc::kWindowMax))
         ->capture_default_str();
     std::vector<std::string> criteria;
     for (const auto& named : kc::kFlowCriterionNames) criteria.emplace_back(named.second);

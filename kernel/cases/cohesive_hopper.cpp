@@ -19,7 +19,7 @@ constexpr double kGrainDensity = 1000, kGrainPoisson = 0.3, kTimestepFraction = 
 
 Material grain_material(const CohesiveHopperCase& c) { return {c.young, kGrainPoisson, kGrainDensity, "meal"}; }
 
-void check(bool ok, const char* field, double value, const char* rule) {
+void check(bool ok, const char* field, double value, const std::string& rule) {
   if (!ok || (value != 0 && std::abs(value) < 1e-300))
     throw std::invalid_argument(std::string(field) + " = " + silo::setting_text(value) + ": " + rule);
 }
@@ -31,7 +31,8 @@ void validate(const CohesiveHopperCase& c) {
   check(c.amplitude >= 0 && c.amplitude <= 0.01, "amplitude", c.amplitude, "must be in [0, 0.01] m");
   check(c.theta_deg >= 5 && c.theta_deg <= 80, "theta", c.theta_deg, "must be in [5, 80] deg");
   check(c.grains >= 10 && c.grains <= 20000, "grains", c.grains, "must be in [10, 20000]");
-  check(c.window >= 0.05 && c.window <= 10, "window", c.window, "must be in [0.05, 10] s");
+  check(c.window >= kWindowMin && c.window <= kWindowMax, "window", c.window,
+        "must be in [" + silo::setting_text(kWindowMin) + ", " + silo::setting_text(kWindowMax) + "] s");
   if (c.frequency > 0) {
     // at least 20 steps per period (the time step of the smallest grain, 0.9 r; about 1.7e-5 s by default)
     const Material m = grain_material(c);

@@ -28,6 +28,11 @@ struct CohesiveHopperCase {
                                  ///< (examples/cohesive_arch): slow runs took 2.7-4.4 s to reach half or to stop
 };
 
+/// The bounds of CohesiveHopperCase::window (and of a silo search's window) [s]: a guard against typos. Up to a minute:
+/// near the cut-off a broken arch drains slowly (the meal's silo at 40 deg and 50 Hz let out a third in 5 s, and a
+/// run still discharging at the window's end is decided only by a longer window).
+inline constexpr double kWindowMin = 0.05, kWindowMax = 60;
+
 /// Throws std::invalid_argument naming the field and the value when a setting is out of range.
 void validate(const CohesiveHopperCase& c);
 

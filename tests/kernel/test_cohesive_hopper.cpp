@@ -75,6 +75,12 @@ TEST_CASE("cohesive hopper: bad settings and searches name the field and the val
   CHECK_THROWS_WITH(validate(c, s), Catch::Matchers::Contains("window = 0.6 s: shorter than 1 s"));
   s.criterion = FlowCriterion::half_within_window;
   CHECK_NOTHROW(validate(c, s));
+  // up to a minute (a broken arch near the cut-off drains slowly), not beyond
+  s = {};
+  c.window = 60;
+  CHECK_NOTHROW(validate(c, s));
+  c.window = 61;
+  CHECK_THROWS_WITH(validate(c, s), Catch::Matchers::Contains("window = 61: must be in [0.05, 60] s"));
 }
 
 TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or file", "[kernel][cohesion][cli]") {
