@@ -135,6 +135,7 @@ run_case shear-kernel/material-subnormal 2 "density"    -- shear "$work/subnorma
 run_case shear-kernel/campaign-readonly 2 "campaign" "$ro" -- shear "$tiny" --engine kernel -s 5e3,1e4,2e4 --campaign "$ro/camp"
 run_case shear-kernel/campaign-file  2 "campaign"       -- shear "$tiny" --engine kernel -s 5e3,1e4,2e4 --campaign "$tiny"
 run_case shear-kernel/timeout-subnormal 2 "--timeout"   -- "${K[@]}" -s 5e3,1e4 --timeout 1e-320
+run_case shear-kernel/timeout-huge   2 "--timeout"      -- "${K[@]}" -s 5e3,1e4 --timeout 1e99
 run_case shear-kernel/retries-huge   2 "--retries"      -- "${K[@]}" -s 5e3,1e4 --retries 1e9
 run_case shear-kernel/retries-many   2 "--retries"      -- "${K[@]}" -s 5e3,1e4 --retries 1000000000
 run_case shear-kernel/jobs-huge      2 "--jobs"         -- "${K[@]}" -s 5e3,1e4 --jobs 1e9
@@ -224,6 +225,8 @@ run_case cutoff/seeds-many           2 "seeds"           -- cutoff --bond-number
 run_case cutoff/seeds-negative       2 "--seeds"         -- cutoff --bond-number 10 --seeds -1
 run_case cutoff/grains-huge          2 "--grains"        -- cutoff --bond-number 10 --grains 2000000000
 run_case cutoff/window-nan           2 "--window"        -- cutoff --bond-number 10 --window nan
+run_case cutoff/window-long          2 "--window"        -- cutoff --bond-number 10 --window 61
+run_case cutoff/criterion-empty      2 "--criterion: an empty value" -- cutoff --bond-number 10 --criterion ""
 run_case cutoff/json-folder          2 "--json"          -- cutoff --bond-number 10 --json "$work/folder.json"
 run_case cutoff/json-readonly        2 "--json"  "$ro"   -- cutoff --bond-number 10 --json "$ro/c.json"
 run_case cutoff/json-no-folder       2 "--json"          -- cutoff --bond-number 10 --json /no/such/c.json
