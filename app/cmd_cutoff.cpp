@@ -40,6 +40,7 @@ struct CutoffCli {
     std::string bracket = "0,400";
     std::string criterion{kc::flow_criterion_name(kc::FlowCriterion::flow_stops)};
     double tol = 25;
+    double max_window = 0;  // 0: not given (kDefaultWindowFactor x --window by flow-stops)
     std::vector<long long> seeds{1};
     std::string json;
     long max_runs = 10000;
@@ -60,6 +61,10 @@ constexpr const char* kHopperOptions[] = {"--bond-number", "--theta", "--grains"
 // The silo search's own options (its campaign), which the small hopper (run in this process) does not use.
 constexpr const char* kSiloSearchOptions[] = {"--campaign", "--jobs", "--executor", "--partition"};
 
+// Without --max-window a run still discharging at its window's end runs again in up to this many times the window
+// (two doublings): the silo's meal at 40 deg had two of three runs at 50 Hz undecided at 5 s, both decided by 10 s.
+constexpr double kDefaultWindowFactor = 4;
+
 // Every run of a search ends once this fraction of the filled mass is out (by either criterion it has flowed then),
 // when its flow stops, or at the window's end.
 constexpr double kFlowingFraction = 0.5;
@@ -79,10 +84,11 @@ std::pair<double, double> parse_bracket(const std::string& text) {
     return {ends[0], ends[1]};
 }
 
-// The runs the search may make (both ends, then every bisection, each with every seed), refused above --max-runs
+// The runs the search may make (both ends, then every bisection, each with every seed in every window of its
+// ladder at most), refused above --max-runs
 // before the first run; a tolerance finer than the search's bisection bound (kc::kMaxBisections) is refused naming
 // the option.
-void check_search_size(const kc::CutoffSearch& s, long max_runs) {
+void check_search_size(const kc::CutoffSearch& s, double first_window, long max_runs) {
     const double width = s.hi - s.lo;
     if (!(width > 0) || !(s.tol > 0) || s.tol >= width) return;  // kc::validate names these
     if (s.tol < std::ldexp(width, -kc::kMaxBisections))
@@ -90,9 +96,11 @@ void check_search_size(const kc::CutoffSearch& s, long max_runs) {
                         std::to_string(kc::kMaxBisections) + " of the bracket (" + analytics::number_text(width) +
                         " Hz), more bisections than frequencies a run can tell apart");
     const int bisections = static_cast<int>(std::ceil(std::log2(width / s.tol)));
-    orchestrator::check_run_count(static_cast<double>(2 + bisections) * s.seeds.size(), max_runs,
+    const std::size_t windows = kc::window_ladder(first_window, s.longest_window).size();
+    orchestrator::check_run_count(static_cast<double>(2 + bisections) * s.seeds.size() * windows, max_runs,
                                   "cutoff: (2 ends + " + std::to_string(bisections) + " bisections) x " +
-                                      std::to_string(s.seeds.size()) + " seeds");
+                                      std::to_string(s.seeds.size()) + " seeds" +
+                                      (windows > 1 ? " x up to " + std::to_string(windows) + " windows" : ""));
 }
 
 kc::CutoffSearch search_from(const CutoffCli& o) {
@@ -102,6 +110,10 @@ kc::CutoffSearch search_from(const CutoffCli& o) {
     for (const auto& [criterion, name] : kc::kFlowCriterionNames)
         if (name == o.criterion) search.criterion = criterion;  // the option's check admits the names only
     search.seeds.assign(o.seeds.begin(), o.seeds.end());
+    search.longest_window = o.max_window > 0 ? o.max_window
+                            : search.criterion == kc::FlowCriterion::flow_stops
+                                ? std::min(kDefaultWindowFactor * o.base.window, kc::kWindowMax)
+                                : o.base.window;
     // a seed twice is one bed counted twice in the majority (and one run folder for two runs)
     for (std::size_t i = 0; i < o.seeds.size(); ++i)
         if (std::find(o.seeds.begin(), o.seeds.begin() + i, o.seeds[i]) != o.seeds.begin() + i)
@@ -111,7 +123,7 @@ kc::CutoffSearch search_from(const CutoffCli& o) {
         throw UserError("--amplitude = " + analytics::number_text(o.base.amplitude) +
                         " m: the cut-off search vibrates the bin; give an amplitude > 0");
     try {
-        check_search_size(search, o.max_runs);
+        check_search_size(search, o.base.window, o.max_runs);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
@@ -150,17 +162,30 @@ void report_seed_brackets(const kc::CutoffResult& res, nlohmann::json& out) {
                     "of the seeds flowing), and the cut-off differs from bed to bed by more than the tolerance\n");
 }
 
-// The runs that were still discharging at the window's end, counted and named in a note: by the flow-stops criterion
-// they flow (their flow had not stopped), and a longer window would decide them.
-void report_window_end_runs(kc::FlowCriterion criterion, double window, nlohmann::json& out) {
-    long undecided = 0;
-    for (const auto& run : out.at("runs"))
-        undecided += run.at("end") == kernel::silo::discharge_end_name(kernel::silo::DischargeEnd::time_limit);
+// The runs still discharging at the end of the longest window, counted and named in a note: by the flow-stops
+// criterion they flow (their flow had not stopped), and a longer --max-window would decide them. (A run at the end of
+// a shorter window ran again in a longer one.)
+void report_window_end_runs(kc::FlowCriterion criterion, double longest_window, nlohmann::json& out) {
+    long undecided = 0, extended = 0;
+    for (const auto& run : out.at("runs")) {
+        if (run.at("end") != kernel::silo::discharge_end_name(kernel::silo::DischargeEnd::time_limit)) continue;
+        (run.at("window_s").get<double>() >= longest_window ? undecided : extended) += 1;
+    }
     out["runs_at_window_end"] = undecided;
+    out["runs_run_again_in_a_longer_window"] = extended;
     if (undecided > 0 && criterion == kc::FlowCriterion::flow_stops)
-        std::printf("note: %ld run(s) still discharging at the window's end (%g s) counted as flowing; a longer "
-                    "--window decides whether their flow stops\n",
-                    undecided, window);
+        std::printf("note: %ld run(s) still discharging at the end of the longest window (%g s) counted as flowing; "
+                    "a longer --max-window decides whether their flow stops\n",
+                    undecided, longest_window);
+}
+
+// The windows of a search in words: "window 5 s" or "window 5 s, a run still discharging at its end again in 10, 20 s".
+std::string ladder_text(const std::vector<double>& ladder) {
+    std::string text = "window " + kernel::silo::setting_text(ladder.front()) + " s";
+    for (std::size_t k = 1; k < ladder.size(); ++k)
+        text += (k == 1 ? ", a run still discharging at its end again in " : ", ") +
+                kernel::silo::setting_text(ladder[k]) + (k + 1 == ladder.size() ? " s" : "");
+    return text;
 }
 
 // The search's result, printed and added to the JSON report; the exit status.
@@ -194,17 +219,19 @@ kernel::silo::SiloCaseSettings silo_run_settings(kernel::silo::SiloCaseSettings 
 }
 
 // The same run as demcal silo's options, for the campaign (silo_run_settings is what they parse to); named by its
-// frequency and seed, the rest being the campaign's settings.
-SiloRunPlan silo_run_plan(const CutoffCli& o, double frequency, unsigned seed) {
+// frequency and seed, and by its window where it is longer than the campaign's (a run again in a longer window), the
+// rest being the campaign's settings.
+SiloRunPlan silo_run_plan(const CutoffCli& o, double frequency, unsigned seed, double window) {
     std::vector<std::string> a = o.silo_args;
     if (std::find(a.begin(), a.end(), "--no-plots") == a.end()) a.push_back("--no-plots");  // a search reads numbers
     a.insert(a.end(), {"--seed", std::to_string(seed), "--stop-fraction", silo_number(kFlowingFraction), "--max-time",
-                       silo_number(o.base.window)});
+                       silo_number(window)});
     if (frequency > 0 && o.base.amplitude > 0)
         a.insert(a.end(), {"--vibration-frequency", silo_number(frequency), "--vibration-amplitude",
                            silo_number(o.base.amplitude)});
     std::ostringstream name;
     name << "f" << std::setprecision(12) << frequency << "_seed" << seed;
+    if (window != o.base.window) name << "_w" << window;
     return {name.str(), a};
 }
 
@@ -217,10 +244,10 @@ nlohmann::json silo_campaign_settings(const CutoffCli& o) {
 
 struct SearchStopped {};  // a signal or a suspended run stopped the campaign: the same command continues it
 
-// One finished run of the campaign, read from its summary.json: the line printed and the JSON entry; whether it
-// flows. A run that failed ends the search (its log named).
-// `run`: its settings (silo_run_settings), whose vibration gives the peak acceleration.
-bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double frequency,
+// One finished run of the campaign, read from its summary.json: the line printed and the JSON entry; how it ended.
+// A run that failed ends the search (its log named).
+// `run`: its settings (silo_run_settings), whose vibration gives the peak acceleration and max_time the window.
+kernel::silo::DischargeEnd read_search_run(const fs::path& dir, const SiloRunPlan& plan, double frequency,
                      const kernel::silo::SiloCaseSettings& run, kc::FlowCriterion criterion, nlohmann::json& runs) {
     const unsigned seed = static_cast<unsigned>(run.seed);
     const auto summary = silo_run_summary(dir, plan.name);
@@ -237,16 +264,18 @@ bool read_search_run(const fs::path& dir, const SiloRunPlan& plan, double freque
     const double peak_g = run.vibration.peak_acceleration() / run.gravity;
     const std::string stop_reason = summary->text("discharge/stop_reason");
     const double cpu = summary->number("cpu_s"), discharge_time = summary->number("discharge/time_s");
+    const bool decided = kc::decided(criterion, *end);
     std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% of %.1f g out in %.2f s -> %s  [%s; %.1f s CPU]\n",
                 frequency, peak_g, seed, 100 * fraction, 1e3 * filled, discharge_time,
-                flows ? "flows" : "arched", stop_reason.c_str(), cpu);
+                !decided ? "undecided" : flows ? "flows" : "arched", stop_reason.c_str(), cpu);
     std::fflush(stdout);
     runs.push_back({{"frequency_hz", frequency}, {"seed", seed}, {"run", plan.name}, {"peak_acceleration_g", peak_g},
                     {"discharged_fraction", fraction}, {"filled_mass_kg", filled},
                     {"bulk_density_kg_m3", summary->number("bulk_density_kg_m3")}, {"discharge_time_s", discharge_time},
-                    {"end", end_name}, {"stop_reason", stop_reason}, {"flows", flows}, {"cpu_s", cpu},
+                    {"window_s", run.max_time}, {"end", end_name}, {"stop_reason", stop_reason}, {"flows", flows},
+                    {"decided", decided}, {"cpu_s", cpu},
                     {"wall_s", summary->number("wall_s")}});
-    return flows;
+    return *end;
 }
 
 int run_silo_search(const CutoffCli& o, CLI::App& sub) {
@@ -264,9 +293,11 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
         for (double f : {search.lo, search.hi})  // every frequency of the search lies in the bracket
             ks::validate(silo_run_settings(base, f, search.seeds.front(), o.base.amplitude, o.base.window));
         kc::validate_window(o.base.window, search.criterion);
+        kc::validate_window_ladder(o.base.window, search.longest_window, search.criterion);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
+    const std::vector<double> ladder = kc::window_ladder(o.base.window, search.longest_window);
     const nlohmann::json settings = silo_campaign_settings(o);
     const fs::path dir = o.campaign.empty()
                              ? fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(settings.dump()).substr(0, 12))
@@ -278,26 +309,33 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     const std::string amount = base.fill_mass > 0 ? ks::setting_text(base.fill_mass) + " kg of grain"
                                                    : std::to_string(base.particles) + " grains";
     std::printf("cut-off search in the silo: %s, %s, stiffness scale %g; %s; A = %g m along x; bracket "
-                "[%g, %g] Hz to %g Hz, %zu seed(s); %s; window %g s; runs in %s\n",
+                "[%g, %g] Hz to %g Hz, %zu seed(s); %s; %s; runs in %s\n",
                 base.geometry.describe().c_str(), amount.c_str(), base.materials.stiffness_scale,
                 ks::contact_law_name(base).c_str(), o.base.amplitude, search.lo, search.hi, search.tol,
-                search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(), o.base.window,
-                dir.string().c_str());
+                search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(),
+                ladder_text(ladder).c_str(), dir.string().c_str());
     std::fflush(stdout);
     nlohmann::json runs = nlohmann::json::array();
     kc::CutoffResult res;
     try {
         res = kc::find_cutoff_batched(search, [&](double f, const std::vector<unsigned>& seeds) {
-            std::vector<SiloRunPlan> plans;
-            for (unsigned seed : seeds) plans.push_back(silo_run_plan(o, f, seed));
-            const SiloCampaignOutcome outcome =
-                run_silo_campaign(dir, plans, o.silo_args, o.jobs, "cutoff", {o.executor, o.partition});
-            if (outcome.stopped) throw SearchStopped{};
-            std::vector<bool> answers;
-            for (std::size_t k = 0; k < seeds.size(); ++k)
-                answers.push_back(read_search_run(dir, plans[k], f,
-                                                  silo_run_settings(base, f, seeds[k], o.base.amplitude, o.base.window),
+            // the seeds side by side in each window; those still discharging at its end again in the next
+            const auto ends = kc::deciding_ends(search.criterion, ladder, seeds, [&](double window,
+                                                                                   const std::vector<unsigned>& batch) {
+                std::vector<SiloRunPlan> plans;
+                for (unsigned seed : batch) plans.push_back(silo_run_plan(o, f, seed, window));
+                const SiloCampaignOutcome outcome =
+                    run_silo_campaign(dir, plans, o.silo_args, o.jobs, "cutoff", {o.executor, o.partition});
+                if (outcome.stopped) throw SearchStopped{};
+                std::vector<ks::DischargeEnd> got;
+                for (std::size_t k = 0; k < batch.size(); ++k)
+                    got.push_back(read_search_run(dir, plans[k], f,
+                                                  silo_run_settings(base, f, batch[k], o.base.amplitude, window),
                                                   search.criterion, runs));
+                return got;
+            });
+            std::vector<bool> answers;
+            for (ks::DischargeEnd end : ends) answers.push_back(kc::flows(search.criterion, end));
             return answers;
         });
     } catch (const SearchStopped&) {
@@ -312,12 +350,13 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
                           {"amplitude_m", o.base.amplitude},
                           {"direction", "x"},
                           {"window_s", o.base.window},
+                          {"max_window_s", ladder.back()},
                           {"campaign", dir.string()},
                           {"criterion", kc::flow_criterion_name(search.criterion)},
                           {"criterion_text", kc::flow_criterion_text(search.criterion) +
                                                  "; a frequency flows when at least half of the seeds flow"},
                           {"runs", runs}};
-    report_window_end_runs(search.criterion, o.base.window, out);
+    report_window_end_runs(search.criterion, ladder.back(), out);
     return conclude(res, std::move(out), o.json);
 }
 
@@ -333,32 +372,36 @@ int run(const CutoffCli& o, CLI::App& sub) {
     auto report = [&](const kc::CohesiveHopperCase& c, const kc::CohesiveHopperOutcome& r) {
         const bool flows = r.flows(search.criterion);
         const std::string_view end = kernel::silo::discharge_end_name(r.end);
+        const bool decided = kc::decided(search.criterion, r.end);
         std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% out in %.2f s, %s -> %s  [%.1f s]\n", c.frequency,
                     r.peak_acceleration_g, c.seed, 100 * r.discharged_fraction, r.discharge_s,
-                    std::string(end).c_str(), flows ? "flows" : "arched", r.wall_s);
+                    std::string(end).c_str(), !decided ? "undecided" : flows ? "flows" : "arched", r.wall_s);
         std::fflush(stdout);
         runs.push_back({{"frequency_hz", c.frequency}, {"seed", c.seed}, {"peak_acceleration_g", r.peak_acceleration_g},
                         {"discharged_fraction", r.discharged_fraction}, {"discharge_time_s", r.discharge_s},
-                        {"end", end}, {"flows", flows}, {"wall_s", r.wall_s}});
+                        {"window_s", c.window}, {"end", end}, {"flows", flows}, {"decided", decided},
+                        {"wall_s", r.wall_s}});
     };
     kc::CutoffResult res;
     try {
         kc::validate(o.base, search);  // before the first run
         std::printf("cut-off search: Bo = %g, theta = %g deg, A = %g m, bracket [%g, %g] Hz to %g Hz, %zu seed(s); "
-                    "%s; window %g s\n",
+                    "%s; %s\n",
                     o.base.bond_number, o.base.theta_deg, o.base.amplitude, search.lo, search.hi, search.tol,
-                    search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(), o.base.window);
+                    search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(),
+                    ladder_text(kc::window_ladder(o.base.window, search.longest_window)).c_str());
         res = kc::find_cutoff(o.base, search, report);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
     nlohmann::json out = {{"case", "small hopper"}, {"bond_number", o.base.bond_number}, {"theta_deg", o.base.theta_deg},
                           {"amplitude_m", o.base.amplitude}, {"grains", o.base.grains}, {"window_s", o.base.window},
+                          {"max_window_s", kc::window_ladder(o.base.window, search.longest_window).back()},
                           {"criterion", kc::flow_criterion_name(search.criterion)},
                           {"criterion_text", kc::flow_criterion_text(search.criterion) +
                                                  "; a frequency flows when at least half of the seeds flow"},
                           {"runs", runs}};
-    report_window_end_runs(search.criterion, o.base.window, out);
+    report_window_end_runs(search.criterion, kc::window_ladder(o.base.window, search.longest_window).back(), out);
     return conclude(res, std::move(out), o.json);
 }
 
@@ -391,6 +434,12 @@ void add_cutoff_command(CLI::App& app) {
                         " s with --criterion flow-stops")
         ->check(number_in(kc::kWindowMin, kc::kWindowMax))
         ->capture_default_str();
+    sub->add_option("--max-window", o->max_window,
+                    "longest window [s]: a run still discharging at its window's end (not decided by flow-stops) runs "
+                    "again from the start in twice the window, up to this one (default " +
+                        kernel::silo::setting_text(kDefaultWindowFactor) + " x --window, at most " +
+                        kernel::silo::setting_text(kc::kWindowMax) + " s; equal to --window: no run again)")
+        ->check(number_in(kc::kWindowMin, kc::kWindowMax));
     std::vector<std::string> criteria;
     for (const auto& named : kc::kFlowCriterionNames) criteria.emplace_back(named.second);
     sub->add_option("--criterion", o->criterion,

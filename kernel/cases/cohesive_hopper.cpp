@@ -116,6 +116,7 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {
 void validate(const CohesiveHopperCase& base, const CutoffSearch& s) {
   validate(s);
   validate_window(base.window, s.criterion);
+  validate_window_ladder(base.window, s.longest_window, s.criterion);
   CohesiveHopperCase c = base;
   for (double f : {s.lo, s.hi}) {  // every frequency of the search lies in the bracket: both ends checked
     c.frequency = f;
@@ -126,12 +127,18 @@ void validate(const CohesiveHopperCase& base, const CutoffSearch& s) {
 CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,
                          const std::function<void(const CohesiveHopperCase&, const CohesiveHopperOutcome&)>& report) {
   validate(c, s);
+  const std::vector<double> ladder = window_ladder(c.window, s.longest_window);
   return find_cutoff(s, [&](double f, unsigned seed) {
-    c.frequency = f;
-    c.seed = seed;
-    const CohesiveHopperOutcome o = run_cohesive_hopper(c);
-    if (report) report(c, o);
-    return o.flows(s.criterion);
+    const auto ends = deciding_ends(s.criterion, ladder, {seed}, [&](double window, const std::vector<unsigned>&) {
+      CohesiveHopperCase run = c;
+      run.frequency = f;
+      run.seed = seed;
+      run.window = window;
+      const CohesiveHopperOutcome o = run_cohesive_hopper(run);
+      if (report) report(run, o);
+      return std::vector<silo::DischargeEnd>{o.end};
+    });
+    return flows(s.criterion, ends.front());
   });
 }
 

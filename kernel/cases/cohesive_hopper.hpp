@@ -23,15 +23,10 @@ struct CohesiveHopperCase {
   int grains = 800;
   unsigned seed = 1;             ///< seed of the jitter of the initial lattice
   double settle = 0.4;           ///< time with the outlet closed [s]
-  double window = 5.0;           ///< longest time after the opening a run lasts [s] (it ends earlier once half the
-                                 ///< mass is out or its flow stops: cutoff_search.hpp's FlowCriterion); measured
+  double window = 5.0;           ///< longest time after the opening a run lasts [s], kWindowMin..kWindowMax (it
+                                 ///< ends earlier once half the mass is out or its flow stops: cutoff_search.hpp's FlowCriterion); measured
                                  ///< (examples/cohesive_arch): slow runs took 2.7-4.4 s to reach half or to stop
 };
-
-/// The bounds of CohesiveHopperCase::window (and of a silo search's window) [s]: a guard against typos. Up to a minute:
-/// near the cut-off a broken arch drains slowly (the meal's silo at 40 deg and 50 Hz let out a third in 5 s, and a
-/// run still discharging at the window's end is decided only by a longer window).
-inline constexpr double kWindowMin = 0.05, kWindowMax = 60;
 
 /// Throws std::invalid_argument naming the field and the value when a setting is out of range.
 void validate(const CohesiveHopperCase& c);
@@ -51,8 +46,9 @@ CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c);
 /// Throws std::invalid_argument naming the setting when the search or the case at either end of the bracket is invalid,
 /// or the window is too short for the search's criterion to see an arch (shortest_window).
 void validate(const CohesiveHopperCase& c, const CutoffSearch& s);
-/// The lowest frequency at which this bed flows (cutoff_search.hpp), every seed at each frequency; `report` sees
-/// every run.
+/// The lowest frequency at which this bed flows (cutoff_search.hpp), every seed at each frequency, a run still
+/// discharging at its window's end run again in the longer windows of window_ladder(c.window, s.longest_window);
+/// `report` sees every run (its case holds the window it ran in).
 CutoffResult find_cutoff(CohesiveHopperCase c, const CutoffSearch& s,
                          const std::function<void(const CohesiveHopperCase&, const CohesiveHopperOutcome&)>& report);
 

@@ -46,6 +46,51 @@ bool flows(FlowCriterion c, silo::DischargeEnd end) {
   throw std::logic_error("flows: a run that has not ended (" + std::string(silo::discharge_end_name(end)) + ")");
 }
 
+bool decided(FlowCriterion c, silo::DischargeEnd end) {
+  (void)flows(c, end);  // a run that has not ended is a caller's error here too
+  return !(c == FlowCriterion::flow_stops && end == silo::DischargeEnd::time_limit);
+}
+
+std::vector<double> window_ladder(double first, double longest) {
+  std::vector<double> ladder{first};
+  while (ladder.back() < longest) ladder.push_back(std::min(2 * ladder.back(), longest));
+  return ladder;
+}
+
+void validate_window_ladder(double first, double longest, FlowCriterion c) {
+  if (longest == 0) return;  // the first window only
+  const std::string shown = "max_window = " + silo::setting_text(longest) + " s";
+  if (!(longest >= first && longest <= kWindowMax))
+    throw std::invalid_argument(shown + ": must be in [window, " + silo::setting_text(kWindowMax) + "] s (window " +
+                                silo::setting_text(first) + " s)");
+  if (c != FlowCriterion::flow_stops && longest != first)
+    throw std::invalid_argument(shown + ": a longer window decides runs by flow-stops only; by " +
+                                std::string(flow_criterion_name(c)) + " the window is part of the criterion");
+}
+
+std::vector<silo::DischargeEnd> deciding_ends(FlowCriterion c, const std::vector<double>& ladder,
+                                              const std::vector<unsigned>& seeds, const EndsInWindow& ends_in) {
+  std::vector<silo::DischargeEnd> ends(seeds.size(), silo::DischargeEnd::running);
+  std::vector<std::size_t> open(seeds.size());  // indices of the seeds not decided yet
+  for (std::size_t k = 0; k < seeds.size(); ++k) open[k] = k;
+  for (double window : ladder) {
+    if (open.empty()) break;
+    std::vector<unsigned> batch;
+    for (std::size_t k : open) batch.push_back(seeds[k]);
+    const std::vector<silo::DischargeEnd> got = ends_in(window, batch);
+    if (got.size() != batch.size())
+      throw std::logic_error("deciding_ends: " + std::to_string(got.size()) + " ends for " +
+                             std::to_string(batch.size()) + " seeds");
+    std::vector<std::size_t> still_open;
+    for (std::size_t i = 0; i < open.size(); ++i) {
+      ends[open[i]] = got[i];
+      if (!decided(c, got[i])) still_open.push_back(open[i]);
+    }
+    open = std::move(still_open);
+  }
+  return ends;
+}
+
 void validate(const CutoffSearch& s) {
   if (!(s.lo >= 0 && s.lo < s.hi && s.hi <= 1000))
     throw std::invalid_argument("bracket = [" + silo::setting_text(s.lo) + ", " + silo::setting_text(s.hi) +

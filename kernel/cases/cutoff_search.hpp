@@ -39,10 +39,39 @@ void validate_window(double window, FlowCriterion c);
 /// error (std::logic_error).
 bool flows(FlowCriterion c, silo::DischargeEnd end);
 
+/// The bounds of a run's window (the small hopper's and the silo search's) [s]: a guard against typos. Up to a minute:
+/// near the cut-off a broken arch drains slowly (the meal's silo at 40 deg and 50 Hz let out a third in 5 s, and a
+/// run still discharging at the window's end is decided only by a longer window).
+inline constexpr double kWindowMin = 0.05, kWindowMax = 60;
+
+/// Whether the criterion has decided a run that ended so. Not decided: a run still discharging at its window's end by
+/// flow-stops (its flow may yet stop: a longer window decides it); by half-within-window such a run has arched.
+bool decided(FlowCriterion c, silo::DischargeEnd end);
+
+/// The windows a run is tried in [s]: `first`, then twice the last while the run is not decided, the last one
+/// `longest` (a rung above it is cut to it). longest <= first (0 included): the first window only.
+std::vector<double> window_ladder(double first, double longest);
+
+/// Throws std::invalid_argument naming max_window unless it is 0 (the first window only) or first <= longest <=
+/// kWindowMax, and longest == first by a criterion that a run's window end decides (half-within-window: a longer
+/// window would change the criterion, not decide a run).
+void validate_window_ladder(double first, double longest, FlowCriterion c);
+
+/// Runs `seeds` in the ladder's windows in turn, each window with the seeds it has not decided yet
+/// (`ends_in(window, seeds)` answers their ends in order, side by side if it can), and returns each seed's end in the
+/// first window that decided it, or in the last one.
+using EndsInWindow =
+    std::function<std::vector<silo::DischargeEnd>(double window, const std::vector<unsigned>& seeds)>;
+std::vector<silo::DischargeEnd> deciding_ends(FlowCriterion c, const std::vector<double>& ladder,
+                                              const std::vector<unsigned>& seeds, const EndsInWindow& ends_in);
+
 struct CutoffSearch {
   double lo = 0, hi = 400, tol = 25;  ///< the bracket and the final width [Hz]
   std::vector<unsigned> seeds{1};     ///< repeats: each frequency runs once per seed
   FlowCriterion criterion = FlowCriterion::flow_stops;
+  /// [s] a run still discharging at its window's end (flow-stops) runs again in twice the window, up to this one
+  /// (window_ladder); 0: the case's window only
+  double longest_window = 0;
 };
 
 /// One run of the search: a frequency, a seed and its answer.

@@ -95,6 +95,11 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
       // an empty value is named as one, before the option's list of names ("--criterion:  not in {...}")
       {"--criterion ''", "--criterion: an empty value"},
       {"--window 0.5 -- --theta 30", "window = 0.5 s"},
+      // the longest window: not below the first, and only by the criterion a longer window can decide
+      {"--window 5 --max-window 2", "max_window = 2 s: must be in [window, 60] s"},
+      {"--criterion half-within-window --max-window 10", "max_window = 10 s: a longer window decides runs by"},
+      {"--max-window 61", "--max-window"},
+      {"--window 5 --max-window 2 -- --theta 30", "max_window = 2 s"},
       // the silo case (options after --): its own options stay with demcal silo, the search's with cutoff
       {"--bond-number 5 -- --theta 30", "--bond-number applies to the small hopper"},
       {"-- --theta 30 --seed 3", "silo option --seed after --: demcal cutoff sets it"},

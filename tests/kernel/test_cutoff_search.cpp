@@ -7,6 +7,7 @@
 
 #include <map>
 #include <stdexcept>
+#include <vector>
 
 using namespace demcal::kernel::cases;
 
@@ -124,6 +125,65 @@ TEST_CASE("cut-off criteria: how a run ended decides whether it flows, the same 
     CHECK_THROWS_WITH(validate_window(0.99, FlowCriterion::flow_stops), Catch::Matchers::Contains("window = 0.99 s"));
     CHECK_NOTHROW(validate_window(1, FlowCriterion::flow_stops));
     CHECK_NOTHROW(validate_window(0.3, FlowCriterion::half_within_window));
+}
+
+TEST_CASE("cut-off windows: a run still discharging at its window's end runs again in twice the window, up to the "
+          "longest, with only the seeds it has not decided", "[kernel][cohesion][cutoff]") {
+    using demcal::kernel::silo::DischargeEnd;
+    CHECK(window_ladder(5, 20) == std::vector<double>{5, 10, 20});
+    CHECK(window_ladder(5, 15) == std::vector<double>{5, 10, 15});  // the last rung cut to the longest
+    CHECK(window_ladder(5, 5) == std::vector<double>{5});
+    CHECK(window_ladder(5, 0) == std::vector<double>{5});
+    // decided: every end but a flow still running at the window's end by flow-stops
+    CHECK_FALSE(decided(FlowCriterion::flow_stops, DischargeEnd::time_limit));
+    CHECK(decided(FlowCriterion::half_within_window, DischargeEnd::time_limit));
+    for (DischargeEnd e : {DischargeEnd::flow_stopped, DischargeEnd::stop_fraction, DischargeEnd::emptied})
+        CHECK(decided(FlowCriterion::flow_stops, e));
+    CHECK_THROWS_AS(decided(FlowCriterion::flow_stops, DischargeEnd::running), std::logic_error);
+
+    // seed 1 half out in the first window, seed 2 stops in the second, seed 3 still discharging in every window
+    const std::map<unsigned, std::map<double, DischargeEnd>> end_of{
+        {1, {{5, DischargeEnd::stop_fraction}}},
+        {2, {{5, DischargeEnd::time_limit}, {10, DischargeEnd::flow_stopped}}},
+        {3, {{5, DischargeEnd::time_limit}, {10, DischargeEnd::time_limit}, {20, DischargeEnd::time_limit}}}};
+    std::vector<std::pair<double, std::vector<unsigned>>> asked;
+    const auto ends = deciding_ends(FlowCriterion::flow_stops, window_ladder(5, 20), {1, 2, 3},
+                                    [&](double window, const std::vector<unsigned>& seeds) {
+                                        asked.emplace_back(window, seeds);
+                                        std::vector<DischargeEnd> out;
+                                        for (unsigned s : seeds) out.push_back(end_of.at(s).at(window));
+                                        return out;
+                                    });
+    CHECK(ends == std::vector<DischargeEnd>{DischargeEnd::stop_fraction, DischargeEnd::flow_stopped,
+                                            DischargeEnd::time_limit});
+    REQUIRE(asked.size() == 3);
+    CHECK(asked[0].second == std::vector<unsigned>{1, 2, 3});
+    CHECK(asked[1] == std::make_pair(10.0, std::vector<unsigned>{2, 3}));
+    CHECK(asked[2] == std::make_pair(20.0, std::vector<unsigned>{3}));
+    // half-within-window: the window's end decides, one window only
+    asked.clear();
+    deciding_ends(FlowCriterion::half_within_window, window_ladder(5, 20), {2},
+                  [&](double window, const std::vector<unsigned>& seeds) {
+                      asked.emplace_back(window, seeds);
+                      return std::vector<DischargeEnd>{DischargeEnd::time_limit};
+                  });
+    CHECK(asked.size() == 1);
+    // an answer per seed asked, or a caller's error
+    CHECK_THROWS_AS(deciding_ends(FlowCriterion::flow_stops, {5}, {1, 2},
+                                  [](double, const std::vector<unsigned>&) {
+                                      return std::vector<DischargeEnd>{DischargeEnd::stop_fraction};
+                                  }),
+                    std::logic_error);
+
+    // the longest window: 0 (none) or between the first and kWindowMax; longer only by flow-stops
+    CHECK_NOTHROW(validate_window_ladder(5, 0, FlowCriterion::half_within_window));
+    CHECK_NOTHROW(validate_window_ladder(5, 60, FlowCriterion::flow_stops));
+    CHECK_THROWS_WITH(validate_window_ladder(5, 4, FlowCriterion::flow_stops),
+                      Catch::Matchers::Contains("max_window = 4 s"));
+    CHECK_THROWS_WITH(validate_window_ladder(5, 61, FlowCriterion::flow_stops),
+                      Catch::Matchers::Contains("max_window = 61 s"));
+    CHECK_THROWS_WITH(validate_window_ladder(5, 10, FlowCriterion::half_within_window),
+                      Catch::Matchers::Contains("half-within-window"));
 }
 
 TEST_CASE("flow stall clock: the stall counts from the last grain out, not before the vibration starts",

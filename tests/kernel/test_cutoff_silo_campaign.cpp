@@ -59,3 +59,64 @@ TEST_CASE("demcal cutoff in the silo: runs kept in a campaign, the same command 
     CHECK_THAT(read_file(dir / "hopper.log"), Catch::Contains("--jobs applies to the silo search"));
     fs::remove_all(dir);
 }
+
+// A bed that arches still and at 20 Hz, and at 40 Hz drains slowly: 42 % of it out at the 1 s window's end (measured
+// on this build: half out at 1.41 s). The run is undecided by flow-stops and runs again in the 2 s window, which
+// decides it; the same command again runs nothing, and a search that may not lengthen the window (--max-window 1)
+// reuses the 1 s runs and counts the undecided one as flowing, with a note.
+TEST_CASE("demcal cutoff in the silo: a run still discharging at its window's end runs again in a longer window",
+          "[silo][cutoff][cli]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-cutoff-window-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string silo = " -- --material '" + std::string(DEMCAL_SOURCE_DIR) +
+                             "/examples/materials/silo_meal.json' --outlet 0.025 --theta 30 --particles 300 "
+                             "--stiffness-scale 0.01 --fill-time 0.3 --threads 1";
+    const std::string search = "cutoff --amplitude 2.2e-4 --bracket 0,40 --tol 20 --seeds 1 --window 1 --campaign '" +
+                               (dir / "c").string() + "' ";
+    CHECK(run_demcal_command(search + "--max-window 2 --json '" + (dir / "first.json").string() + "'" + silo,
+                             dir / "first.log") == 0);
+    const std::string log = read_file(dir / "first.log");
+    INFO(log);
+    CHECK_THAT(log, Catch::Contains("window 1 s, a run still discharging at its end again in 2 s"));
+    CHECK_THAT(log, Catch::Contains("-> undecided"));
+    CHECK_THAT(log, Catch::Contains("cut-off frequency in [20, 40] Hz"));
+    CHECK(fs::exists(dir / "c" / "runs" / "f40_seed1" / "summary.json"));
+    CHECK(fs::exists(dir / "c" / "runs" / "f40_seed1_w2" / "summary.json"));
+    const auto first = nlohmann::json::parse(read_file(dir / "first.json"));
+    CHECK(first["max_window_s"] == 2.0);
+    REQUIRE(first["runs"].size() == 4);  // 0 Hz, 40 Hz in 1 s and in 2 s, 20 Hz
+    const auto& short_run = first["runs"][1];
+    const auto& long_run = first["runs"][2];
+    CHECK(short_run["run"] == "f40_seed1");
+    CHECK(short_run["end"] == "time_limit");
+    CHECK(short_run["window_s"] == 1.0);
+    CHECK_FALSE(short_run["decided"].get<bool>());
+    CHECK(short_run["discharged_fraction"].get<double>() < 0.5);
+    CHECK(long_run["run"] == "f40_seed1_w2");
+    CHECK(long_run["window_s"] == 2.0);
+    CHECK(long_run["decided"].get<bool>());
+    CHECK(long_run["end"] != "time_limit");
+    // the longer run repeats the shorter one's trajectory, then goes on: more discharge time, at least as much out
+    CHECK(long_run["discharge_time_s"].get<double>() > short_run["discharge_time_s"].get<double>());
+    CHECK(long_run["discharged_fraction"].get<double>() >= short_run["discharged_fraction"].get<double>());
+    CHECK(first["runs_at_window_end"] == 0);
+    CHECK(first["runs_run_again_in_a_longer_window"] == 1);
+
+    // again: nothing runs, the same answers
+    CHECK(run_demcal_command(search + "--max-window 2 --json '" + (dir / "again.json").string() + "'" + silo,
+                             dir / "again.log") == 0);
+    CHECK_THAT(read_file(dir / "again.log"), !Catch::Contains("[1/1]"));
+    CHECK(nlohmann::json::parse(read_file(dir / "again.json"))["runs"] == first["runs"]);
+
+    // the first window only: the 1 s runs reused, the undecided one counted as flowing and noted
+    CHECK(run_demcal_command(search + "--max-window 1 --json '" + (dir / "short.json").string() + "'" + silo,
+                             dir / "short.log") == 0);
+    CHECK_THAT(read_file(dir / "short.log"), !Catch::Contains("[1/1]"));
+    CHECK_THAT(read_file(dir / "short.log"), Catch::Contains("1 run(s) still discharging at the end of the longest "
+                                                             "window (1 s) counted as flowing"));
+    const auto short_search = nlohmann::json::parse(read_file(dir / "short.json"));
+    CHECK(short_search["runs_at_window_end"] == 1);
+    CHECK(short_search["runs"].size() == 3);
+    fs::remove_all(dir);
+}

@@ -211,8 +211,11 @@ TEST_CASE("cutoff: a search that could not end or would start too many runs is r
     std::string seeds;
     for (int i = 1; i <= 800; ++i) seeds += (i > 1 ? "," : "") + std::to_string(i);
     refused({{{"cutoff", "--bond-number", "10", "--tol", "1e-300"}, {"--tol = 1e-300 Hz", "finer than 2^-30"}},
-             {{"cutoff", "--bond-number", "10", "--seeds", seeds, "--max-runs", "1000"},
+             {{"cutoff", "--bond-number", "10", "--seeds", seeds, "--max-runs", "1000", "--max-window", "5"},
               {"cutoff: (2 ends + 4 bisections) x 800 seeds = 4800 simulations", "--max-runs = 1000"}},
+             // counted at most: every run again in each longer window (5 s, 10 s, 20 s by default)
+             {{"cutoff", "--bond-number", "10", "--seeds", seeds, "--max-runs", "1000"},
+              {"x 800 seeds x up to 3 windows = 14400 simulations"}},
              {{"cutoff", "--bond-number", "10", "--bracket", "nan,400"}, {"--bracket = 'nan,400'", "'nan' is not a number"}},
              {{"cutoff", "--bond-number", "10", "--bracket", "1e-320,400"}, {"--bracket", "'1e-320' is subnormal"}},
              {{"cutoff", "--bond-number", "10", "--bracket", "0,1e308"}, {"--bracket", "'1e308' is implausibly large"}}},
