@@ -102,6 +102,13 @@ TEST_CASE("demcal cutoff in the silo: a run still discharging at its window's en
     CHECK(long_run["discharged_fraction"].get<double>() >= short_run["discharged_fraction"].get<double>());
     CHECK(first["runs_at_window_end"] == 0);
     CHECK(first["runs_run_again_in_a_longer_window"] == 1);
+    // bit for bit: the 1 s run's discharge record (but its closing line at the window's end) opens the 2 s run's
+    const std::string short_csv = read_file(dir / "c" / "runs" / "f40_seed1" / "discharge.csv");
+    const std::string long_csv = read_file(dir / "c" / "runs" / "f40_seed1_w2" / "discharge.csv");
+    const std::size_t last_line = short_csv.rfind('\n', short_csv.size() - 2);
+    REQUIRE(last_line != std::string::npos);
+    CHECK(last_line > 1000);  // hundreds of records compared, not the header only
+    CHECK(long_csv.compare(0, last_line + 1, short_csv, 0, last_line + 1) == 0);
 
     // again: nothing runs, the same answers
     CHECK(run_demcal_command(search + "--max-window 2 --json '" + (dir / "again.json").string() + "'" + silo,
