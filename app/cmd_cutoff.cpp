@@ -325,7 +325,7 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
                 std::vector<SiloRunPlan> plans;
                 for (unsigned seed : batch) plans.push_back(silo_run_plan(o, f, seed, window));
                 const SiloCampaignOutcome outcome =
-                    run_silo_campaign(dir, plans, o.silo_args, o.jobs, "cutoff", {o.executor, o.partition});
+                    run_silo_campaign(dir, plans, o.jobs, "cutoff", {o.executor, o.partition});
                 if (outcome.stopped) throw SearchStopped{};
                 std::vector<ks::DischargeEnd> got;
                 for (std::size_t k = 0; k < batch.size(); ++k)

@@ -370,7 +370,7 @@ int run(const VibrationCli& o) {
     // campaign, its finished runs reused
     open_silo_campaign(dir, campaign_settings(o), "vibration", {"thetas_deg", "frequencies_hz", "repeats", "first_seed"});
     const SiloCampaignOutcome outcome =
-        run_silo_campaign(dir, plans, o.silo_args, o.jobs, "vibration", {o.executor, o.partition});
+        run_silo_campaign(dir, plans, o.jobs, "vibration", {o.executor, o.partition});
     if (outcome.stopped) {
         report(o, dir, runs);
         return kExitResumeLater;

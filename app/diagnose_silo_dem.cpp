@@ -128,7 +128,7 @@ public:
                 for (int k = 0; k < args_.seeds; ++k) plans.push_back(plan(hash, file, c, args_.first_seed + k));
         }
         const auto start = std::chrono::steady_clock::now();
-        const SiloCampaignOutcome o = run_silo_campaign(dir_, plans, args_.silo_args, args_.jobs, "diagnose",
+        const SiloCampaignOutcome o = run_silo_campaign(dir_, plans, args_.jobs, "diagnose",
                                                             {args_.executor, args_.partition});
         wall_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         cpu_seconds_ += o.cpu_seconds;

@@ -58,7 +58,11 @@ pid_t spawn_demcal(const std::vector<std::string>& args, const fs::path& log) {
     sigaddset(&defaults, SIGINT);
     sigaddset(&defaults, SIGTERM);  // (SIGHUP keeps its disposition: under nohup the runs ignore it too)
     posix_spawnattr_setsigdefault(&attr, &defaults);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
+    // its own process group: Ctrl-C reaches this process only, which sends the run one SIGTERM. In the terminal's group
+    // the run got SIGINT and then the forwarded SIGTERM, and the second signal (SA_RESETHAND: "stop now") killed it
+    // while it wrote its checkpoint.
+    posix_spawnattr_setpgroup(&attr, 0);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
     pid_t pid = 0;
     const int err = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&fa);
@@ -74,14 +78,17 @@ double cpu_of(const rusage& u) {
            1e-6 * double(u.ru_stime.tv_usec);
 }
 
-// `demcal silo --resume DIR` with the session options of the silo options (the rest is in the checkpoint).
-std::vector<std::string> resume_command(const fs::path& dir, const std::vector<std::string>& session_args) {
+// `demcal silo --resume DIR` with the session options of the run's own options (--threads, --no-plots, ...: the rest
+// is in the checkpoint). From the plan, not the campaign's shared options: a command may add a session option to
+// every plan (cutoff's --no-plots), and a resumed run without it drew plots, or failed where gnuplot is missing.
+std::vector<std::string> resume_command(const SiloRunPlan& plan, const fs::path& dir) {
     std::vector<std::string> a{"silo", "--resume", dir.string()};
-    for (std::size_t k = 0; k < session_args.size(); ++k) {
-        const std::string& arg = session_args[k];
+    const std::vector<std::string>& args = plan.silo_args;
+    for (std::size_t k = 0; k < args.size(); ++k) {
+        const std::string& arg = args[k];
         if (arg == "--no-plots") a.push_back(arg);
-        if ((arg == "--threads" || arg == "--checkpoint-every" || arg == "--wall-limit") && k + 1 < session_args.size())
-            a.insert(a.end(), {arg, session_args[k + 1]});
+        if ((arg == "--threads" || arg == "--checkpoint-every" || arg == "--wall-limit") && k + 1 < args.size())
+            a.insert(a.end(), {arg, args[k + 1]});
     }
     return a;
 }
@@ -254,8 +261,8 @@ void record_run_end(const fs::path& rd, const std::string& name, int rc, bool st
 
 // The runs left as SLURM array tasks (orchestrator::SlurmExecutor: sbatch, squeue, the tasks' exit_status files).
 void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& todo, std::size_t total,
-                  const std::vector<std::string>& session_args, int jobs, const std::string& command,
-                  const SiloCampaignExecutor& where, SiloCampaignOutcome& outcome) {
+                  int jobs, const std::string& command, const SiloCampaignExecutor& where,
+                  SiloCampaignOutcome& outcome) {
     std::error_code ec;
     const fs::path self = fs::read_symlink("/proc/self/exe", ec);
     if (ec) throw std::runtime_error(command + ": cannot find this program's own path (/proc/self/exe)");
@@ -266,7 +273,7 @@ void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& to
         const bool resume = fs::exists(rd / "checkpoint.bin");
         fs::create_directories(rd);
         std::vector<std::string> argv{program};
-        const auto args = resume ? resume_command(rd, session_args) : fresh_command(*plan, rd, false);
+        const auto args = resume ? resume_command(*plan, rd) : fresh_command(*plan, rd, false);
         argv.insert(argv.end(), args.begin(), args.end());
         queue.push_back({plan->name, rd, argv, where.time_limit_s});
     }
@@ -294,7 +301,7 @@ void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& to
 }  // namespace
 
 SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<SiloRunPlan>& plans,
-                                      const std::vector<std::string>& session_args, int jobs,
+                                      int jobs,
                                       const std::string& command, const SiloCampaignExecutor& where) {
     // one demcal per campaign: two sweeps on one folder ran the same runs into the same run folders at once
     std::unique_ptr<orchestrator::FolderLock> lock;
@@ -315,7 +322,7 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
             todo.push_back(&plan);
     }
     if (where.executor == "slurm") {
-        run_on_slurm(dir, todo, plans.size(), session_args, jobs, command, where, outcome);
+        run_on_slurm(dir, todo, plans.size(), jobs, command, where, outcome);
         return outcome;
     }
     if (where.executor != "local")
@@ -333,13 +340,13 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
             fs::create_directories(rd);
             std::cout << "[" << outcome.finished + outcome.failed + running.size() + 1 << "/" << plans.size() << "] "
                       << plan.name << (resume ? " (resumed)" : "") << std::endl;
-            running[spawn_demcal(resume ? resume_command(rd, session_args) : fresh_command(plan, rd, false),
+            running[spawn_demcal(resume ? resume_command(plan, rd) : fresh_command(plan, rd, false),
                                  rd / "silo.log")] = &plan;
             ++outcome.started;
         }
         if (running.empty()) break;
         if (g_stop_requested && !signalled_children) {
-            // Ctrl-C reaches the runs from the terminal too; a SIGTERM sent to this process alone must reach them.
+            // the runs have their own process groups (spawn_demcal): a stop reaches them from here only, once
             for (const auto& [pid, plan] : running) ::kill(pid, SIGTERM);
             signalled_children = true;
         }

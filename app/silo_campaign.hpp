@@ -53,12 +53,11 @@ struct SiloCampaignExecutor {
 };
 
 // Runs what is left of `plans` in DIR/runs/<name>/, at most `jobs` at once; progress lines "[k/N] name" on stdout,
-// each run's output in its silo.log. `session_args` are silo options of the session (--threads, --no-plots, ...) that a
-// resumed run takes again (the rest is in its checkpoint). SIGINT/SIGTERM during the call: the running runs are sent
+// each run's output in its silo.log; a resumed run takes the session options of its plan again (--threads,
+// --no-plots, ...: the rest is in its checkpoint). SIGINT/SIGTERM during the call: the running runs are sent
 // SIGTERM (they checkpoint and exit 75), the call waits for them and returns stopped.
 SiloCampaignOutcome run_silo_campaign(const std::filesystem::path& dir, const std::vector<SiloRunPlan>& plans,
-                                      const std::vector<std::string>& session_args, int jobs,
-                                      const std::string& command, const SiloCampaignExecutor& where = {});
+                                      int jobs, const std::string& command, const SiloCampaignExecutor& where = {});
 
 // A finished run's summary.json, read field by field: a field given by its path ("rate/rate_kg_s") that is missing
 // or holds another type throws UserError naming the file, the field and what it holds (a summary edited or damaged

@@ -4,7 +4,12 @@
 // arch (it flows at 0 Hz), which keeps the search to its first frequency: seconds.
 #include <catch2/catch.hpp>
 
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -125,5 +130,67 @@ TEST_CASE("demcal cutoff in the silo: a run still discharging at its window's en
     const auto short_search = nlohmann::json::parse(read_file(dir / "short.json"));
     CHECK(short_search["runs_at_window_end"] == 1);
     CHECK(short_search["runs"].size() == 3);
+    fs::remove_all(dir);
+}
+
+// Ctrl-C in a terminal sends SIGINT to the whole foreground process group. The runs of a silo campaign used to share
+// it: each got SIGINT from the terminal and SIGTERM forwarded by the campaign, and the second signal killed it while it
+// wrote its checkpoint (checkpoint.bin.tmp left, the run lost). And a resumed run lost cutoff's --no-plots: without
+// gnuplot it failed, for good. Here the search starts in a group of its own with SIGINT at its default, without
+// gnuplot on PATH; the group gets SIGINT while the first run fills; the same command then finishes the search.
+TEST_CASE("demcal cutoff in the silo: Ctrl-C to the process group keeps the run's checkpoint, which resumes without "
+          "gnuplot", "[silo][cutoff][cli][signals]") {
+    const fs::path dir = fs::temp_directory_path() / ("demcal-test-cutoff-ctrlc-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir / "empty_bin");  // PATH: no gnuplot (nor anything else)
+    const std::string command = std::string("exec '") + DEMCAL_BINARY + "' cutoff --tol 390 --seeds 1 --campaign '" +
+                                (dir / "c").string() + "' -- --material '" + DEMCAL_SOURCE_DIR +
+                                "/examples/materials/silo_meal_g04.json' --theta 30 --particles 600 "
+                                "--stiffness-scale 0.01 --fill-time 0.5 --threads 1";
+    const auto start = [&](const fs::path& log) {
+        const pid_t pid = ::fork();
+        if (pid == 0) {
+            ::setpgid(0, 0);
+            ::signal(SIGINT, SIG_DFL);  // as in an interactive shell's foreground job
+            ::setenv("PATH", (dir / "empty_bin").c_str(), 1);
+            const std::string cmd = command + " > '" + log.string() + "' 2>&1";
+            ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+            ::_exit(127);
+        }
+        ::setpgid(pid, pid);  // (both sides: no race with the kill below)
+        return pid;
+    };
+    const pid_t pid = start(dir / "stopped.log");
+    REQUIRE(pid > 0);
+    const fs::path run = dir / "c" / "runs" / "f0_seed1";
+    int status = 0;
+    bool ended = false;
+    // once the run is under way (it fills for about 4 s of CPU): the stop makes it write its checkpoint
+    for (int i = 0; i < 12000 && !ended && !fs::exists(run / "silo.log"); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        ended = ::waitpid(pid, &status, WNOHANG) == pid;
+    }
+    REQUIRE_FALSE(ended);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    ::killpg(pid, SIGINT);
+    ::waitpid(pid, &status, 0);
+    INFO(read_file(dir / "stopped.log"));
+    INFO(read_file(run / "silo.log"));
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 75);  // stopped: the same command continues
+    CHECK_THAT(read_file(run / "silo.log"), !Catch::Contains("Killed"));
+    CHECK(fs::exists(run / "checkpoint.bin"));
+    CHECK_FALSE(fs::exists(run / "checkpoint.bin.tmp"));
+    CHECK_FALSE(fs::exists(run / "summary.json"));
+    CHECK_FALSE(fs::exists(run / "failed"));
+
+    const pid_t again = start(dir / "again.log");
+    ::waitpid(again, &status, 0);
+    INFO(read_file(dir / "again.log"));
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) <= 1);  // a search's answer (found or not), no failure
+    CHECK_THAT(read_file(dir / "again.log"), Catch::Contains("f0_seed1 (resumed)"));
+    CHECK(fs::exists(run / "summary.json"));
+    CHECK_FALSE(fs::exists(run / "section.png"));  // --no-plots kept
     fs::remove_all(dir);
 }
