@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <string_view>
 #include <thread>
 
@@ -107,6 +108,28 @@ void refuse_empty_values(CLI::App& app) {
         opt->transform(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); }, ""));
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
+}
+
+void read_values_strictly(CLI::App& app) {
+    std::set<std::string> names{"--"};
+    for (const CLI::Option* opt : app.get_options()) {
+        for (const std::string& l : opt->get_lnames()) names.insert("--" + l);
+        for (const std::string& s : opt->get_snames()) names.insert("-" + s);
+    }
+    const CLI::Validator not_an_option(
+        [names](std::string& text) {
+            const std::string name = text.substr(0, text.find('='));
+            return names.count(name) ? "'" + analytics::shortened_text(text) + "' is an option of this command, not " +
+                                           "a value: the value is missing"
+                                     : std::string();
+        },
+        "");
+    for (CLI::Option* opt : app.get_options()) {
+        if (opt->get_type_size_max() <= 0 || !opt->nonpositional()) continue;  // a flag; the words after --
+        if (opt->get_items_expected_max() > 1) opt->allow_extra_args(false);
+        opt->transform(not_an_option);
+    }
+    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) read_values_strictly(*sub);
 }
 
 namespace {

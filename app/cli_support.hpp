@@ -31,6 +31,12 @@ CLI::Validator run_timeout();  // 0 < x <= kMaxRunTimeout
 // option the integer rule (integer_in, never clamped). Call once every command is registered.
 void refuse_empty_values(CLI::App& app);
 
+// How every option of `app` and its subcommands reads its value: a list option takes one value per occurrence (its
+// items split at commas; `cutoff --seeds 1 -- --theta 50` took the -- as a second value, and the silo options after
+// it as the small hopper's own), and a value that is one of the command's own option names, or --, is refused as a
+// value left out (`silo --out --check` ran into a folder named --check). Call once every command is registered.
+void read_values_strictly(CLI::App& app);
+
 // Refuses, once the command line is parsed and before any command runs, an option the rest of the command line makes
 // void, naming it and what it needs: --partition without --executor slurm, --yade with --engine kernel (both were
 // silently ignored: a user who meant a SLURM campaign got a local one). One rule per pair, for every command that

@@ -485,7 +485,6 @@ void add_silo_dem_options(CLI::App* diagnose, SiloDemArgs& dem) {
     diagnose->add_option("--candidates", dem.candidates,
                          "silo-dem: the DEM effects to try, by name (default: all of " + candidate_names() +
                              "; e.g. wall_friction,cohesion)")
-        ->allow_extra_args(false)  // (one value, split at commas: not the silo options after --)
         ->delimiter(',');
     diagnose->add_option("silo_args", dem.silo_args,
                          "silo-dem, after --: options of every demcal silo run (e.g. --geometry G --particles 2000 "

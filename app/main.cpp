@@ -55,6 +55,7 @@ int run_command(int argc, char** argv) {
     demcal::add_calibration_commands(app);
     demcal::add_scale_command(app);
     demcal::refuse_empty_values(app);
+    demcal::read_values_strictly(app);
     demcal::refuse_inapplicable_options(app);
     try {
         demcal::check_argument_lengths(argc, argv);

@@ -1137,3 +1137,24 @@ TEST_CASE("a DEMCAL_YADE_SCRIPTS folder without demcal's scripts is refused by t
     }
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: an option name where a value belongs is a value left out, and a list option stops before --",
+          "[cli]") {
+    // `silo --out --check` ran a whole silo into a folder named --check; `predict g.json --json --help` wrote a file
+    // named --help; `cutoff ... --seeds 1 -- --theta 50` took the -- as a second seed and ran the small hopper at 50
+    // deg instead of the silo search
+    const fs::path root = test::fresh_test_dir("hostile-option-values"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string geometry = test::source_path("examples/silo/seed_conical_30deg.json").string();
+    refused({{{"silo", "--theta", "30", "--particles", "200", "--out", "--check"},
+              {"--out: '--check' is an option of this command, not a value: the value is missing"}},
+             {{"predict", geometry, "--json", "--help"}, {"--json: '--help' is an option of this command"}},
+             {{"predict", geometry, "--json", "--"}, {"--json: '--' is an option of this command"}},
+             {{"cutoff", "--json", "--bond-number=3"}, {"--json: '--bond-number=3' is an option"}},
+             {{"cutoff", "--grains", "100", "--seeds", "1", "--", "--theta", "50"},
+              {"--grains applies to the small hopper; with silo options after --"}},
+             {{"cutoff", "--seeds", "1", "--", "--material", (dir / "none.json").string(), "--theta", "30"},
+              {"none.json' does not exist"}}},
+            dir);
+    fs::remove_all(root);
+}
