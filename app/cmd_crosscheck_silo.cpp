@@ -14,6 +14,7 @@
 #include "app/silo_settings.hpp"
 #include "kernel/silo/silo_case.hpp"
 #include "analytics/user_input.hpp"
+#include "analytics/number_text.hpp"
 #include "orchestrator/campaign_directory.hpp"
 #include "orchestrator/executor.hpp"
 #include "orchestrator/run_identity.hpp"
@@ -207,7 +208,13 @@ CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
             throw UserError("--geometry = '" + o.geometry + "': shape = " + analytics::json_value_text(geometry["shape"]) +
                             ": yade_scripts/silo.py builds the conical silo only; cross-check a conical geometry");
     }
-    if (!o.yade_material.empty()) in.yade_material = analytics::read_json_input(o.yade_material, "yade-material");
+    if (!o.yade_material.empty()) {
+        in.yade_material = analytics::read_json_input(o.yade_material, "yade-material");
+        // the report says YADE ran a different material on purpose: the same one is a void option
+        if (!o.material.empty() && in.yade_material == analytics::read_json_input(o.material, "material"))
+            throw UserError("--yade-material = '" + analytics::shortened_text(o.yade_material) +
+                            "': the same material as --material; omit it (YADE runs the bed's material)");
+    }
     for (double theta : o.thetas) check_kernel_run(o, theta);
     return in;
 }
@@ -342,7 +349,8 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
         const auto out = orchestrator::run_stored_jobs(
             store, campaign_id, jobs, *executor,
             [](const std::string& event, const orchestrator::StoredJob& job, const std::string& detail) {
-                std::cout << std::left << std::setw(9) << event << job.name
+                // a column of 9, and a space after a longer event ("retry later")
+                std::cout << event << std::string(event.size() < 9 ? 9 - event.size() : 1, ' ') << job.name
                           << (detail.empty() ? "" : " (" + detail + ")") << std::endl;
             });
         return !out.interrupted;

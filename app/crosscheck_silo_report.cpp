@@ -354,7 +354,9 @@ constexpr const char* kOwnFillSection =
 // What holds over all angles, for the closing lines.
 struct Verdict {
     bool all_agree = true, all_patterns_agree = true, all_patterns_determined = true;
+    std::size_t compared = 0;  // angles at which both codes' runs are there: the verdicts hold over these only
     void add(const Comparison& c) {
+        ++compared;
         all_agree = all_agree && c.agree;
         all_patterns_agree = all_patterns_agree && (c.patterns_agree || !c.patterns_determined);
         all_patterns_determined = all_patterns_determined && c.patterns_determined;
@@ -362,6 +364,12 @@ struct Verdict {
 };
 
 std::string closing_text(const ReportSettings& s, const Verdict& v) {
+    if (v.compared == 0)
+        return "\nNo angle could be compared: a run of every angle failed (see the rows above); nothing is concluded.\n";
+    const std::string at_every = v.compared == s.thetas.size()
+                                     ? "at every angle"
+                                     : "at every angle compared (" + std::to_string(v.compared) + " of " +
+                                           std::to_string(s.thetas.size()) + ")";
     std::ostringstream md;
     md << "\nThe kernel ran "
        << (s.kernel_law == kernel::silo::SiloContactLaw::yade ? "YADE's Hertz-Mindlin (--kernel-law yade)"
@@ -375,13 +383,13 @@ std::string closing_text(const ReportSettings& s, const Verdict& v) {
                                    std::to_string(s.wall_facets) + ")"
                              : std::string())
        << ".\n\nRates agree when YADE / kernel lies within 1 +/- " << g(s.tolerance)
-       << (v.all_agree ? ": they do at every angle." : ": **they do not at every angle**.");
+       << (v.all_agree ? ": they do " + at_every + "." : ": **they do not " + at_every + "**.");
     if (!s.yade_material.is_null())
         md << " YADE ran a different material on purpose (--yade-material " << s.yade_material_file << ").";
     md << " Flow patterns: YADE's frames (at the kernel's frame interval) classified by the kernel's own "
           "classifier with the kernel's settings; "
-       << (!v.all_patterns_agree        ? "**not the same at every angle** (marked)."
-           : v.all_patterns_determined  ? "the same at every angle."
+       << (!v.all_patterns_agree        ? "**not the same " + at_every + "** (marked)."
+           : v.all_patterns_determined  ? "the same " + at_every + "."
                                         : "the same wherever both were determined (see each report's message for "
                                           "the others).")
        << "\n\nDifferences YADE cannot remove (yade_scripts/README.md):\n";
@@ -446,9 +454,13 @@ Report write_report(const fs::path& root, const ReportSettings& s) {
     md << closing_text(s, verdict);
     if (own_fill_too) md << kOwnFillSection << own_fill_md.str();
     report["fill_mode"] = s.fill_text;
-    report["rates_agree"] = verdict.all_agree;
-    report["patterns_agree"] = verdict.all_patterns_agree;  // at every angle where both codes determined one
-    report["patterns_determined"] = verdict.all_patterns_determined;
+    // over the angles compared; null where none was (a failed run is no agreement)
+    const auto over_compared = [&](bool value) { return verdict.compared > 0 ? json(value) : json(nullptr); };
+    report["angles_compared"] = verdict.compared;
+    report["complete"] = out.complete;
+    report["rates_agree"] = over_compared(verdict.all_agree);
+    report["patterns_agree"] = over_compared(verdict.all_patterns_agree);  // where both codes determined one
+    report["patterns_determined"] = over_compared(verdict.all_patterns_determined);
     write_result_file(root / "crosscheck_silo.json", report.dump(2) + "\n");
     write_result_file(root / "crosscheck_silo.md", md.str());
     out.markdown = md.str();

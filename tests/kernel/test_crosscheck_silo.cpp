@@ -80,6 +80,22 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     CHECK(mismatch["angles"][0]["rates_agree"] == false);
     CHECK(mismatch["angles"][0]["yade_material_as_bed"] == false);
     CHECK(read_file(dir / "third.log").find("DIFFER") != std::string::npos);
+    // the same file for both codes is no mismatch: a void option, refused
+    CHECK(run_demcal(args + " --material '" + (dir / "mismatch.json").string() + "' --yade-material '" +
+                         (dir / "mismatch.json").string() + "'",
+                     dir / "same.log") == 2);
+    CHECK_THAT(read_file(dir / "same.log"), Catch::Contains("the same material as --material"));
+    // YADE killed at its timeout: nothing compared, and the report says so (it said "rates agree" and exit 1)
+    const std::string timed_out = "crosscheck silo --theta 45 --particles 200 --stiffness-scale 1e-3 --max-time 1 "
+                                  "--timeout 0.5 --jobs 1 -c '" + (dir / "t").string() + "'";
+    CHECK(run_demcal(timed_out, dir / "timeout.log") == 1);
+    CHECK_THAT(read_file(dir / "timeout.log"), Catch::Contains("retry later theta_45 yade"));
+    const auto none = nlohmann::json::parse(read_file(dir / "t" / "crosscheck_silo.json"));
+    CHECK(none["angles_compared"] == 0);
+    CHECK(none["complete"] == false);
+    CHECK(none["rates_agree"].is_null());
+    CHECK(none["patterns_agree"].is_null());
+    CHECK_THAT(read_file(dir / "t" / "crosscheck_silo.md"), Catch::Contains("No angle could be compared"));
     // a bad angle: exit 2, named, nothing run
     CHECK(run_demcal("crosscheck silo --theta 95 -c '" + (dir / "bad").string() + "'", dir / "bad.log") == 2);
     CHECK(read_file(dir / "bad.log").find("theta") != std::string::npos);
