@@ -1,6 +1,7 @@
 #include "analytics/diagnose_model.hpp"
 
 #include "analytics/discharge_models.hpp"
+#include "analytics/failure_line.hpp"
 
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_fit.h>
@@ -203,6 +204,8 @@ Model failure_line_model(const MeasuredData& d, Setting& s) {
     if (is_constant(d.at("sigma_Pa")))
         throw std::invalid_argument("sigma_Pa: every row has the normal stress " + short_number(sigma.front()) +
                                     " Pa: a failure line needs at least two different normal stresses");
+    const auto [lowest, highest] = std::minmax_element(sigma.begin(), sigma.end());
+    check_normal_stress_spread(*lowest, *highest, "sigma_Pa");  // 5000, 5000.0000001, ... gave mu_b = 3.7e8
     m.relative = false;
     m.param_names = {"mu_b", "tau_c_Pa"};
     double c0 = 0, c1 = 0, c00, c01, c11, sse;

@@ -25,17 +25,20 @@ void check_failure_line_design(std::span<const double> normal_stresses, int repl
                                     std::to_string(distinct.size()));
     // stresses closer than the box's servo holds them (a few % of the target, up to 15 % in a small box) make a line
     // of that noise: 5000, 5000.0000001, 5000.0000002 Pa gave mu_b = 2e9 with exit 0
-    const double lowest = *distinct.begin(), highest = *distinct.rbegin();
-    if (highest - lowest < kMinNormalStressSpread * std::fabs(highest))
-        throw std::invalid_argument("normal-stress: " + number_text(lowest) + " to " + number_text(highest) +
-                                    " Pa: a failure line needs normal stresses at least " +
-                                    number_text(100 * kMinNormalStressSpread) +
-                                    " % apart (the largest - the smallest), more than the box's servo spreads them");
+    check_normal_stress_spread(*distinct.begin(), *distinct.rbegin(), "normal-stress");
     if (static_cast<double>(distinct.size()) * replicates < 3)
         throw std::invalid_argument("replicates = " + std::to_string(replicates) + " at " +
                                     std::to_string(distinct.size()) +
                                     " distinct normal-stress values: a failure line needs at least 3 points (a line "
                                     "through 2 leaves nothing to estimate its uncertainty)");
+}
+
+void check_normal_stress_spread(double lowest, double highest, const std::string& field) {
+    if (highest - lowest < kMinNormalStressSpread * std::fabs(highest))
+        throw std::invalid_argument(field + ": " + number_text(lowest) + " to " + number_text(highest) +
+                                    " Pa: a failure line needs normal stresses at least " +
+                                    number_text(100 * kMinNormalStressSpread) +
+                                    " % apart (the largest - the smallest): closer ones give a line through their noise");
 }
 
 FailureLine fit_failure_line(std::span<const double> sigma, std::span<const double> tau, double confidence) {

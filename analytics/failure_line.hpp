@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <span>
+#include <string>
 
 namespace demcal::analytics {
 
@@ -43,7 +44,11 @@ FailureLine fit_failure_line(std::span<const double> sigma, std::span<const doub
 // stresses and 3 points. Throws std::invalid_argument naming --normal-stress or --replicates and the values, so that
 // a campaign whose line cannot be fitted is refused before its runs, not after them.
 void check_failure_line_design(std::span<const double> normal_stresses, int replicates);
-// The smallest spread of a design's normal stresses, (largest - smallest) / largest.
+// The smallest spread of a design's normal stresses, (largest - smallest) / largest: more than a simulated box's
+// servo spreads a stress, and below what a Jenike test's loads span (a factor of 2-4).
 inline constexpr double kMinNormalStressSpread = 0.2;
+// Throws std::invalid_argument naming `field` and the range when normal stresses from `lowest` to `highest` spread
+// less than kMinNormalStressSpread: a line through them is a line through their noise.
+void check_normal_stress_spread(double lowest, double highest, const std::string& field);
 
 }  // namespace demcal::analytics

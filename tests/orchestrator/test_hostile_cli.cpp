@@ -1158,3 +1158,16 @@ TEST_CASE("probe 57: an option name where a value belongs is a value left out, a
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: measured normal stresses closer than a failure line can tell apart are refused, as a campaign's",
+          "[cli]") {
+    // diagnose fitted 5000 .. 5000.0000002 Pa: mu_b = 3.7e8, tau_c = -1.9e12 Pa, "determined", exit 0
+    const fs::path root = test::fresh_test_dir("hostile-close-stresses"), dir = root / "work";
+    fs::create_directories(dir);
+    const fs::path csv = root / "close.csv";
+    std::ofstream(csv) << "sigma_Pa,tau_Pa\n5000,3000\n5000.0000001,3100\n5000.0000002,3050\n5000.0000001,3080\n";
+    refused({{{"diagnose", "--model", "failure-line", "--data", csv.string(), "--json", (dir / "d.json").string()},
+              {"sigma_Pa: 5000 to 5000 Pa", "at least 20 % apart"}}},
+            dir);
+    fs::remove_all(root);
+}
