@@ -159,7 +159,16 @@ constexpr OptionNeeds kOptionNeeds[] = {
     {"partition", "executor", "slurm", "local", "a SLURM partition"},
     {"yade", "engine", "yade", "yade", "YADE's launcher"},
     {"grid-points", "method", "grid", "surrogate", "the grid's points per parameter"},
+    {"sequential", "method", "surrogate", "surrogate", "the surrogate loop's order (slope, then cohesion)"},
 };
+
+// Two options of which the second makes the first void: given together, one was ignored (silo's --dt with
+// --dt-fraction recorded a fraction it did not run; --plot svg with --no-plot drew nothing).
+struct ExclusiveOptions {
+    const char* option;
+    const char* other;
+};
+constexpr ExclusiveOptions kExclusiveOptions[] = {{"dt-fraction", "dt"}, {"plot", "no-plot"}};
 
 // A local pool of --jobs runs takes that many cores and the memory of as many simulations (YADE: about 250 MB each):
 // `-j 1000` on a laptop is a typo that takes the machine down, not a plan. Four per core leaves room to oversubscribe
@@ -193,9 +202,19 @@ void check_options_apply(const CLI::App& cmd) {
         if (!opt || !other || opt->count() == 0) continue;
         const std::string value = value_or_default(*other, rule.other_default);
         if (value == rule.value) continue;
-        throw UserError(std::string("--") + rule.option + " = '" + analytics::shortened_text(opt->as<std::string>()) +
-                        "' is " + rule.what + ": it applies to --" + rule.other + " " + rule.value + " only (this " +
-                        "command runs with --" + rule.other + " " + value + ")");
+        const std::string given = opt->get_expected_max() == 0  // a flag has no value to show
+                                      ? std::string("--") + rule.option
+                                      : std::string("--") + rule.option + " = '" +
+                                            analytics::shortened_text(opt->as<std::string>()) + "'";
+        throw UserError(given + " is " + rule.what + ": it applies to --" + rule.other + " " + rule.value +
+                        " only (this command runs with --" + rule.other + " " + value + ")");
+    }
+    for (const ExclusiveOptions& pair : kExclusiveOptions) {
+        const CLI::Option* opt = option_named(cmd, pair.option);
+        const CLI::Option* other = option_named(cmd, pair.other);
+        if (opt && other && opt->count() > 0 && other->count() > 0)
+            throw UserError(std::string("--") + pair.option + " and --" + pair.other + ": --" + pair.other +
+                            " makes --" + pair.option + " void; give one of the two");
     }
     check_local_jobs(cmd);
     for (const CLI::App* sub : cmd.get_subcommands()) check_options_apply(*sub);

@@ -1171,3 +1171,20 @@ TEST_CASE("probe 57: measured normal stresses closer than a failure line can tel
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: two options of which one makes the other void are refused together, by name", "[cli]") {
+    // silo --dt 1e-5 --dt-fraction 0.9 ran at --dt and recorded the fraction 0.9 in its summary; --plot svg with
+    // --no-plot drew nothing; calibrate --method grid --sequential ignored --sequential
+    const fs::path root = test::fresh_test_dir("hostile-void-pairs"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    refused({{{"silo", "--theta", "30", "--dt", "1e-5", "--dt-fraction", "0.9", "--out", (dir / "s").string()},
+              {"--dt-fraction and --dt: --dt makes --dt-fraction void"}},
+             {{"scale", tiny, "--radii", "1e-3,2e-3", "--no-plot", "--plot", "svg", "-c", (dir / "c").string()},
+              {"--plot and --no-plot"}},
+             {{"calibrate", "--start", tiny, "--engine", "kernel", "--method", "grid", "--sequential", "--target",
+               "mu_b=0.5,tau_c=1000", "-o", (dir / "cal.json").string()},
+              {"--sequential is the surrogate loop's order", "--method surrogate only"}}},
+            dir);
+    fs::remove_all(root);
+}
