@@ -576,6 +576,33 @@ void check_out_folder_free(const fs::path& dir) {
                             "another --out (a new or empty folder), or remove it");
 }
 
+// Refuses a --vtk folder that already holds snapshots (silo_*.vtk) for a new run: it replaced a user's file of that
+// name, and a second run there overwrote the first run's first frames and left its later ones, one mixed series.
+void check_vtk_folder_free(const std::string& vtk_dir) {
+    std::error_code ec;
+    for (fs::directory_iterator it(vtk_dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.rfind("silo_", 0) == 0 && it->path().extension() == ".vtk")
+            throw UserError("vtk = '" + vtk_dir + "' already holds snapshots (" + name + "): give a new or empty "
+                            "folder, or remove them");
+    }
+}
+
+// The VTK folder's lock, for the whole run (two runs wrote one series), unless it is the output folder (locked as
+// such). Made again on a resume where it was removed.
+std::unique_ptr<orchestrator::FolderLock> lock_vtk_folder(const std::string& vtk_dir, const fs::path& out_dir) {
+    if (vtk_dir.empty()) return nullptr;
+    std::error_code ec;
+    fs::create_directories(vtk_dir, ec);
+    if (ec) throw UserError("vtk = '" + vtk_dir + "': cannot create the directory: " + ec.message());
+    if (fs::equivalent(vtk_dir, out_dir, ec)) return nullptr;
+    try {
+        return std::make_unique<orchestrator::FolderLock>(vtk_dir, "silo VTK folder");
+    } catch (const std::runtime_error& e) {
+        throw UserError(e.what());
+    }
+}
+
 void check_checkpoint_options(const SiloCli& o, const CLI::App& sub) {
     if (o.no_checkpoint && o.wall_limit > 0)
         throw UserError("--wall-limit " + ks::setting_text(o.wall_limit) +
@@ -589,7 +616,10 @@ void check_checkpoint_options(const SiloCli& o, const CLI::App& sub) {
 // to resume from a checkpoint it could never write): the VTK folder, the run's files apart from its inputs, and the
 // exported beds, whose writers are attached to the run here.
 void prepare_outputs(const SiloCli& o, const fs::path& dir, ks::SiloCaseSettings& s) {
-    if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk");
+    if (!s.vtk_dir.empty()) {
+        check_output_folder(s.vtk_dir, "--vtk");
+        check_vtk_folder_free(s.vtk_dir);
+    }
     std::vector<NamedPath> outputs{{dir.string(), "--out"}};
     for (const char* name : kRunFiles) outputs.push_back({(dir / name).string(), std::string("--out's ") + name});
     outputs.insert(outputs.end(), {{o.export_bed, "--export-bed"}, {o.export_final_bed, "--export-final-bed"},
@@ -664,6 +694,8 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     const auto lock = lock_output_folder(dir);
     if (fs::exists(dir / kCheckpointName) || fs::is_regular_file(dir / "summary.json"))
         throw UserError("out = '" + dir.string() + "': another demcal has just run into this folder");
+    const auto vtk_lock = lock_vtk_folder(s.vtk_dir, dir);
+    if (!s.vtk_dir.empty()) check_vtk_folder_free(s.vtk_dir);  // a run started beside this one
     if (!o.no_checkpoint) {
         s.checkpoint_file = (dir / kCheckpointName).string();
         s.checkpoint_interval = o.checkpoint_every;
@@ -710,6 +742,7 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     check_output_folder(dir.string(), "--resume");
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "vtk (the run's snapshot folder, in its checkpoint)");
     const auto lock = lock_output_folder(dir);  // two resumes of one run read and wrote one checkpoint at once
+    const auto vtk_lock = lock_vtk_folder(s.vtk_dir, dir);
     if (!o.no_plots) require_gnuplot("--no-plots");
     if (!fs::exists(file)) throw UserError("resume = '" + dir.string() + "': another demcal has just finished it");
     s.threads = threads;

@@ -1188,3 +1188,17 @@ TEST_CASE("probe 57: two options of which one makes the other void are refused t
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: a VTK folder that already holds snapshots is refused for a new run, the user's file kept",
+          "[cli]") {
+    // --vtk replaced a user's silo_000000.vtk, and a second run into one folder left a mixed series of both runs
+    const fs::path root = test::fresh_test_dir("hostile-vtk-folder"), dir = root / "work";
+    fs::create_directories(dir / "vtk");
+    std::ofstream(dir / "vtk" / "silo_000000.vtk") << "precious\n";
+    refused({{{"silo", "--theta", "30", "--particles", "200", "--out", (dir / "s").string(), "--vtk",
+               (dir / "vtk").string()},
+              {"vtk = '", "already holds snapshots (silo_000000.vtk)"}}},
+            dir);
+    CHECK(test::read_file(dir / "vtk" / "silo_000000.vtk") == "precious\n");
+    fs::remove_all(root);
+}
