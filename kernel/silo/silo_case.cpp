@@ -410,28 +410,42 @@ void validate_run_control(const SiloCaseSettings& s) {
         reject_setting("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
 }
 
+// Hertz's overlap of a head-on impact at `speed`: delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5).
+double hertz_impact_overlap(double m_star, double r_star, double e_star, double speed) {
+  return std::pow(15 * m_star * speed * speed / (16 * e_star * std::sqrt(r_star)), 0.4);
+}
+
 void validate_contact_softness(const SiloCaseSettings& s) {
-    // Contacts so soft that two grains meeting at the speed of a fall through the whole silo would overlap by more
-    // than the smallest sphere's radius pass through each other (a stiffness_scale of 1e-12 gave a 2 s time step and every grain fell through the walls). Hertz's impact
-    // overlap, two grains head on: delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5), m* = m/2, R* = r/2, E* = E/(2(1-nu^2)).
-    // The reduced cases' 1e-3 gives 0.6 r; 1e-4 would give 1.6 r.
-    const double grain_mass = mass_of_grain(s.materials);
-    const double smallest_radius = smallest_sphere_radius(s.materials);
-    const Material grain = s.materials.wheat_scaled();
-    const double young = 2 * grain.shear_modulus * (1 + grain.poisson);
-    const double e_star = young / (2 * (1 - grain.poisson * grain.poisson));
-    const double speed = std::sqrt(2 * std::abs(s.gravity) * s.geometry.top()) +
-                         (s.vibration.vibrates() ? s.vibration.peak_velocity() : 0.0);
-    const double impact_overlap =
-        std::pow(15 * 0.5 * grain_mass * speed * speed / (16 * e_star * std::sqrt(0.5 * smallest_radius)), 0.4);
-    if (!(impact_overlap <= smallest_radius))
-        reject_setting("stiffness_scale", s.materials.stiffness_scale,
-                       "makes the grains so soft that two meeting at " + setting_text(speed) +
-                           " m/s (a fall through the silo) would overlap by " + setting_text(impact_overlap / smallest_radius) +
-                           " sphere radii: they would pass through each other; at least " +
-                           setting_text(s.materials.stiffness_scale *
-                                        std::pow(impact_overlap / smallest_radius, 2.5)) +
-                           " for this material and silo");
+  // Contacts so soft that a grain meeting another, or a wall, at the speed of a fall through the whole silo would
+  // overlap by more than the smallest sphere's radius pass through (a stiffness_scale of 1e-12 gave a 2 s time step and
+  // every grain fell through the walls; a wall of G = 1 kPa let every grain through, reported as an empty silo with
+  // exit 0). Two grains head on: m* = m/2, R* = r/2, E* = E/(2(1-nu^2)); a grain on a wall: m* = m, R* = r,
+  // 1/E* = (1-nu^2)/E + (1-nu_w^2)/E_w. The reduced cases' 1e-3 gives 0.6 r; 1e-4 would give 1.6 r.
+  const double grain_mass = mass_of_grain(s.materials);
+  const double smallest_radius = smallest_sphere_radius(s.materials);
+  const Material grain = s.materials.wheat_scaled(), wall = s.materials.steel_scaled();
+  const auto young = [](const Material& m) { return 2 * m.shear_modulus * (1 + m.poisson); };
+  const auto compliance = [&](const Material& m) { return (1 - m.poisson * m.poisson) / young(m); };
+  const double speed = std::sqrt(2 * std::abs(s.gravity) * s.geometry.top()) +
+                       (s.vibration.vibrates() ? s.vibration.peak_velocity() : 0.0);
+  const double grains_overlap =
+      hertz_impact_overlap(0.5 * grain_mass, 0.5 * smallest_radius, 1 / (2 * compliance(grain)), speed);
+  const double wall_overlap =
+      hertz_impact_overlap(grain_mass, smallest_radius, 1 / (compliance(grain) + compliance(wall)), speed);
+  const std::string meeting = " m/s (a fall through the silo) would overlap by ";
+  if (!(grains_overlap <= smallest_radius))
+    reject_setting("stiffness_scale", s.materials.stiffness_scale,
+                   "makes the grains so soft that two meeting at " + setting_text(speed) + meeting +
+                       setting_text(grains_overlap / smallest_radius) +
+                       " sphere radii: they would pass through each other; at least " +
+                       setting_text(s.materials.stiffness_scale * std::pow(grains_overlap / smallest_radius, 2.5)) +
+                       " for this material and silo");
+  if (!(wall_overlap <= smallest_radius))
+    reject_setting("wall.shear_modulus_Pa", s.materials.steel.shear_modulus,
+                   "scaled by the stiffness scale " + setting_text(s.materials.stiffness_scale) +
+                       ", makes the walls so soft that a grain meeting one at " + setting_text(speed) + meeting +
+                       setting_text(wall_overlap / smallest_radius) +
+                       " sphere radii: it would pass through the wall");
 }
 
 }  // namespace

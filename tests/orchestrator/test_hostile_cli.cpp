@@ -1202,3 +1202,17 @@ TEST_CASE("probe 57: a VTK folder that already holds snapshots is refused for a 
     CHECK(test::read_file(dir / "vtk" / "silo_000000.vtk") == "precious\n");
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: a wall so soft that a falling grain passes through it is refused, the field named", "[cli]") {
+    // a wall of G = 1 kPa let every grain through: "bulk density 0 kg/m^3", an empty silo, exit 0
+    const fs::path root = test::fresh_test_dir("hostile-soft-wall"), dir = root / "work";
+    fs::create_directories(dir);
+    auto material = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/silo_wheat_table21.json")));
+    material["wall"]["shear_modulus_Pa"] = 1e3;
+    std::ofstream(root / "soft_wall.json") << material.dump();
+    refused({{{"silo", "--theta", "30", "--particles", "300", "--stiffness-scale", "0.01", "--material",
+               (root / "soft_wall.json").string(), "--out", (dir / "s").string()},
+              {"wall.shear_modulus_Pa = 1000", "it would pass through the wall"}}},
+            dir);
+    fs::remove_all(root);
+}
