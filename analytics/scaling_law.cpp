@@ -8,12 +8,24 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace demcal::analytics {
+
+void check_radius_spacing(std::vector<double> radii, const std::string& field) {
+    std::sort(radii.begin(), radii.end());
+    for (std::size_t i = 1; i < radii.size(); ++i)
+        if (radii[i] - radii[i - 1] < kMinRadiusStep * std::fabs(radii[i])) {
+            std::ostringstream o;
+            o << std::setprecision(12) << field << ": " << radii[i - 1] << " and " << radii[i] << " m differ by less than "
+              << 100 * kMinRadiusStep << " %: one radius for a scaling law (give radii further apart)";
+            throw std::invalid_argument(o.str());
+        }
+}
 
 namespace {
 

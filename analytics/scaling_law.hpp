@@ -35,6 +35,14 @@ struct ScalingLawFit {
     nlohmann::json to_json() const;
 };
 
+// Radii closer than this (relative to the larger of two) are one radius for a scaling law: a packing does not tell
+// them apart, and a law through them is a law through their noise (1e-3, 1.0000001e-3, 1.0000002e-3 m fitted
+// E = 4e17 r - 4e14 Pa, "determined", R^2 = 1).
+inline constexpr double kMinRadiusStep = 0.01;
+// Throws std::invalid_argument naming `field` and the two radii when two of `radii` (any order) are closer than
+// kMinRadiusStep.
+void check_radius_spacing(std::vector<double> radii, const std::string& field);
+
 // y = A r + B by weighted least squares (gsl_fit_wlinear; sigma empty = equal weights, scale from the residuals).
 // Needs >= 3 points on >= 2 distinct r; throws std::invalid_argument naming the problem otherwise.
 ScalingLawFit fit_linear_law(std::span<const double> r, std::span<const double> y, std::span<const double> sigma = {},

@@ -510,6 +510,11 @@ EnlargementPoints read_enlargement_points(const std::vector<std::string>& materi
         p.nu.push_back(m.at("poisson_ratio").get<double>());
     }
     if (p.r.size() < 3) throw UserError("materials: " + std::to_string(p.r.size()) + " given, need at least 3 radii");
+    try {
+        analytics::check_radius_spacing(p.r, "materials' particle_radius");
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
     return p;
 }
 

@@ -43,6 +43,19 @@ void check_quantity(const std::string& quantity) {
     if (quantity != "mu_b" && quantity != "tau_c")
         throw std::invalid_argument("target quantity '" + quantity + "' is not one of mu_b, tau_c");
 }
+
+// The targets a bulk material can have: an angle of internal friction below 85 deg (mu_b = 1e9, 89.99999994 deg,
+// started a study) and a cohesion up to 100 MPa (beyond a weak rock's). `shown` names where the value came from.
+constexpr double kMaxTargetMuB = 11.43;  // tan(85 deg)
+constexpr double kMaxTargetTauC = 1e8;   // [Pa]
+void check_target_value(const std::string& quantity, double value, const std::string& shown) {
+    if (quantity == "mu_b" && !(value > 0 && value <= kMaxTargetMuB))
+        throw std::invalid_argument(shown + ": mu_b must be > 0 and at most " + analytics::number_text(kMaxTargetMuB) +
+                                    " (an angle of internal friction below 85 deg)");
+    if (quantity == "tau_c" && !(value >= 0 && value <= kMaxTargetTauC))
+        throw std::invalid_argument(shown + ": tau_c must be >= 0 and at most " + analytics::number_text(kMaxTargetTauC) +
+                                    " Pa (a cohesion [Pa])");
+}
 }  // namespace
 
 double macro_value(const analytics::FailureLine& line, const std::string& quantity) {
@@ -66,6 +79,9 @@ double MacroTarget::acceptance(double tolerance) const {
 
 std::vector<MacroTarget> parse_targets(const std::string& text) {
     std::vector<MacroTarget> targets;
+    if (!text.empty() && (text.back() == ',' || text.front() == ',' || text.find(",,") != std::string::npos))
+        throw std::invalid_argument("target = '" + analytics::shortened_text(text) +
+                                    "' has an empty item (two commas in a row, or one at an end)");
     std::stringstream items(text);
     std::string item;
     while (std::getline(items, item, ',')) {
@@ -84,10 +100,12 @@ std::vector<MacroTarget> parse_targets(const std::string& text) {
             throw std::invalid_argument("target " + t.quantity + " = '" + analytics::shortened_text(value) + "' " +
                                         *number.defect);
         t.value = number.value;
-        if (t.quantity == "mu_b" && !(t.value > 0))
-            throw std::invalid_argument("target mu_b = " + value + " must be > 0 (a friction coefficient)");
-        if (t.quantity == "tau_c" && t.value < 0)
-            throw std::invalid_argument("target tau_c = " + value + " must be >= 0 (a cohesion [Pa])");
+        const std::string shown = "target " + t.quantity + " = " + analytics::shortened_text(value);
+        check_target_value(t.quantity, t.value, shown);
+        // a band of tol x |0| = 0 Pa: no simulated line ever meets it, and the loop divides by it
+        if (t.quantity == "tau_c" && t.value == 0)
+            throw std::invalid_argument(shown + ": a tolerance relative to 0 Pa is 0 Pa, which no simulated line "
+                                        "meets; give a cohesion > 0, or --measured (its interval is the band)");
         for (const auto& other : targets)
             if (other.quantity == t.quantity) throw std::invalid_argument("target " + t.quantity + " is given twice");
         targets.push_back(t);
@@ -105,7 +123,13 @@ std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigm
                                         "): stresses must be >= 0 Pa");
     const auto line = analytics::fit_failure_line(sigma, tau, confidence);
     std::vector<MacroTarget> targets;
-    for (const auto& q : macro_quantities()) targets.push_back({q, macro_value(line, q), macro_half_width(line, q)});
+    for (const auto& q : macro_quantities()) {
+        targets.push_back({q, macro_value(line, q), macro_half_width(line, q)});
+        // a measured line's own values: a shear stress 600,000 times the normal one gave mu_b = 6e5
+        if (q == "mu_b" || targets.back().value > 0)  // (a measured line may cross 0 a little below: tau_c < 0 is noise)
+            check_target_value(q, targets.back().value, "the measured failure line's " + q + " = " +
+                                                            analytics::number_text(targets.back().value));
+    }
     return targets;
 }
 

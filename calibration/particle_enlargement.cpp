@@ -75,6 +75,7 @@ void check_radii(const std::vector<double>& radii) {
                                         " m after " + num(radii[i - 1]) +
                                         " m; the radii must increase (the first is the reference)");
     }
+    analytics::check_radius_spacing(radii, "radii");
 }
 
 // Every evaluation of the study goes through here: counts, and CPU of each distinct failure line once.

@@ -1216,3 +1216,25 @@ TEST_CASE("probe 57: a wall so soft that a falling grain passes through it is re
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: calibration targets no bulk material has, and radii a law cannot tell apart, are refused",
+          "[cli]") {
+    // tau_c=0 gave an acceptance band of 0 Pa (never met, divided by); mu_b=1e9 (89.99999994 deg) and a measured
+    // shear stress 600,000 times the normal one started studies; 'mu_b=0.55,' passed its empty item; radii 1e-7
+    // apart started a scale study
+    const fs::path root = test::fresh_test_dir("hostile-targets"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const auto calibrate = [&](const std::string& option, const std::string& value) {
+        return std::vector<std::string>{"calibrate", "--start", tiny, "--engine", "kernel", option, value, "-o",
+                                        (dir / "cal.json").string()};
+    };
+    refused({{calibrate("--target", "tau_c=0"), {"target tau_c = 0", "no simulated line meets"}},
+             {calibrate("--target", "mu_b=1e9"), {"target mu_b = 1e9", "below 85 deg"}},
+             {calibrate("--target", "mu_b=0.55,"), {"'mu_b=0.55,' has an empty item"}},
+             {calibrate("--measured", "5000:3000,10000:6000,15000:9e9"), {"the measured failure line's mu_b"}},
+             {{"scale", tiny, "--radii", "1e-3,1.0000001e-3,1.0000002e-3", "-c", (dir / "c").string()},
+              {"radii: 0.001 and 0.0010000001 m differ by less than 1 %"}}},
+            dir);
+    fs::remove_all(root);
+}
