@@ -52,6 +52,8 @@ std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<
         if (!ok) throw UserError(option + " '" + item + "' is not of the form NAME=LOW:HIGH");
         const std::string name = item.substr(0, eq);
         if (!orchestrator::find_shear_param(name)) throw UserError(option + " '" + item + "': unknown parameter '" + name + "'");
+        if (out.count(name))  // the last one silently won
+            throw UserError(option + " '" + item + "': a range for " + name + " is given twice");
         out[name] = {lo, hi};
     }
     return out;

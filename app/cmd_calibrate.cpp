@@ -16,6 +16,7 @@
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_params.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -75,7 +76,16 @@ SensitivityOptions sensitivity_options(const SensitivityCli& o) {
     s.params = o.params;
     s.levels = o.levels;
     s.relative_span = o.span;
-    s.ranges = parse_ranges(o.ranges, "range");
+    s.ranges = parse_ranges(o.ranges, "--range");
+    for (std::size_t i = 0; i < o.params.size(); ++i)  // one parameter twice is one factor counted twice
+        if (std::find(o.params.begin(), o.params.begin() + i, o.params[i]) != o.params.begin() + i)
+            throw UserError("--params: " + o.params[i] + " is given twice");
+    // a range for a parameter the study does not vary was silently ignored
+    if (!o.params.empty())
+        for (const auto& [name, range] : s.ranges)
+            if (std::find(o.params.begin(), o.params.end(), name) == o.params.end())
+                throw UserError("--range " + name + "=...: " + name + " is not among --params; add it there or drop "
+                                "the range");
     s.shape.criterion = analytics::shape_criterion_from_string(o.criterion);
     s.shape.alpha = o.alpha;
     s.line = line_kind_from_string(o.campaign.line);
@@ -365,7 +375,7 @@ void run_calibrate(CalibrateCli& o) {
     check_paths_apart({{o.start_file, "start"}, {o.sensitivity_file, "sensitivity"}}, {{o.output, "output"}});
     const auto start = orchestrator::validate_material(read_json_file(o.start_file, "start"), o.start_file);
     const auto targets = targets_of(o);
-    const auto bounds = parse_ranges(o.bounds, "bounds");
+    const auto bounds = parse_ranges(o.bounds, "--bounds");
     const CalibrationOptions options = calibration_options(o);
     check_calibrate_options(o, start, targets, bounds, options);
     SensitivityStudy study;

@@ -45,10 +45,10 @@ calibration::EnlargementOptions enlargement_options(const ScaleCli& o) {
     e.trend.alpha = o.alpha;
     e.study.levels = o.levels;
     e.study.relative_span = o.span;
-    e.study.ranges = parse_ranges(o.ranges, "range");
+    e.study.ranges = parse_ranges(o.ranges, "--range");
     e.calibration.max_evaluations = o.max_evaluations;
     e.calibration.accept_simulated_interval = !o.strict;
-    e.bounds = parse_ranges(o.bounds, "bounds");
+    e.bounds = parse_ranges(o.bounds, "--bounds");
     e.fit_unconverged = o.allow_unconverged;
     e.point_targets = o.point_targets;
     return e;

@@ -1238,3 +1238,22 @@ TEST_CASE("probe 57: calibration targets no bulk material has, and radii a law c
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: a study's range for a parameter it does not vary, a range or a parameter given twice, are refused",
+          "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-study-design"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "c").string();
+    refused({{{"sensitivity", tiny, "--engine", "kernel", "--params", "young_modulus", "--range",
+               "friction_coefficient=0.1:0.9", "-c", camp},
+              {"--range friction_coefficient=...: friction_coefficient is not among --params"}},
+             {{"sensitivity", tiny, "--engine", "kernel", "--range", "friction_coefficient=0.1:0.9", "--range",
+               "friction_coefficient=0.2:0.5", "-c", camp},
+              {"--range 'friction_coefficient=0.2:0.5': a range for friction_coefficient is given twice"}},
+             {{"calibrate", "--start", tiny, "--engine", "kernel", "--params", "friction_coefficient,friction_coefficient",
+               "--target", "mu_b=0.5", "-o", (dir / "cal.json").string()},
+              {"--params: friction_coefficient is given twice"}}},
+            dir);
+    fs::remove_all(root);
+}
