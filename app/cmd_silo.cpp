@@ -1077,9 +1077,13 @@ ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options,
     SiloCli o;
     add_silo_options(&parser, o);
     refuse_empty_values(parser);  // the number rule, as on demcal silo's own command line
+    read_values_strictly(parser);
     std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
     try {
         parser.parse(reversed);
+    } catch (const CLI::Success&) {  // -h after --: CLI11's own text said "This should be caught in your main function"
+        throw UserError("silo options of " + owner + ": -h/--help after --: `demcal silo --help` lists the silo "
+                        "options, `demcal " + owner.substr(owner.rfind(' ') + 1) + " --help` this command's");
     } catch (const CLI::ParseError& e) {
         throw UserError("silo options of " + owner + ": " + e.what());
     }

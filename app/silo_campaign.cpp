@@ -158,7 +158,15 @@ void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
         text << is.rdbuf();
         is.close();
         fs::remove(log);
-        if (exit_status(status) != 0) throw UserError("run " + plan.name + ": " + text.str().substr(0, 500));
+        if (exit_status(status) != 0) {
+            // the run's own refusal, one line: without its "demcal: error: " (the caller's message has one) and its
+            // closing newline (shown as a literal \n at the end of the caller's line)
+            std::string why = text.str().substr(0, 500);
+            constexpr std::string_view prefix = "demcal: error: ";
+            if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
+            while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+            throw UserError("run " + plan.name + ": " + why);
+        }
     }
 }
 

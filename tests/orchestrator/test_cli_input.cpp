@@ -57,7 +57,7 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
          "shear: 2 normal stresses x 600 replicates = 1200"},
         {{"shear", tiny, "-s", "5e3,1e4", "-r", "600", "--max-runs", "1e9"}, "--max-runs: '1e9' is not an integer"},
         // a negative cohesion target or negative measured stresses were calibrated against
-        {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800 must be >= 0"},
+        {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800: tau_c must be >= 0"},
         {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
          "measured point 1 (5000:-7000): stresses must be >= 0 Pa"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "friction_coefficient", "--alpha", "2"}, "alpha = 2"},

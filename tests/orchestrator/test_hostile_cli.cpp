@@ -1154,7 +1154,16 @@ TEST_CASE("probe 57: an option name where a value belongs is a value left out, a
              {{"cutoff", "--grains", "100", "--seeds", "1", "--", "--theta", "50"},
               {"--grains applies to the small hopper; with silo options after --"}},
              {{"cutoff", "--seeds", "1", "--", "--material", (dir / "none.json").string(), "--theta", "30"},
-              {"none.json' does not exist"}}},
+              {"none.json' does not exist"}},
+             // -h among the silo options printed CLI11's "This should be caught in your main function"
+             {{"cutoff", "--seeds", "1", "--", "--theta", "30", "-h"}, {"-h/--help after --: `demcal silo --help`"}},
+             {{"cutoff", "--seeds", "1", "--", "--theta", "30", "--geometry", "--particles", "300"},
+              {"--geometry: '--particles' is an option of this command"}},
+             // a run's own refusal inside the sweep's: one prefix, no literal \n at its end
+             {{"vibration", "--theta", "30", "--frequency", "0", "--campaign", (dir / "v").string(), "--",
+               "--particles", "300", "--vibration-start", "0.1"},
+              {"demcal: error: run theta30_f0_seed1: --vibration-start applies to a vibrating bin",
+               "and --vibration-amplitude\n"}}},  // (its end: no literal \n before it)
             dir);
     fs::remove_all(root);
 }
