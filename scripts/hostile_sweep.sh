@@ -356,6 +356,27 @@ for r in (0.0025, 0.003):
 EOF2
 run_case enlarge/same-radius-twice   2 "both have particle_radius" -- enlarge --no-plot -o e.json "$work/enlarge_0.0025.json" "$work/enlarge_0.003.json" "$work/enlarge_0.003.json"
 
+# probe 57 (a helper's hostile pass of 650 cases): option names as values, void pairs, absurd targets, soft walls
+run_case silo/out-is-option          2 "--out: '--check' is an option" -- silo --theta 30 --particles 200 --out --check
+run_case cutoff/seeds-before-dashes  2 "--grains applies to the small hopper" -- cutoff --grains 100 --seeds 1 -- --theta 50
+run_case cutoff/help-after-dashes    2 "-h/--help after --" -- cutoff --seeds 1 -- --theta 30 -h
+run_case cutoff/max-window-short     2 "max_window = 2 s" -- cutoff --bond-number 10 --window 5 --max-window 2
+run_case silo/dt-and-fraction        2 "--dt-fraction and --dt" -- silo --theta 30 --dt 1e-5 --dt-fraction 0.9 --out s
+run_case calibrate/tau-c-zero        2 "tau_c = 0"       -- calibrate --target mu_b=0.5,tau_c=0 --start "$tiny" --engine kernel -o c.json
+run_case calibrate/mu-b-huge         2 "below 85 deg"    -- calibrate --target mu_b=1e9 --start "$tiny" --engine kernel -o c.json
+run_case calibrate/target-trailing   2 "empty item"      -- calibrate --target mu_b=0.55, --start "$tiny" --engine kernel -o c.json
+run_case scale/radii-too-close       2 "differ by less than 1 %" -- scale "$tiny" --radii 1e-3,1.0000001e-3,1.0000002e-3 -c sc
+run_case sensitivity/range-not-param 2 "not among --params" -- sensitivity "$tiny" --engine kernel --params young_modulus --range friction_coefficient=0.1:0.9 -c se
+python3 - "$wheat" "$work" <<'EOF3'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["wall"]["shear_modulus_Pa"] = 1e3
+json.dump(m, open("%s/soft_wall.json" % sys.argv[2], "w"))
+EOF3
+run_case silo/soft-wall              2 "wall.shear_modulus_Pa" -- silo --theta 30 --particles 300 --stiffness-scale 0.01 --material "$work/soft_wall.json" --out s
+printf 'sigma_Pa,tau_Pa\n5000,3000\n5000.0000001,3100\n5000.0000002,3050\n' > "$work/close.csv"
+run_case diagnose/stresses-too-close 2 "sigma_Pa: 5000 to 5000" -- diagnose --model failure-line --data "$work/close.csv" --json d.json
+
 echo
 echo "hostile sweep: $pass passed, $fail failed"
 for f in "${failures[@]}"; do echo "  $f"; done
