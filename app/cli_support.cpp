@@ -22,6 +22,7 @@
 #include <thread>
 
 #include <climits>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace demcal {
@@ -305,6 +306,26 @@ void check_name_lengths(const std::string& path, const std::string& named, PathK
 
 }  // namespace
 
+namespace {
+// An existing output is replaced by a rename over it (a result is never half-written). In a folder with the sticky bit
+// (as /tmp) only the file's or the folder's owner may do that: another user's file there passed every check, then
+// failed the command after its work with "Operation not permitted". Followed through a link, as the write is.
+void check_replaceable(const std::string& path, const std::string& named) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path target = fs::canonical(path, ec);
+    if (ec) return;  // not there yet: created, not replaced
+    const fs::path folder = target.parent_path();
+    struct stat file_st {}, folder_st {};
+    if (::stat(target.c_str(), &file_st) != 0 || ::stat(folder.c_str(), &folder_st) != 0) return;
+    const uid_t me = ::geteuid();
+    if ((folder_st.st_mode & S_ISVTX) && me != 0 && file_st.st_uid != me && folder_st.st_uid != me)
+        throw UserError(named + ": another user's file in " + analytics::shortened_text(folder.string(), 200) +
+                        ", a folder with the sticky bit (as /tmp), where only its owner may replace it; give "
+                        "another name");
+}
+}  // namespace
+
 void check_output_file(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
@@ -323,6 +344,7 @@ void check_output_file(const std::string& path, const std::string& option) {
     if (!can_create_files_in(folder))
         throw UserError(named + ": the folder " + folder.string() + " is not writable");
     if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) throw UserError(named + " is not writable");
+    check_replaceable(path, named);
 }
 
 namespace {

@@ -1266,3 +1266,29 @@ TEST_CASE("probe 57: a study's range for a parameter it does not vary, a range o
             dir);
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 57: another user's file in a sticky folder is refused as an output before any work", "[cli]") {
+    // it passed every check, the search ran, and the rename over it failed at the end (exit 1)
+    if (::geteuid() != 0) {
+        WARN("needs root: another user's file is made by root and the command runs as nobody");
+        return;
+    }
+    const fs::path root = test::fresh_test_dir("hostile-sticky"), sticky = root / "sticky";
+    fs::create_directories(sticky);
+    fs::permissions(root, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                              fs::perms::others_read | fs::perms::others_exec);
+    fs::permissions(sticky, fs::perms::all | fs::perms::sticky_bit);
+    std::ofstream(sticky / "out.json") << "{}\n";
+    fs::permissions(sticky / "out.json", fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read |
+                                             fs::perms::group_write | fs::perms::others_read | fs::perms::others_write);
+    const std::string cmd = "cd '" + root.string() + "' && runuser -u nobody -- '" + std::string(DEMCAL_BINARY) +
+                            "' cutoff --bond-number 5 --grains 100 --window 1 --tol 390 --theta 5 --json " +
+                            "sticky/out.json > '" + (root / "out.log").string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    CHECK((WIFEXITED(status) ? WEXITSTATUS(status) : -1) == 2);
+    const std::string log = test::read_file(root / "out.log");
+    CHECK_THAT(log, Contains("--json = 'sticky/out.json': another user's file") && Contains("sticky bit"));
+    CHECK_THAT(log, !Contains("f =    0.0 Hz"));  // refused before the first run
+    CHECK(test::read_file(sticky / "out.json") == "{}\n");
+    fs::remove_all(root);
+}
