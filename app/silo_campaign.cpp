@@ -184,6 +184,16 @@ void open_silo_campaign(const fs::path& dir, const json& settings, const std::st
             if (stored.is_object()) stored.erase(key);
             now.erase(key);
         }
+        // the command that made it, where its settings say (cutoff's do; a vibration sweep's were taken for this
+        // command's with other settings)
+        const std::string stored_command = stored.is_object() && stored.contains("command") &&
+                                                   stored["command"].is_string()
+                                               ? stored["command"].get<std::string>()
+                                               : "";
+        if (stored_command != (now.contains("command") ? now["command"].get<std::string>() : ""))
+            throw UserError("campaign = '" + dir.string() + "' holds a " +
+                            (stored_command.empty() ? "campaign of another command" : stored_command + " campaign") +
+                            " (" + settings_file.string() + "), not a " + command + " one: give another --campaign");
         if (stored != now)
             throw UserError("campaign = '" + dir.string() + "' holds a " + command + " campaign with other settings (" +
                             settings_file.string() + "): give another --campaign, or the same settings to continue it");

@@ -59,6 +59,12 @@ TEST_CASE("demcal cutoff in the silo: runs kept in a campaign, the same command 
     CHECK(run_demcal_command("cutoff --amplitude 1e-4 --campaign '" + (dir / "c").string() + "'" + silo,
                              dir / "other.log") == 2);
     CHECK_THAT(read_file(dir / "other.log"), Catch::Contains("holds a cutoff campaign with other settings"));
+    // another command's sweep in this folder: named as what it is (it said "a vibration campaign with other settings")
+    CHECK(run_demcal_command("vibration --theta 30 --frequency 0 --campaign '" + (dir / "c").string() +
+                                 "' -- --particles 300",
+                             dir / "vibration.log") == 2);
+    CHECK_THAT(read_file(dir / "vibration.log"), Catch::Contains("holds a cutoff campaign") &&
+                                                     Catch::Contains("not a vibration one"));
     // the campaign's options belong to the silo search
     CHECK(run_demcal_command("cutoff --bond-number 10 --jobs 2", dir / "hopper.log") == 2);
     CHECK_THAT(read_file(dir / "hopper.log"), Catch::Contains("--jobs applies to the silo search"));
