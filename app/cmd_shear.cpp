@@ -1,4 +1,5 @@
 // demcal shear / status / resume: YADE direct-shear campaigns and their failure lines.
+#include "analytics/number_text.hpp"
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/execution_options.hpp"
@@ -14,6 +15,7 @@
 
 #include <map>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
@@ -37,6 +39,7 @@ struct ShearCliOptions {
     std::string plot_format = "png";
     std::string engine = "yade";
     ExecutionOptions exec;
+    bool yade_given = false;  // resume: --yade typed (it applies to campaigns of the YADE engine)
 };
 
 // Failure line with its points and 95 % band, and the shear curves, for one campaign.
@@ -225,6 +228,20 @@ void print_status(const std::string& dir) {
 void run_resume(const ShearCliOptions& opt) {
     if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite"))
         throw UserError("campaign = '" + opt.campaign_dir + "' holds no campaign.sqlite");
+    if (opt.yade_given) {  // void where every unfinished campaign runs on the kernel (it was silently ignored)
+        bool unfinished = false, on_yade = false;
+        for (const auto& o : inspect_campaigns(opt.campaign_dir)) {
+            if (std::all_of(o.runs.begin(), o.runs.end(),
+                            [](const orchestrator::RunRecord& r) { return r.state == orchestrator::RunState::done; }))
+                continue;
+            unfinished = true;
+            on_yade = on_yade || o.campaign.kind != orchestrator::CampaignKind::shear ||
+                      ShearCampaignSpec::from_json(o.campaign.spec).engine == ShearEngine::yade;
+        }
+        if (unfinished && !on_yade)
+            throw UserError("--yade = '" + analytics::shortened_text(opt.exec.yade) + "' is YADE's launcher: the "
+                            "unfinished campaigns of " + opt.campaign_dir + " run on the kernel engine; omit it");
+    }
     find_yade(opt.exec.yade);  // before the store is opened: a bad --yade costs nothing
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
     const auto outs = runner.resume(print_progress);
@@ -269,7 +286,10 @@ void add_shear_commands(CLI::App& app) {
     resume->add_option("dir", resume_opt->campaign_dir, "campaign directory")->required();
     resume->add_option("--plot", resume_opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     add_execution_options(resume, resume_opt->exec);
-    resume->callback([resume_opt] { run_resume(*resume_opt); });
+    resume->callback([resume_opt, resume] {
+        resume_opt->yade_given = resume->count("--yade") > 0;
+        run_resume(*resume_opt);
+    });
 }
 
 }  // namespace demcal

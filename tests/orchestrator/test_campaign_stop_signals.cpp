@@ -42,6 +42,9 @@ TEST_CASE("a shear campaign stopped by SIGTERM or SIGHUP stops its runs, and res
     CHECK(test::processes_under(camp).empty());
     REQUIRE(test::run_demcal({"status", camp.string()}, dir / "status.log") == 0);
     CHECK_THAT(test::read_file(dir / "status.log"), Catch::Matchers::Contains("[interrupted]"));
+    // YADE's launcher on a resume of kernel campaigns is a void option (it was ignored, exit 0)
+    CHECK(test::run_demcal({"resume", camp.string(), "--yade", "/usr/bin/yade"}, dir / "yade.log") == 2);
+    CHECK_THAT(test::read_file(dir / "yade.log"), Catch::Matchers::Contains("run on the kernel engine; omit it"));
     REQUIRE(test::run_demcal({"resume", camp.string()}, dir / "resume.log") == 0);
     CHECK_FALSE(test::find_file(camp, "failure_line_", ".json").empty());
     fs::remove_all(dir);
