@@ -16,6 +16,7 @@
 #include <gsl/gsl_statistics_double.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -317,8 +318,10 @@ std::string cell_row(double theta, double f, double g, const CellSummary& s) {
     return md.str();
 }
 
-// Returns how many cells have a rate (a mean over at least one run whose rate was determined).
-int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs) {
+// Returns how many cells have a rate (a mean over at least one run whose rate was determined). `stopped`: the sweep
+// stopped before its end (a signal); the report says so and counts the runs finished (a stopped sweep's report read
+// as a whole one, n = 0 in every cell).
+int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs, bool stopped) {
     std::vector<RunResult> results;
     json all = json::array();
     for (const RunSpec& r : runs) {
@@ -344,10 +347,17 @@ int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec
             data_by_theta[theta] += std::to_string(f) + " " + std::to_string(s.mean) + " " +
                                     std::to_string(std::isfinite(s.sd) ? s.sd : 0.0) + "\n";
     }
+    const auto finished = std::count_if(results.begin(), results.end(), [](const RunResult& r) { return r.finished; });
+    if (stopped)
+        md << "\n**The sweep stopped before its end: " << finished << " of " << runs.size()
+           << " runs finished; the same command continues it.**\n";
     md << "\nChanges are paired seed by seed against the still run of the same angle and seed (the same filled bed); "
           "SE: the standard error of the pairs' mean. d ln(rate) = d ln(density) + d ln(speed) at the outlet splits a "
           "change of the rate.\n";
-    const json out = {{"settings", campaign_settings(o)}, {"cells", table}, {"runs", all}};
+    const json out = {{"settings", campaign_settings(o)}, {"complete", !stopped && finished == std::ptrdiff_t(runs.size())},
+                      {"stopped", stopped},         {"runs_finished", finished},
+                      {"runs_planned", runs.size()}, {"cells", table},
+                      {"runs", all}};
     write_result_file(dir / "vibration.json", out.dump(1) + "\n");
     write_result_file(dir / "vibration.md", md.str());
     std::cout << md.str();
@@ -372,11 +382,11 @@ int run(const VibrationCli& o) {
     const SiloCampaignOutcome outcome =
         run_silo_campaign(dir, plans, o.jobs, "vibration", {o.executor, o.partition});
     if (outcome.stopped) {
-        report(o, dir, runs);
+        report(o, dir, runs, true);
         return kExitResumeLater;
     }
     std::cout << outcome.finished << " runs finished, " << outcome.failed << " failed\n";
-    if (report(o, dir, runs) == 0 && outcome.finished > 0) {
+    if (report(o, dir, runs, false) == 0 && outcome.finished > 0) {
         std::cout << "no cell has a rate: no run's discharge rate was determined (see each run's summary.json, "
                      "rate.message), so the sweep measured nothing (exit 1)\n";
         return 1;

@@ -40,6 +40,8 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
   REQUIRE(demcal_run(sweep, dir / "first.log") == 0);
   const auto report = nlohmann::json::parse(demcal::test::read_file(campaign / "vibration.json"));
   REQUIRE(report["cells"].size() == 2);
+  CHECK(report["complete"] == true);  // (a stopped sweep's report says stopped, with the runs finished)
+  CHECK(report["runs_finished"] == 4);
   for (const auto& cell : report["cells"]) {
     CHECK(cell["n"] == 2);
     CHECK(cell["rate_mean_g_s"].get<double>() > 0);
