@@ -298,6 +298,9 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
         throw UserError(e.what());
     }
     const std::vector<double> ladder = kc::window_ladder(o.base.window, search.longest_window);
+    // the longest run the search may start, checked by demcal silo itself (its step count: the first window's runs
+    // passed where a 20 s one would not end)
+    if (ladder.size() > 1) check_silo_runs({silo_run_plan(o, search.hi, search.seeds.front(), ladder.back())});
     const nlohmann::json settings = silo_campaign_settings(o);
     const fs::path dir = o.campaign.empty()
                              ? fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(settings.dump()).substr(0, 12))
