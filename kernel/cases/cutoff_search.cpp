@@ -53,6 +53,7 @@ bool decided(FlowCriterion c, silo::DischargeEnd end) {
 
 std::vector<double> window_ladder(double first, double longest) {
   std::vector<double> ladder{first};
+  if (!(first > 0)) return ladder;  // (doubling 0 never reaches the longest)
   while (ladder.back() < longest) ladder.push_back(std::min(2 * ladder.back(), longest));
   return ladder;
 }

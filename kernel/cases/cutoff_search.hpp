@@ -49,7 +49,7 @@ inline constexpr double kWindowMin = 0.05, kWindowMax = 60;
 bool decided(FlowCriterion c, silo::DischargeEnd end);
 
 /// The windows a run is tried in [s]: `first`, then twice the last while the run is not decided, the last one
-/// `longest` (a rung above it is cut to it). longest <= first (0 included): the first window only.
+/// `longest` (a rung above it is cut to it). longest <= first (0 included), or first <= 0: the first window only.
 std::vector<double> window_ladder(double first, double longest);
 
 /// Throws std::invalid_argument naming max_window unless it is 0 (the first window only) or first <= longest <=

@@ -134,6 +134,7 @@ TEST_CASE("cut-off windows: a run still discharging at its window's end runs aga
     CHECK(window_ladder(5, 15) == std::vector<double>{5, 10, 15});  // the last rung cut to the longest
     CHECK(window_ladder(5, 5) == std::vector<double>{5});
     CHECK(window_ladder(5, 0) == std::vector<double>{5});
+    CHECK(window_ladder(0, 20) == std::vector<double>{0});  // no endless doubling of 0
     // decided: every end but a flow still running at the window's end by flow-stops
     CHECK_FALSE(decided(FlowCriterion::flow_stops, DischargeEnd::time_limit));
     CHECK(decided(FlowCriterion::half_within_window, DischargeEnd::time_limit));
