@@ -188,6 +188,11 @@ std::string ladder_text(const std::vector<double>& ladder) {
     return text;
 }
 
+// What a run's end says by the criterion, for its printed line: flows, arched, or undecided (a longer window decides).
+const char* answer_word(kc::FlowCriterion c, kernel::silo::DischargeEnd end) {
+    return !kc::decided(c, end) ? "undecided" : kc::flows(c, end) ? "flows" : "arched";
+}
+
 // The search's result, printed and added to the JSON report; the exit status.
 int conclude(const kc::CutoffResult& res, nlohmann::json out, const std::string& json_file) {
     if (res.found) {
@@ -267,7 +272,7 @@ kernel::silo::DischargeEnd read_search_run(const fs::path& dir, const SiloRunPla
     const bool decided = kc::decided(criterion, *end);
     std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% of %.1f g out in %.2f s -> %s  [%s; %.1f s CPU]\n",
                 frequency, peak_g, seed, 100 * fraction, 1e3 * filled, discharge_time,
-                !decided ? "undecided" : flows ? "flows" : "arched", stop_reason.c_str(), cpu);
+                answer_word(criterion, *end), stop_reason.c_str(), cpu);
     std::fflush(stdout);
     runs.push_back({{"frequency_hz", frequency}, {"seed", seed}, {"run", plan.name}, {"peak_acceleration_g", peak_g},
                     {"discharged_fraction", fraction}, {"filled_mass_kg", filled},
@@ -378,7 +383,7 @@ int run(const CutoffCli& o, CLI::App& sub) {
         const bool decided = kc::decided(search.criterion, r.end);
         std::printf("  f = %6.1f Hz (%6.2f g), seed %u: %5.1f %% out in %.2f s, %s -> %s  [%.1f s]\n", c.frequency,
                     r.peak_acceleration_g, c.seed, 100 * r.discharged_fraction, r.discharge_s,
-                    std::string(end).c_str(), !decided ? "undecided" : flows ? "flows" : "arched", r.wall_s);
+                    std::string(end).c_str(), answer_word(search.criterion, r.end), r.wall_s);
         std::fflush(stdout);
         runs.push_back({{"frequency_hz", c.frequency}, {"seed", c.seed}, {"peak_acceleration_g", r.peak_acceleration_g},
                         {"discharged_fraction", r.discharged_fraction}, {"discharge_time_s", r.discharge_s},
