@@ -107,6 +107,30 @@ std::string invalid_cell(const MeasuredData& d, std::size_t row, const std::stri
     return d.where(row, column) + ": value '" + shortened_text(d.at(column).text[row]) + "' " + why;
 }
 
+// Two conditions whose values agree to 0.01 % but not exactly (theta 30 and 30.0000001) are one silo written two ways
+// (a rounding in a spreadsheet): taken as two, each got its own runs and the leave-one-out held one half of a
+// condition out. No experiment sets an angle or a size to 0.01 %: refused, both lines named, not merged silently.
+constexpr double kConditionResolution = 1e-4;
+void check_apart_from_others(const MeasuredData& d, std::size_t row, const SiloCondition& c,
+                             const SiloMeasurements& m) {
+    auto near = [](double a, double b) {
+        return (std::isnan(a) && std::isnan(b)) || std::fabs(a - b) <= kConditionResolution * std::max(std::fabs(a), std::fabs(b));
+    };
+    for (std::size_t k = 0; k < m.conditions.size(); ++k) {
+        const SiloCondition& o = m.conditions[k];
+        if (!(near(c.theta_deg, o.theta_deg) && near(c.outlet_m, o.outlet_m) && near(c.diameter_m, o.diameter_m) &&
+              near(c.body_height_m, o.body_height_m)))
+            continue;
+        std::size_t first = 0;
+        while (m.condition_of_row[first] != k) ++first;
+        throw std::invalid_argument(d.where(row, "theta_deg") + ": the condition " + c.label() + " differs from " +
+                                    o.label() + " (line " + std::to_string(m.lines[first]) + ") by less than " +
+                                    number_text(100 * kConditionResolution) +
+                                    " %: one silo written two ways? Write its values alike (repeats of one condition "
+                                    "are rows with the same values)");
+    }
+}
+
 }  // namespace
 
 std::vector<double> candidate_grid(const DemEffectCandidate& c, int points) {
@@ -184,7 +208,10 @@ SiloMeasurements silo_measurements_from(const MeasuredData& d) {
         const double rate = value("rate_g_s", r);
         if (!(rate > 0)) throw std::invalid_argument(invalid_cell(d, r, "rate_g_s", "must be > 0 g/s"));
         auto it = std::find(m.conditions.begin(), m.conditions.end(), c);
-        if (it == m.conditions.end()) it = m.conditions.insert(m.conditions.end(), c);
+        if (it == m.conditions.end()) {
+            check_apart_from_others(d, r, c, m);
+            it = m.conditions.insert(m.conditions.end(), c);
+        }
         m.condition_of_row.push_back(std::size_t(it - m.conditions.begin()));
         m.rate_g_s.push_back(rate);
         m.lines.push_back(d.lines[r]);

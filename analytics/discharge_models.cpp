@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <stdexcept>
 
@@ -115,6 +116,40 @@ std::vector<std::string> oldal_rectangular_limit_violations(double depth, double
     return out;
 }
 
+namespace {
+struct PlausibleRange {
+    double low, high;
+    const char* unit;
+    const char* why;
+};
+
+// `shown`: what precedes the value ("rho_b_kg_m3=", "data.csv: line 3, column rho_b_kg_m3: ")
+void check_in_range(const std::string& shown, double v, const PlausibleRange& r) {
+    if (!(v >= r.low && v <= r.high))
+        throw std::invalid_argument(shown + number_text(v) + " outside [" + number_text(r.low) + ", " +
+                                    number_text(r.high) + "]" + (*r.unit ? std::string(" ") + r.unit : std::string()) +
+                                    " (" + r.why + ")");
+}
+}  // namespace
+
+void check_plausible_silo_quantity(const std::string& field, double value, const std::string& where) {
+    // the bounds of bulk solids and silos, wide enough for any real case
+    static const char* const silo_size = "no silo is larger than 100 m";  // the largest are about 50 m across
+    static const std::map<std::string, PlausibleRange> ranges{
+        {"outlet_m", {0, 100, "m", silo_size}},
+        {"D_m", {0, 100, "m", silo_size}},
+        {"b_m", {0, 100, "m", silo_size}},
+        {"c_m", {0, 100, "m", silo_size}},
+        {"d_p_m", {1e-6, 1, "m", "bulk solids: from 1 um powders to 1 m rocks"}},
+        {"rho_b_kg_m3",
+         {10, 2e4, "kg/m^3", "bulk solids: from about 30 kg/m^3 (expanded perlite) to about 12000 (tungsten powder)"}},
+        {"W_kg_s", {0, 1e5, "kg/s", "the largest ship loaders discharge about 10 t/s"}},
+    };
+    const auto range = ranges.find(field);
+    if (range == ranges.end()) throw std::logic_error("no plausible range for the silo quantity " + field);
+    check_in_range(where.empty() ? field + "=" : where + ": ", value, range->second);
+}
+
 void validate(const SiloGeometry& g) {
     auto positive = [](const char* field, double v) {
         if (!(std::isfinite(v) && v > 0)) throw std::invalid_argument(std::string(field) + "=" + number_text(v) + " must be > 0");
@@ -123,19 +158,9 @@ void validate(const SiloGeometry& g) {
     positive("d_p_m", g.particle_size);
     positive("rho_b_kg_m3", g.bulk_density);
     // Finite but absurd values (a bulk density of 0.001 kg/m^3, a silo 1e99 m across) gave rates reported as valid.
-    // The bounds are those of bulk solids and silos, wide enough for any real case.
-    auto plausible = [](const char* field, double v, double lo, double hi, const char* unit, const char* why) {
-        if (!(v >= lo && v <= hi))
-            throw std::invalid_argument(std::string(field) + "=" + number_text(v) + " outside [" + number_text(lo) +
-                                        ", " + number_text(hi) + "]" + (*unit ? std::string(" ") + unit : std::string()) + " (" +
-                                        why + ")");
-    };
-    constexpr double largest_silo_m = 100;  // the largest silos are about 50 m across
-    const char* silo_size = "no silo is larger than 100 m";
-    plausible("outlet_m", g.outlet, 0, largest_silo_m, "m", silo_size);
-    plausible("d_p_m", g.particle_size, 1e-6, 1, "m", "bulk solids: from 1 um powders to 1 m rocks");
-    plausible("rho_b_kg_m3", g.bulk_density, 10, 2e4, "kg/m^3",
-              "bulk solids: from about 30 kg/m^3 (expanded perlite) to about 12000 (tungsten powder)");
+    check_plausible_silo_quantity("outlet_m", g.outlet);
+    check_plausible_silo_quantity("d_p_m", g.particle_size);
+    check_plausible_silo_quantity("rho_b_kg_m3", g.bulk_density);
     if (!(g.half_angle_deg > 0 && g.half_angle_deg <= 90))
         throw std::invalid_argument("theta_deg=" + number_text(g.half_angle_deg) + " not in (0, 90] (90 = flat bottom)");
     if (g.outlet <= g.particle_size)
@@ -143,15 +168,15 @@ void validate(const SiloGeometry& g) {
                                     number_text(g.particle_size) + ")");
     if (g.shape == SiloShape::conical) {
         positive("D_m", g.silo_diameter);
-        plausible("D_m", g.silo_diameter, 0, largest_silo_m, "m", silo_size);
+        check_plausible_silo_quantity("D_m", g.silo_diameter);
         if (g.outlet >= g.silo_diameter)
             throw std::invalid_argument("outlet_m=" + number_text(g.outlet) + " is not smaller than the silo, D_m=" +
                                         number_text(g.silo_diameter));
     } else {
         positive("b_m", g.depth);
         positive("c_m", g.width);
-        plausible("b_m", g.depth, 0, largest_silo_m, "m", silo_size);
-        plausible("c_m", g.width, 0, largest_silo_m, "m", silo_size);
+        check_plausible_silo_quantity("b_m", g.depth);
+        check_plausible_silo_quantity("c_m", g.width);
         if (g.outlet >= g.width)
             throw std::invalid_argument("outlet_m=" + number_text(g.outlet) + " is not smaller than the silo width, c_m=" +
                                         number_text(g.width));
@@ -161,6 +186,9 @@ void validate(const SiloGeometry& g) {
     positive("slot_C", g.slot_c);
     positive("delta", g.arch_delta);
     // model constants: several times their literature values at most (C 0.55-0.65, k 1-3, C' ~1.03, delta ~0.5)
+    auto plausible = [](const char* field, double v, double lo, double hi, const char* unit, const char* why) {
+        check_in_range(std::string(field) + "=", v, {lo, hi, unit, why});
+    };
     plausible("beverloo_C", g.beverloo_c, 0, 3, "", "Beverloo's C is 0.55-0.65 in the literature");
     plausible("beverloo_k", g.beverloo_k, 0, 10, "", "Beverloo's k is 1-3 in the literature");
     plausible("slot_C", g.slot_c, 0, 5, "", "Myers and Sellers' C' is about 1");

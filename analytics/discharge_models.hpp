@@ -40,6 +40,12 @@ struct SiloGeometry {
 // not larger than the particles or not smaller than the silo, angles out of range).
 void validate(const SiloGeometry& g);
 
+// The range a measured or given silo quantity can have, the same for a geometry file and a row of measured data:
+// outlet_m, D_m, b_m, c_m (no silo is larger than 100 m), d_p_m (1 um powders to 1 m rocks), rho_b_kg_m3 (10 to
+// 2e4 kg/m^3) and W_kg_s (up to 1e5 kg/s: the largest ship loaders discharge about 10 t/s). Throws
+// std::invalid_argument "FIELD=VALUE outside [LO, HI] UNIT (WHY)", or "WHERE: VALUE outside ..." given `where`.
+void check_plausible_silo_quantity(const std::string& field, double value, const std::string& where = "");
+
 // One model's prediction with the reasons it may not apply.
 struct DischargePrediction {
     std::string model;                  // e.g. "beverloo"

@@ -41,6 +41,16 @@ void check_normal_stress_spread(double lowest, double highest, const std::string
                                     " % apart (the largest - the smallest): closer ones give a line through their noise");
 }
 
+void check_measured_stress(double value, const std::string& field) {
+    if (!(value >= 0))
+        throw std::invalid_argument(field + ": " + number_text(value) + " Pa is negative: a measured stress is >= 0");
+    if (value > kMaxMeasuredStressPa)
+        throw std::invalid_argument(field + ": " + number_text(value) + " Pa is above " +
+                                    number_text(kMaxMeasuredStressPa) +
+                                    " Pa, more than any shear test of a bulk solid reaches (its grains crush at tens "
+                                    "of MPa): a unit slip?");
+}
+
 FailureLine fit_failure_line(std::span<const double> sigma, std::span<const double> tau, double confidence) {
     if (sigma.size() != tau.size())
         throw std::invalid_argument("failure line: " + std::to_string(sigma.size()) + " normal stresses but " +

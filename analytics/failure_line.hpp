@@ -51,4 +51,11 @@ inline constexpr double kMinNormalStressSpread = 0.2;
 // less than kMinNormalStressSpread: a line through them is a line through their noise.
 void check_normal_stress_spread(double lowest, double highest, const std::string& field);
 
+// The largest stress a measured point of a bulk solid's failure line can have: grains crush at tens of MPa, and no
+// shear cell reaches 1 GPa. A larger value is a unit slip (kPa typed as Pa twice, psi as Pa) or garbage.
+inline constexpr double kMaxMeasuredStressPa = 1e9;
+// Throws std::invalid_argument naming `field` and the value when a measured normal or shear stress is negative or
+// above kMaxMeasuredStressPa. One rule for every way a measured line comes in (a CSV, --measured).
+void check_measured_stress(double value, const std::string& field);
+
 }  // namespace demcal::analytics

@@ -1,5 +1,8 @@
 #include "analytics/measured_data.hpp"
 
+#include "analytics/discharge_models.hpp"
+#include "analytics/failure_line.hpp"
+
 #include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
 
@@ -241,10 +244,8 @@ void validate_measured(const MeasuredData& data, MeasuredKind kind) {
     if (kind == MeasuredKind::shear) {
         const auto& sigma = require_numeric("sigma_Pa");
         const auto& tau = require_numeric("tau_Pa");
-        for (std::size_t r = 0; r < data.rows(); ++r) {
-            check(r, sigma, sigma.values[r] >= 0, "is negative: normal stress must be >= 0");
-            check(r, tau, tau.values[r] >= 0, "is negative: shear strength must be >= 0");
-        }
+        for (std::size_t r = 0; r < data.rows(); ++r)
+            for (const auto* col : {&sigma, &tau}) check_measured_stress(col->values[r], data.where(r, col->name));
         return;
     }
 
@@ -288,6 +289,9 @@ void validate_measured(const MeasuredData& data, MeasuredKind kind) {
                                             geometry->text[r] + " silo)");
             check(r, *col, col->values[r] > 0, "is not a positive silo size");
         }
+        for (const auto* col : {&outlet, &dp, &rho, &rate})
+            check_plausible_silo_quantity(col->name, col->values[r], data.where(r, col->name));
+        for (const auto* col : sizes) check_plausible_silo_quantity(col->name, col->values[r], data.where(r, col->name));
         check(r, outlet, outlet.values[r] < silo_size.values[r],
               "is not smaller than the silo (" + silo_size.name + " = " + num(silo_size.values[r]) + ")");
     }

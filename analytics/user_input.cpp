@@ -96,6 +96,14 @@ private:
     [[noreturn]] void refuse(const std::string& rule) const { throw InputError(what_ + ": " + field() + " " + rule); }
 };
 
+// nlohmann's messages start with its own tag ("[json.exception.parse_error.101] "), which names the library's
+// exception class, not anything in the user's file
+std::string without_library_tag(std::string message) {
+    if (message.rfind("[json.exception.", 0) == 0)
+        if (const auto end = message.find("] "); end != std::string::npos) message.erase(0, end + 2);
+    return message;
+}
+
 }  // namespace
 
 nlohmann::json parse_json_text(std::string_view text, const std::string& what) {
@@ -106,7 +114,7 @@ nlohmann::json parse_json_text(std::string_view text, const std::string& what) {
     try {
         return nlohmann::json::parse(text.begin(), text.end(), std::ref(rules));
     } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number too large for a double
-        throw InputError(what + " is not valid JSON: " + shortened_text(e.what(), 200));
+        throw InputError(what + " is not valid JSON: " + shortened_text(without_library_tag(e.what()), 200));
     }
 }
 

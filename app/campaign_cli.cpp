@@ -70,7 +70,7 @@ void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
         throw UserError(e.what());
     }
     if (c.engine == "kernel" && !c.template_path.empty())
-        throw UserError("template = '" + c.template_path + "' is a YADE script: it applies to --engine yade only");
+        throw UserError("--template = '" + c.template_path + "' is a YADE script: it applies to --engine yade only");
     orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));
 }
 

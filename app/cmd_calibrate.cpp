@@ -47,14 +47,14 @@ void check_study_matches_start(const SensitivityStudy& study, const nlohmann::js
     }
     for (const auto& [key, value] : here.items())
         if (!base.contains(key) || base[key] != value)
-            throw UserError("sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
+            throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
                             key + " = " + (base.contains(key) ? analytics::json_value_text(base[key]) : "(absent)") +
                             ", the start material " + analytics::json_value_text(value) +
                             ": a study holds for the material it varied (run it for this start, or start from its "
                             "base)");
     for (const auto& [key, value] : base.items())
         if (!here.contains(key))
-            throw UserError("sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
+            throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
                             key + ", the start material has not");
 }
 
@@ -307,7 +307,7 @@ SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json
     try {
         study = SensitivityStudy::from_json(read_json_file(file, "sensitivity"));
     } catch (const std::invalid_argument& e) {  // a field missing, of the wrong type or out of range
-        throw UserError("sensitivity = '" + file + "': " + e.what());
+        throw UserError("--sensitivity = '" + file + "': " + e.what());
     }
     check_study_matches_start(study, start, file);
     return study;
@@ -371,8 +371,8 @@ void print_calibration_summary(const CalibrateCli& o, const CalibrationResult& r
 
 void run_calibrate(CalibrateCli& o) {
     const auto& camp = o.study.campaign;
-    if (!o.output.empty()) check_output_file(o.output, "output");  // before hours of calibration, not after
-    check_paths_apart({{o.start_file, "start"}, {o.sensitivity_file, "sensitivity"}}, {{o.output, "output"}});
+    if (!o.output.empty()) check_output_file(o.output, "--output");  // before hours of calibration, not after
+    check_paths_apart({{o.start_file, "--start"}, {o.sensitivity_file, "--sensitivity"}}, {{o.output, "--output"}});
     const auto start = orchestrator::validate_material(read_json_file(o.start_file, "start"), o.start_file);
     const auto targets = targets_of(o);
     const auto bounds = parse_ranges(o.bounds, "--bounds");
@@ -454,7 +454,7 @@ struct EnlargeCli {
 // The output and the plot files beside it: checked, and apart from the inputs, before anything is read.
 void check_enlarge_outputs(const EnlargeCli& o) {
     if (fs::path(o.output).extension() != ".json")  // the plot and its data take the same name
-        throw UserError("output = '" + o.output + "': must end in .json");
+        throw UserError("--output = '" + o.output + "': must end in .json");
     check_output_file(o.output, "output");
     std::vector<NamedPath> inputs;
     for (const auto& file : o.materials) inputs.push_back({file, "material"});

@@ -184,7 +184,7 @@ fs::path crosscheck_dir(const CrosscheckOptions& opt) {
                              ? fs::path("campaigns") / ("crosscheck-" + fs::path(opt.material_file).stem().string())
                              : fs::path(opt.campaign_dir);
     if (fs::exists(dir) && !fs::is_directory(dir))
-        throw UserError("campaign = '" + dir.string() + "' exists and is not a folder");
+        throw UserError("--campaign = '" + dir.string() + "' exists and is not a folder");
     return dir;
 }
 
@@ -242,7 +242,7 @@ int run_crosscheck(const CrosscheckOptions& opt) {
     const EngineRuns r = run_engines(runner, specs);
     if (r.interrupted) {
         std::cout << "interrupted: run the same command again to continue\n";
-        return 130;
+        return kExitResumeLater;
     }
     std::optional<analytics::FailureLineComparison> peak, residual;
     const auto& y = r.ev.at(ShearEngine::yade);

@@ -158,7 +158,7 @@ void check_kernel_run(const SiloCrosscheckOptions& o, double theta) {
         for (const auto& [silo_option, own_option] : kRenamed)
             if (message.rfind(std::string(silo_option) + " = ", 0) == 0)
                 message = own_option + message.substr(std::string(silo_option).size());
-        throw UserError("theta = " + g(theta) + ": the kernel run refuses its settings: " + message);
+        throw UserError("--theta = " + g(theta) + ": the kernel run refuses its settings: " + message);
     }
 }
 
@@ -172,21 +172,21 @@ struct CrosscheckInputs {
 
 // Every refusal the options can earn, named, before anything is written.
 CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
-    if (o.thetas.empty()) throw UserError("theta: give at least one cone half angle");
+    if (o.thetas.empty()) throw UserError("--theta: give at least one cone half angle");
     for (std::size_t i = 0; i < o.thetas.size(); ++i) {
         const double t = o.thetas[i];
-        if (!(t > 0 && t < 90)) throw UserError("theta = " + g(t) + " deg must lie in (0, 90)");
+        if (!(t > 0 && t < 90)) throw UserError("--theta = " + g(t) + " deg must lie in (0, 90)");
         // one folder per angle: a repeated angle, or two that its folder's name cannot tell apart, would run twice into it
         for (std::size_t k = 0; k < i; ++k)
             if (o.angle(o.thetas[k]) == o.angle(t))
-                throw UserError("theta = " + g(t) + " deg " + (o.thetas[k] == t ? "is given twice" : "shares its folder '" +
+                throw UserError("--theta = " + g(t) + " deg " + (o.thetas[k] == t ? "is given twice" : "shares its folder '" +
                                 o.angle(t) + "' with theta = " + g(o.thetas[k]) + " deg; give angles further apart"));
     }
     const double runs_per_angle = 1.0 + static_cast<double>(yade_runs(o.fill()).size());
     orchestrator::check_run_count(runs_per_angle * static_cast<double>(o.thetas.size()), o.max_runs,
                                   "crosscheck silo: " + std::to_string(o.thetas.size()) + " angles x " +
                                       g(runs_per_angle) + " runs");
-    if (!(o.tolerance > 0 && o.tolerance < 1)) throw UserError("tolerance = " + g(o.tolerance) + " must lie in (0, 1)");
+    if (!(o.tolerance > 0 && o.tolerance < 1)) throw UserError("--tolerance = " + g(o.tolerance) + " must lie in (0, 1)");
     check_output_folder(o.dir, "--campaign");
     CrosscheckInputs in;
     in.script = orchestrator::yade_script("silo.py");
@@ -202,16 +202,16 @@ CrosscheckInputs checked_inputs(const SiloCrosscheckOptions& o) {
             throw UserError(option + " = " + file + ": a cohesive material (surface_energy_J_m2 > 0): yade_scripts/silo.py "
                             "has no JKR cohesion to match the kernel's; cross-check cohesionless materials");
     if (!o.geometry.empty()) {
-        const json geometry = analytics::read_json_input(o.geometry, "geometry");
+        const json geometry = analytics::read_json_input(o.geometry, "--geometry");
         // yade_scripts/silo.py builds the conical silo only (its facet walls): a hopper would fail after the kernel's run
         if (geometry.is_object() && geometry.contains("shape") && geometry["shape"] != "conical")
             throw UserError("--geometry = '" + o.geometry + "': shape = " + analytics::json_value_text(geometry["shape"]) +
                             ": yade_scripts/silo.py builds the conical silo only; cross-check a conical geometry");
     }
     if (!o.yade_material.empty()) {
-        in.yade_material = analytics::read_json_input(o.yade_material, "yade-material");
+        in.yade_material = analytics::read_json_input(o.yade_material, "--yade-material");
         // the report says YADE ran a different material on purpose: the same one is a void option
-        if (!o.material.empty() && in.yade_material == analytics::read_json_input(o.material, "material"))
+        if (!o.material.empty() && in.yade_material == analytics::read_json_input(o.material, "--material"))
             throw UserError("--yade-material = '" + analytics::shortened_text(o.yade_material) +
                             "': the same material as --material; omit it (YADE runs the bed's material)");
     }
@@ -358,7 +358,7 @@ int run_silo_crosscheck(const SiloCrosscheckOptions& o) {
     // the YADE stage needs the beds of the kernel stage
     if (!run_stage(kernel_jobs(o, root, program)) || !run_stage(yade_jobs(o, in, root))) {
         std::cout << "interrupted: run the same command again to continue\n";
-        return 130;
+        return kExitResumeLater;
     }
     record_campaign_status(store, campaign_id);
     const auto report = crosscheck_silo::write_report(root, report_settings(o, in));

@@ -40,12 +40,6 @@ optional model constants (defaults in brackets):
   delta_e_deg, phi_w_deg (effective internal and wall friction angles: with both, Jenike's mass-flow limit decides
   the flow pattern and each model says whether it applies))";
 
-std::string fixed(double v, int digits) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-    return buf;
-}
-
 void run_predict(const std::string& geometry_path, const std::string& json_out) {
     check_output_file_in_new_folders(json_out, "--json");  // before anything is printed as a result
     check_paths_apart({{geometry_path, "geometry"}}, {{json_out, "--json"}});

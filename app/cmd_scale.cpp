@@ -62,10 +62,10 @@ fs::path output_of(const ScaleCli& o) {
 void check_scale(const nlohmann::json& base, const ScaleCli& o, const calibration::EnlargementOptions& options) {
     if (!o.output.empty()) {
         if (fs::path(o.output).extension() != ".json")  // the table and plots take the same stem
-            throw UserError("output = '" + o.output + "': must end in .json");
-        check_output_file(o.output, "output");
+            throw UserError("--output = '" + o.output + "': must end in .json");
+        check_output_file(o.output, "--output");
     }
-    check_paths_apart({{o.base_file, "base material"}}, {{output_of(o).string(), "output"}});
+    check_paths_apart({{o.base_file, "base material"}}, {{output_of(o).string(), "--output"}});
     calibration::check_enlargement(base, options);
     const auto& c = o.campaign;
     // the design and every radius's material first: their messages name the cause, the run count only the total

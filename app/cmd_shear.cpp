@@ -148,7 +148,7 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
         std::cout << "no failure line: fewer than 3 finished runs on 2 normal stresses\n";
     }
     keep_results();  // this campaign's report is whole: a later campaign's failure (resume) does not take it
-    if (outcome.interrupted) return 130;
+    if (outcome.interrupted) return kExitResumeLater;
     if (!outcome.infrastructure_failure.empty()) {
         std::cout << "the simulator could not be started (" << outcome.infrastructure_failure
                   << "); the runs it hit stay pending: fix what stops it (its message; --yade for another YADE; the "
@@ -174,7 +174,7 @@ void run_shear(const ShearCliOptions& opt) {
     spec.template_path = opt.template_path;
     spec.engine = parse_shear_engine(opt.engine);
     if (spec.engine == ShearEngine::kernel && !opt.template_path.empty())
-        throw UserError("template = '" + opt.template_path + "' is a YADE script: it applies to --engine yade only");
+        throw UserError("--template = '" + opt.template_path + "' is a YADE script: it applies to --engine yade only");
     validate_shear_spec(spec);
     if (spec.engine == ShearEngine::yade) find_yade(opt.exec.yade);
     analytics::check_failure_line_design(spec.normal_stresses, spec.replicates);
@@ -186,7 +186,7 @@ void run_shear(const ShearCliOptions& opt) {
               << opt.exec.executor << " executor\n";
     const auto outcome = runner.run(spec, print_progress);
     const int code = report_campaign(runner.dir(), outcome, opt.plot_format);
-    if (code == 130) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";
+    if (outcome.interrupted) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";
     if (code != 0) throw CLI::RuntimeError(code);
 }
 
@@ -227,7 +227,7 @@ void print_status(const std::string& dir) {
 
 void run_resume(const ShearCliOptions& opt) {
     if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite"))
-        throw UserError("campaign = '" + opt.campaign_dir + "' holds no campaign.sqlite");
+        throw UserError("--campaign = '" + opt.campaign_dir + "' holds no campaign.sqlite");
     if (opt.yade_given) {  // void where every unfinished campaign runs on the kernel (it was silently ignored)
         bool unfinished = false, on_yade = false;
         for (const auto& o : inspect_campaigns(opt.campaign_dir)) {

@@ -171,7 +171,7 @@ struct GeometryGiven {
 
 GeometryGiven read_geometry_file(const std::string& file) {
     const nlohmann::json j = read_json_file(file, "geometry");
-    if (!j.is_object()) throw UserError("geometry = '" + file + "': must be a JSON object");
+    if (!j.is_object()) throw UserError("--geometry = '" + file + "': must be a JSON object");
     GeometryGiven g;
     for (const auto& [key, value] : j.items()) {
         if (key.rfind("_", 0) == 0) continue;  // keys starting with '_' are comments
@@ -259,7 +259,7 @@ ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub, std::map<std::st
             throw UserError(it->second.source + " = " + ks::setting_text(it->second.value) + ": " + why);
     };
     const auto theta = value("theta_deg");
-    if (!theta) throw UserError("theta: missing; give --theta DEG (or theta_deg in --geometry)");
+    if (!theta) throw UserError("--theta: missing; give --theta DEG (or theta_deg in --geometry)");
     const ks::SiloGeometry seed_silo;
     if (rect) {
         refuse_if_given("D_m", "the diameter applies to the conical silo, not to a rectangular one (" +
@@ -287,7 +287,7 @@ int thread_count(const SiloCli& o) {
 // The options that shape a session rather than the run (also with --resume): checked before anything is written.
 void check_session_options(const SiloCli& o, CLI::App& sub) {
     if (sub.count("--threads") && o.threads < 1)
-        throw UserError("threads = " + std::to_string(o.threads) + ": must be at least 1");
+        throw UserError("--threads = " + std::to_string(o.threads) + ": must be at least 1");
     if (!(o.checkpoint_every > 0) || !std::isfinite(o.checkpoint_every))
         throw UserError("checkpoint-every = " + ks::setting_text(o.checkpoint_every) +
                         ": must be a positive number of seconds");
@@ -385,7 +385,7 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
         throw UserError("--fill-mass = " + ks::setting_text(o.fill_mass) + ": must be > 0 kg (or give --particles)");
     if (sub.count("--vtk-every") && o.vtk.empty())
         throw UserError("--vtk-every applies to the VTK snapshots: add --vtk DIR");
-    if (o.seed < 0) throw UserError("seed = " + std::to_string(o.seed) + ": must be >= 0");
+    if (o.seed < 0) throw UserError("--seed = " + std::to_string(o.seed) + ": must be >= 0");
     s.particles = o.particles;
     s.fill_mass = o.fill_mass;
     s.threads = thread_count(o);
@@ -559,11 +559,11 @@ std::unique_ptr<orchestrator::FolderLock> lock_output_folder(const fs::path& dir
 // silo run has held) a file of the user's that a run would replace.
 void check_out_folder_free(const fs::path& dir) {
     if (fs::exists(dir / kCheckpointName))
-        throw UserError("out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
+        throw UserError("--out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
                         " to start over");
     if (fs::is_regular_file(dir / "summary.json"))  // a new run would leave the old results beside its own until its end
-        throw UserError("out = '" + dir.string() + "' holds the results of a finished run (summary.json): give "
+        throw UserError("--out = '" + dir.string() + "' holds the results of a finished run (summary.json): give "
                         "another --out, or remove them to run again there");
     // any other file a run writes, already there in a folder no silo run has held (no .lock of one): a user's file
     // (a measured discharge.csv in a data folder was replaced by the run's own). In a folder a run held, they are an
@@ -572,7 +572,7 @@ void check_out_folder_free(const fs::path& dir) {
     for (const char* name : kRunFiles)
         if (!fs::exists(fs::symlink_status(dir / ".lock")) &&
             (fs::is_regular_file(fs::symlink_status(dir / name)) || fs::is_symlink(fs::symlink_status(dir / name))))
-            throw UserError("out = '" + dir.string() + "' already holds " + name + ", a file a silo run writes: give "
+            throw UserError("--out = '" + dir.string() + "' already holds " + name + ", a file a silo run writes: give "
                             "another --out (a new or empty folder), or remove it");
 }
 
@@ -583,7 +583,7 @@ void check_vtk_folder_free(const std::string& vtk_dir) {
     for (fs::directory_iterator it(vtk_dir, ec), end; !ec && it != end; it.increment(ec)) {
         const std::string name = it->path().filename().string();
         if (name.rfind("silo_", 0) == 0 && it->path().extension() == ".vtk")
-            throw UserError("vtk = '" + vtk_dir + "' already holds snapshots (" + name + "): give a new or empty "
+            throw UserError("--vtk = '" + vtk_dir + "' already holds snapshots (" + name + "): give a new or empty "
                             "folder, or remove them");
     }
 }
@@ -594,7 +594,7 @@ std::unique_ptr<orchestrator::FolderLock> lock_vtk_folder(const std::string& vtk
     if (vtk_dir.empty()) return nullptr;
     std::error_code ec;
     fs::create_directories(vtk_dir, ec);
-    if (ec) throw UserError("vtk = '" + vtk_dir + "': cannot create the directory: " + ec.message());
+    if (ec) throw UserError("--vtk = '" + vtk_dir + "': cannot create the directory: " + ec.message());
     if (fs::equivalent(vtk_dir, out_dir, ec)) return nullptr;
     try {
         return std::make_unique<orchestrator::FolderLock>(vtk_dir, "silo VTK folder");
@@ -616,6 +616,16 @@ void check_checkpoint_options(const SiloCli& o, const CLI::App& sub) {
 // to resume from a checkpoint it could never write): the VTK folder, the run's files apart from its inputs, and the
 // exported beds, whose writers are attached to the run here.
 void prepare_outputs(const SiloCli& o, const fs::path& dir, ks::SiloCaseSettings& s) {
+    // the bed files are for yade_scripts/silo.py, whose silo is conical (geometry.shape): a rectangular silo's bed was
+    // written, and refused by YADE only when the cross-check was run
+    if (s.geometry.shape == ks::SiloShape::rectangular)
+        for (const auto& [file, option] : {std::pair{o.export_bed, "--export-bed"},
+                                           std::pair{o.export_final_bed, "--export-final-bed"},
+                                           std::pair{o.export_cloud, "--export-cloud"}})
+            if (!file.empty())
+                throw UserError(std::string(option) + " = '" + analytics::shortened_text(file, 200) +
+                                "': the bed files are for YADE's silo (yade_scripts/silo.py), which is conical; "
+                                "this silo is rectangular (--rect or the --geometry file's shape)");
     if (!s.vtk_dir.empty()) {
         check_output_folder(s.vtk_dir, "--vtk");
         check_vtk_folder_free(s.vtk_dir);
@@ -649,13 +659,13 @@ void prepare_outputs(const SiloCli& o, const fs::path& dir, ks::SiloCaseSettings
 void create_output_folders(const fs::path& dir, const std::string& vtk_dir) {
     std::error_code ec;
     const bool created_out = fs::create_directories(dir, ec);
-    if (ec) throw UserError("out = '" + dir.string() + "': cannot create the directory: " + ec.message());
+    if (ec) throw UserError("--out = '" + dir.string() + "': cannot create the directory: " + ec.message());
     if (vtk_dir.empty()) return;
     fs::create_directories(vtk_dir, ec);
     if (ec) {
         std::error_code ignored;
         if (created_out) fs::remove(dir, ignored);  // it is empty
-        throw UserError("vtk = '" + vtk_dir + "': cannot create the directory: " + ec.message());
+        throw UserError("--vtk = '" + vtk_dir + "': cannot create the directory: " + ec.message());
     }
 }
 
@@ -693,7 +703,7 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     // one demcal per output folder: a second one (a repeated command, a sweep started twice) stops here
     const auto lock = lock_output_folder(dir);
     if (fs::exists(dir / kCheckpointName) || fs::is_regular_file(dir / "summary.json"))
-        throw UserError("out = '" + dir.string() + "': another demcal has just run into this folder");
+        throw UserError("--out = '" + dir.string() + "': another demcal has just run into this folder");
     const auto vtk_lock = lock_vtk_folder(s.vtk_dir, dir);
     if (!s.vtk_dir.empty()) check_vtk_folder_free(s.vtk_dir);  // a run started beside this one
     if (!o.no_checkpoint) {
@@ -740,7 +750,7 @@ void resume_silo(const SiloCli& o, CLI::App& sub) {
     }
     // the results, the next checkpoints and the snapshots go where the run wrote before: still writable?
     check_output_folder(dir.string(), "--resume");
-    if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "vtk (the run's snapshot folder, in its checkpoint)");
+    if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk (the run's snapshot folder, in its checkpoint)");
     const auto lock = lock_output_folder(dir);  // two resumes of one run read and wrote one checkpoint at once
     const auto vtk_lock = lock_vtk_folder(s.vtk_dir, dir);
     if (!o.no_plots) require_gnuplot("--no-plots");

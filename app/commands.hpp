@@ -2,6 +2,8 @@
 // A subcommand's callback throws demcal::UserError for bad input it finds itself, and lets the libraries'
 // std::invalid_argument through; main() prints either on one line and exits 2.
 #pragma once
+#include "orchestrator/campaign_suspended.hpp"
+
 #include <CLI/CLI.hpp>
 #include <stdexcept>
 #include <string>
@@ -13,9 +15,9 @@ struct UserError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Exit status of a command that stopped for a reason outside the input (the simulator could not be started): run
-// `demcal resume` once it is fixed (EX_TEMPFAIL of sysexits.h).
-inline constexpr int kExitResumeLater = 75;
+// Exit status of a command that stopped for a reason outside the input (a stop signal, a simulator that could not be
+// started): run the same command, or `demcal resume`, once it is fixed (orchestrator/campaign_suspended.hpp).
+inline constexpr int kExitResumeLater = orchestrator::kExitCampaignSuspended;
 
 // Exit status of a silo run that ended but could not write its results (a full disk; EX_IOERR of sysexits.h): not
 // the run's failure. A campaign does not mark such a run failed: it stops, and the same command runs it again.

@@ -68,6 +68,8 @@ int run_command(int argc, char** argv) {
         return app.exit(e) == 0 ? 0 : 2;
     } catch (const demcal::UserError& e) {
         return failed(2, "error", e.what());
+    } catch (const demcal::orchestrator::CampaignSuspended& e) {
+        return failed(demcal::orchestrator::kExitCampaignSuspended, "stopped", e.what());
     } catch (const std::filesystem::filesystem_error& e) {
         const int code = e.code().value();
         if (code == ENOSPC || code == EDQUOT || code == EIO)  // the machine's state, not the path the user gave

@@ -1,5 +1,7 @@
 #include "calibration/campaign_evaluator.hpp"
 
+#include "orchestrator/campaign_suspended.hpp"
+
 #include <stdexcept>
 
 namespace demcal::calibration {
@@ -32,9 +34,10 @@ FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runne
             ev.replacement_rounds = round;
         }
         if (ev.outcome.interrupted)
-            throw std::runtime_error("interrupted; every finished run is stored: run the same command again to resume");
+            throw orchestrator::CampaignSuspended(
+                "interrupted; every finished run is stored: run the same command again to resume");
         if (!ev.outcome.infrastructure_failure.empty())
-            throw std::runtime_error("the simulator could not be started (" + ev.outcome.infrastructure_failure +
+            throw orchestrator::CampaignSuspended("the simulator could not be started (" + ev.outcome.infrastructure_failure +
                                      "); every finished run is stored: fix it (--yade; the kernel engine: the demcal program) and run the same command again");
         return ev;
     };

@@ -116,11 +116,12 @@ std::vector<MacroTarget> parse_targets(const std::string& text) {
 
 std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigma, std::span<const double> tau,
                                                     double confidence) {
-    for (std::size_t i = 0; i < sigma.size() && i < tau.size(); ++i)
-        if (!(sigma[i] >= 0) || !(tau[i] >= 0))
-            throw std::invalid_argument("measured point " + std::to_string(i + 1) + " (" +
-                                        analytics::number_text(sigma[i]) + ":" + analytics::number_text(tau[i]) +
-                                        "): stresses must be >= 0 Pa");
+    for (std::size_t i = 0; i < sigma.size() && i < tau.size(); ++i) {
+        const std::string point = "measured point " + std::to_string(i + 1) + " (" +
+                                  analytics::number_text(sigma[i]) + ":" + analytics::number_text(tau[i]) + ")";
+        analytics::check_measured_stress(sigma[i], point + " SIGMA");
+        analytics::check_measured_stress(tau[i], point + " TAU");
+    }
     const auto line = analytics::fit_failure_line(sigma, tau, confidence);
     std::vector<MacroTarget> targets;
     for (const auto& q : macro_quantities()) {

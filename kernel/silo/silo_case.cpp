@@ -283,6 +283,25 @@ namespace {
 
 double mass_of_grain(const WheatMaterials& m) { return m.wheat.density * wheat_grain_volume(); }
 
+// The bed must fit the silo: `--particles 5e6` in the 105 mm silo passed the check, and its grains (36 times the
+// silo's volume) would have been generated in a column 30 m tall and spilled over the silo's top. The bound is the
+// densest packing grains can have (0.74, equal spheres in a lattice; random beds of spheres or elongated grains stay
+// below it), so that only a bed that cannot fit is refused, never a full silo.
+constexpr double kDensestSolidFraction = 0.74;
+void validate_bed_fits(const SiloCaseSettings& s, double grain_mass) {
+    const double grains = s.fill_mass > 0 ? s.fill_mass / grain_mass : double(s.particles);
+    const double grain_volume = grain_mass / s.materials.wheat.density;
+    const double smallest_bed = grains * grain_volume / kDensestSolidFraction;
+    if (smallest_bed <= s.geometry.volume()) return;
+    const bool by_mass = s.fill_mass > 0;
+    reject_setting(by_mass ? "fill_mass" : "particles", by_mass ? s.fill_mass : double(s.particles),
+                   "the bed does not fit the silo: its grains fill at least " + setting_text(smallest_bed) +
+                       " m^3 (at a solid fraction of " + setting_text(kDensestSolidFraction) +
+                       ", the densest packing), and the hopper and the body hold " +
+                       setting_text(s.geometry.volume()) + " m^3 (body height " +
+                       setting_text(s.geometry.body_height) + " m): fewer grains, or a taller body");
+}
+
 // The bed: a fill mass or a particle count, many grains and not beyond memory.
 void validate_bed_size(const SiloCaseSettings& s) {
     if (s.fill_mass < 0 || !std::isfinite(s.fill_mass)) reject_setting("fill_mass", s.fill_mass, "must be >= 0 kg");
@@ -302,6 +321,7 @@ void validate_bed_size(const SiloCaseSettings& s) {
     if (s.fill_mass / grain_mass > kMaxGrains)
         reject_setting("fill_mass", s.fill_mass,
                        "more than 5,000,000 grains of " + setting_text(grain_mass * 1e3) + " g");
+    validate_bed_fits(s, grain_mass);
 }
 
 // The stiffness and the time step: resolved, not needlessly fine.

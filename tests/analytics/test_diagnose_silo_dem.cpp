@@ -60,6 +60,8 @@ TEST_CASE("silo-dem data: unknown and ill-formed columns and cells are refused n
     const auto geometry = parse("theta_deg,outlet_m,rate_g_s\n30,0.03,160\n30,0.035,200\n");
     CHECK(geometry.conditions.size() == 2);
     CHECK(geometry.conditions[1].label() == "theta30_outlet0.035");
+    // close but apart by more than the 0.01 % resolution: two conditions
+    CHECK(parse("theta_deg,rate_g_s\n30,160\n30.01,161\n").conditions.size() == 2);
 
     struct Case {
         std::string csv, message;
@@ -75,7 +77,11 @@ TEST_CASE("silo-dem data: unknown and ill-formed columns and cells are refused n
         {"theta_deg,rate_g_s\n30,nan\n", "line 2, column rate_g_s"},
         {"theta_deg,outlet_m,rate_g_s\n30,0,160\n", "line 2, column outlet_m: value '0' must be > 0 m"},
         {"theta_deg,rate_g_s\n30,160,5\n", "line 2"},
-        {"theta_deg,rate_g_s\n", "no data rows"}};
+        {"theta_deg,rate_g_s\n", "no data rows"},
+        // one silo written two ways (a spreadsheet's rounding) was taken as two conditions, each with its own runs
+        {"theta_deg,rate_g_s\n30,160\n50,120\n30.0000001,161\n",
+         "line 4, column theta_deg: the condition theta30.0000001 differs from theta30 (line 2) by less than 0.01 %"},
+        {"theta_deg,outlet_m,rate_g_s\n30,0.035,160\n30,0.03500001,161\n", "differs from theta30_outlet0.035"}};
     for (const auto& c : cases) {
         INFO(c.csv);
         CHECK_THAT(refusal(c.csv), Catch::Matchers::Contains(c.message));

@@ -77,6 +77,12 @@ TEST_CASE("bad discharge files name the line and the column", "[measured]") {
     fails_with("conical,0.105,,,0.2,30,0.0055,780,0.171,anna,12.5\n", "line 3, column outlet_m: 0.2 is not smaller");
     fails_with("conical,0.105,,,0.035,95,0.0055,780,0.171,anna,12.5\n", "line 3, column theta_deg: 95");
     fails_with("conical,0.105,,,0.035,30,0.0055,780,,anna,12.5\n", "line 3, column W_kg_s: missing value");
+    // finite but absurd values were diagnosed as data: the same bounds as a geometry file's (predict)
+    fails_with("conical,0.105,,,0.035,30,0.0055,1e90,0.171,anna,12.5\n",
+               "line 3, column rho_b_kg_m3: 1e+90 outside [10, 20000] kg/m^3");
+    fails_with("conical,0.105,,,0.035,30,0.0055,780,5e7,anna,12.5\n", "line 3, column W_kg_s: 5e+07 outside");
+    fails_with("conical,1e4,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column D_m: 10000 outside [0, 100] m");
+    fails_with("conical,0.105,,,0.035,30,1e-9,780,0.171,anna,12.5\n", "line 3, column d_p_m: 1e-09 outside");
     fails_with("conical,,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column D_m: missing value");
     fails_with("conical,0.105,,,0.035,30,0.0055,780,0.171,,12.5\n", "line 3, column operator: missing value");
     fails_with("conical,0.105,,,0.035,30,0.0055,780,0.171,anna,1 2\n", "line 3, column moisture_pct: '1 2'");
@@ -89,4 +95,6 @@ TEST_CASE("bad discharge files name the line and the column", "[measured]") {
     CHECK_THROWS_WITH(load("sigma_Pa,tau_Pa\n1000,800\n2000,-5\n", MeasuredKind::shear),
                       Catch::Contains("line 3, column tau_Pa: -5"));
     CHECK_THROWS_WITH(load("sigma_Pa,sigma_Pa\n1,2\n", MeasuredKind::shear), Catch::Contains("duplicate column"));
+    CHECK_THROWS_WITH(load("sigma_Pa,tau_Pa\n1000,800\n2e12,5\n", MeasuredKind::shear),
+                      Catch::Contains("line 3, column sigma_Pa: 2e+12 Pa is above 1e+09 Pa"));
 }

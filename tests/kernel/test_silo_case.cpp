@@ -126,6 +126,26 @@ TEST_CASE("silo case: bad settings name the field and the value", "[silo]") {
                                        Catch::Matchers::Contains("checkpoint"));
 }
 
+TEST_CASE("silo case: a bed that cannot fit the silo is refused, a full silo is not", "[silo]") {
+    SiloCaseSettings s;  // the seed's 105 mm silo, 0.4 m body
+    s.geometry = SiloGeometry::conical(30);
+    s.particles = 5'000'000;  // 36 times the silo's volume of grains: it passed the check
+    CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("particles = 5e+06") &&
+                                       Catch::Matchers::Contains("the bed does not fit the silo"));
+    // the silo filled to its top at the solid fraction of a random bed (0.6): accepted
+    const double grain_volume = wheat_grain_volume();
+    s.particles = static_cast<long>(0.6 * s.geometry.volume() / grain_volume);
+    CHECK_NOTHROW(validate(s));
+    // by mass: the same rule, the field named as given
+    s.particles = 50000;
+    s.fill_mass = 0.8 * s.geometry.volume() * s.materials.wheat.density;
+    CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("fill_mass = ") &&
+                                       Catch::Matchers::Contains("does not fit"));
+    // a taller body takes it
+    s.geometry.body_height = 0.6;
+    CHECK_NOTHROW(validate(s));
+}
+
 TEST_CASE("silo case: a small rectangular hopper fills without losing grains and discharges", "[silo]") {
     SiloCaseSettings s = small_rectangular_case();
     std::vector<SiloProgress> reports;

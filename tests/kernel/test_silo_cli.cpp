@@ -87,17 +87,24 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                           Case{"--theta 30 --stop-fraction 2", "--stop-fraction = 2"},
                           Case{"--theta 30 --b 0.05", "--b = 0.05: applies to a rectangular hopper"},
                           Case{"--theta 30 --wall-limit 60 --no-checkpoint", "--wall-limit 60 needs the checkpoint"},
-                          Case{"", "theta: missing"},
+                          Case{"", "--theta: missing"},
                           // a value that once meant "not given" is a value like any other
                           Case{"--theta 30 --outlet -1", "outlet = -1"},
                           Case{"--theta 30 --rect --outlet -1", "--outlet = -1: must be positive"},
-                          Case{"--theta 30 --seed -1", "seed = -1"},
+                          Case{"--theta 30 --seed -1", "--seed = -1"},
                           Case{"--theta 30 --a 0.02", "--a = 0.02: applies to a rectangular hopper"},
                           Case{"--theta 30 --checkpoint-every nan", "--checkpoint-every: 'nan' is not a number"},
                           Case{"--theta 30 --wall-limit -5", "wall-limit = -5"},
                           Case{"--theta 30 --vtk /dev/null/x", "vtk = '/dev/null/x'"},
                           Case{"--theta 30 --vtk-every 0.1", "--vtk-every applies to the VTK snapshots"},
                           Case{"--theta 30 --fill-mass 1e9", "--fill-mass = 1e+09"},
+                          // the grains of a 30 m column in a 0.5 m silo: they passed --check
+                          Case{"--theta 30 --particles 5000000", "--particles = 5e+06: the bed does not fit the silo"},
+                          Case{"--theta 30 --fill-mass 20", "--fill-mass = 20: the bed does not fit the silo"},
+                          // a bed for YADE's conical silo script, from a rectangular silo
+                          Case{"--theta 30 --rect --export-bed bed.json", "--export-bed = 'bed.json': the bed files "
+                                                                          "are for YADE's silo"},
+                          Case{"--theta 30 --rect --export-cloud c.json", "--export-cloud = 'c.json'"},
                           Case{"--theta 30 --dt 1e-4", "dt = 0.0001: larger than the Rayleigh time step"},
                           // the bin's vibration: both numbers or none, ranges, no subnormals
                           Case{"--theta 30 --vibration-frequency 100",

@@ -44,7 +44,7 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"shear", tiny, "-s", "5e3", "--seed", "9223372036854775808"},
          "--seed: '9223372036854775808' is not an integer between 0 and 2147483647"},
         // an output path that cannot be written was found only after the whole calibration
-        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "-o", "/"}, "output = '/' is a folder"},
+        {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "-o", "/"}, "--output = '/' is a folder"},
         {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "-o", "/no/such/folder/m.json"},
          "the folder /no/such/folder does not exist"},
         // limits, named with the flag that lifts them (an absurd level count started millions of runs)
@@ -59,7 +59,10 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         // a negative cohesion target or negative measured stresses were calibrated against
         {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800: tau_c must be >= 0"},
         {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
-         "measured point 1 (5000:-7000): stresses must be >= 0 Pa"},
+         "measured point 1 (5000:-7000) TAU: -7000 Pa is negative"},
+        // a stress no shear cell reaches (kPa typed as Pa twice) was fitted as a line
+        {{"calibrate", "--start", tiny, "--measured", "5e3:4e3,1e4:8e3,2e13:13000"},
+         "measured point 3 (2e+13:13000) SIGMA: 2e+13 Pa is above 1e+09 Pa"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "friction_coefficient", "--alpha", "2"}, "alpha = 2"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--params", "particle_form", "--range", "particle_form=1:3"},
          "sensitivity level particle_form = 1.5"},
@@ -239,6 +242,23 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
     CHECK(test::run_demcal({"resume", campaign.string(), "--yade", stand_in.string()}, dir / "resume.log") == 0);
     INFO(test::read_file(dir / "resume.log"));
     for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::done);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a study stopped by a simulator that cannot start exits 75 as a shear campaign does, not as a failure",
+          "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("cli-study-not-started");
+    std::ofstream(dir / "broken-yade") << "#!/nonexistent/interpreter\n";
+    fs::permissions(dir / "broken-yade", fs::perms::owner_all);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const int rc = test::run_demcal({"sensitivity", tiny, "-s", "5e3,1e4,2e4", "--params", "friction_coefficient",
+                                     "--levels", "3", "--yade", (dir / "broken-yade").string(), "--retries", "0",
+                                     "--jobs", "1", "--campaign", (dir / "campaign").string()},
+                                    dir / "out.log");
+    INFO(test::read_file(dir / "out.log"));
+    CHECK(rc == 75);  // was 1, "failed", for the same stop that a shear campaign reports as "resume later"
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("demcal: stopped: the simulator could not be started"));
+    for (const auto& r : test::stored_runs(dir / "campaign")) CHECK(r.state == orchestrator::RunState::pending);
     fs::remove_all(dir);
 }
 

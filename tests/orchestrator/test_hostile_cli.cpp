@@ -246,7 +246,7 @@ TEST_CASE("crosscheck silo: repeated angles, too many angles and settings the ke
     fs::create_directories(dir);
     const std::string camp = (dir / "camp").string();
     const std::string shear_material = test::source_path("examples/materials/sand-tiny.json").string();
-    refused({{{"crosscheck", "silo", "--theta", "30,30", "--campaign", camp}, {"theta = 30 deg is given twice"}},
+    refused({{{"crosscheck", "silo", "--theta", "30,30", "--campaign", camp}, {"--theta = 30 deg is given twice"}},
              {{"crosscheck", "silo", "--theta", "10,20,30", "--max-runs", "4", "--campaign", camp},
               {"crosscheck silo: 3 angles x 2 runs = 6 simulations", "--max-runs = 4"}},
              {{"crosscheck", "silo", "--theta", "1e-320", "--campaign", camp}, {"--theta", "subnormal"}},
