@@ -40,36 +40,54 @@ std::optional<double> parse_number(const std::string& cell) {
     return v;
 }
 
-std::vector<std::string> split_csv_line(const std::string& line, const std::string& source, int line_no) {
-    std::vector<std::string> fields;
-    std::string cur;
-    bool quoted = false, was_quoted = false;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-        const char ch = line[i];
-        if (quoted) {
-            if (ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-                cur += '"';
-                ++i;
-            } else if (ch == '"') {
-                quoted = false;
+// Splits one record into fields, a piece at a time: RFC 4180 lets a quoted field hold line breaks (a spreadsheet's
+// notes cell of two lines), so a record left inside a quote goes on with the next line. Linear in the text: a file
+// that opens a quote and never closes it costs one pass, not one pass per line.
+class CsvRecordSplitter {
+public:
+    void feed(std::string_view text) {
+        for (std::size_t i = 0; i < text.size(); ++i) {
+            const char ch = text[i];
+            if (quoted_) {
+                if (ch == '"' && i + 1 < text.size() && text[i + 1] == '"') {
+                    append('"');
+                    ++i;
+                } else if (ch == '"') {
+                    quoted_ = false;
+                } else {
+                    append(ch);
+                }
+            } else if (ch == '"' && cur_blank_) {
+                quoted_ = was_quoted_ = true;
+                cur_.clear();
+            } else if (ch == ',') {
+                end_field();
             } else {
-                cur += ch;
+                append(ch);
             }
-        } else if (ch == '"' && trim(cur).empty()) {
-            quoted = was_quoted = true;
-            cur.clear();
-        } else if (ch == ',') {
-            fields.push_back(was_quoted ? cur : trim(cur));
-            cur.clear();
-            was_quoted = false;
-        } else {
-            cur += ch;
         }
     }
-    if (quoted) throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": unterminated quote");
-    fields.push_back(was_quoted ? cur : trim(cur));
-    return fields;
-}
+    bool open_quote() const { return quoted_; }
+    std::vector<std::string> finish() {
+        end_field();
+        return std::move(fields_);
+    }
+
+private:
+    void append(char ch) {
+        cur_ += ch;
+        cur_blank_ = cur_blank_ && (ch == ' ' || ch == '\t' || ch == '\r');
+    }
+    void end_field() {
+        fields_.push_back(was_quoted_ ? cur_ : trim(cur_));
+        cur_.clear();
+        cur_blank_ = true;
+        was_quoted_ = false;
+    }
+    std::vector<std::string> fields_;
+    std::string cur_;
+    bool cur_blank_ = true, quoted_ = false, was_quoted_ = false;
+};
 
 // Cells that may be empty: the geometry-specific sizes (they apply to one geometry only).
 bool may_be_empty(const std::string& column) { return column == "D_m" || column == "b_m" || column == "c_m"; }
@@ -203,21 +221,32 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
         if (line_no == 1) strip_byte_order_mark(line, source);
         const std::string t = trim(line);
         if (t.empty() || t[0] == '#') continue;  // blank lines and comments hold no data
-        const auto fields = split_csv_line(line, source, line_no);
+        const int first_line = line_no;
+        CsvRecordSplitter record;
+        record.feed(line);
+        for (std::string more; record.open_quote() && std::getline(in, more);) {
+            ++line_no;
+            record.feed("\n");
+            record.feed(more);
+        }
+        if (record.open_quote())
+            throw std::invalid_argument(source + ": line " + std::to_string(first_line) +
+                                        ": unterminated quote (the quoted field runs to the end of the file)");
+        const auto fields = record.finish();
         if (!have_header) {
-            read_header(data, fields, t[0], source, line_no);
+            read_header(data, fields, t[0], source, first_line);
             have_header = true;
             continue;
         }
         if (fields.size() != data.columns.size())
-            throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": " +
+            throw std::invalid_argument(source + ": line " + std::to_string(first_line) + ": " +
                                         std::to_string(fields.size()) + " fields, the header has " +
                                         std::to_string(data.columns.size()) +
                                         (fields.size() > data.columns.size() && data.columns.size() > 1
                                              ? " (a decimal comma, 0,105, or an unquoted comma in a text splits a "
                                                "field: numbers are written 0.105)"
                                              : ""));
-        data.lines.push_back(line_no);
+        data.lines.push_back(first_line);
         for (std::size_t c = 0; c < fields.size(); ++c) data.columns[c].text.push_back(fields[c]);
     }
     if (!have_header) throw std::invalid_argument(source + ": no header line");
@@ -326,7 +355,7 @@ std::string to_csv(const MeasuredData& data) {
             out << (c ? "," : "");
             if (col.numeric && !col.values.empty())
                 out << (std::isnan(col.values[r]) ? std::string() : num(col.values[r]));
-            else if (col.text[r].find_first_of(",\"") != std::string::npos)
+            else if (col.text[r].find_first_of(",\"\n\r") != std::string::npos)  // RFC 4180: these are quoted
                 out << '"' << std::regex_replace(col.text[r], std::regex("\""), "\"\"") << '"';
             else
                 out << col.text[r];

@@ -37,6 +37,27 @@ TEST_CASE("discharge CSV loads every row with covariates", "[measured]") {
     CHECK(round.at("W_kg_s").values[0] == Approx(0.171));
 }
 
+TEST_CASE("a quoted field may hold line breaks (RFC 4180), and a quote never closed is named at its line", "[measured]") {
+    // a spreadsheet's notes cell of two lines: it was refused as an unterminated quote
+    const auto data = load(header + "conical,0.105,,,0.035,30,0.0055,780,0.171,\"anna\nwith bob, after rain\",12.5\n" +
+                           "conical,0.105,,,0.035,45,0.0055,780,0.15,\"\"\"quoted\"\"\",13\n");
+    REQUIRE(data.rows() == 2);
+    CHECK(data.lines == std::vector<int>{2, 4});  // the line each row starts on
+    CHECK(data.at("operator").text[0] == "anna\nwith bob, after rain");
+    CHECK(data.at("operator").text[1] == "\"quoted\"");
+    CHECK(data.at("moisture_pct").values[0] == Approx(12.5));
+    std::istringstream again(to_csv(data));  // written back quoted, read back the same
+    CHECK(parse_csv(again, "again.csv").at("operator").text[0] == "anna\nwith bob, after rain");
+    // a row after a field with a line break keeps its own line number in messages
+    CHECK_THROWS_WITH(load(header + "conical,0.105,,,0.035,30,0.0055,780,0.171,\"a\nb\",12.5\n" +
+                           "conical,0.105,,,0.035,30,0.0055,780,-1,anna,12.5\n"),
+                      Catch::Contains("line 4, column W_kg_s"));
+    // never closed: named at the line it opens, after one pass over the rest (100,000 lines, not a pass per line)
+    std::string open = header + "conical,0.105,,,0.035,30,0.0055,780,0.171,\"anna,12.5\n";
+    for (int i = 0; i < 100000; ++i) open += "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n";
+    CHECK_THROWS_WITH(load(open), Catch::Contains("set.csv: line 2: unterminated quote"));
+}
+
 TEST_CASE("a spreadsheet's UTF-8 byte-order mark and CRLF line ends are read, UTF-16 is refused", "[measured]") {
     const std::string row = "conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n";
     const auto with_mark = load("\xEF\xBB\xBF" + header + row);
