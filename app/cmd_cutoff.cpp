@@ -244,7 +244,8 @@ SiloRunPlan silo_run_plan(const CutoffCli& o, double frequency, unsigned seed, d
 // or seeds share a campaign and reuse each other's runs.
 nlohmann::json silo_campaign_settings(const CutoffCli& o) {
     return {{"command", "cutoff"},         {"silo_args", o.silo_args},     {"amplitude_m", o.base.amplitude},
-            {"direction", "x"},            {"window_s", o.base.window},    {"flowing_fraction", kFlowingFraction}};
+            {"direction", "x"},            {"window_s", o.base.window},    {"flowing_fraction", kFlowingFraction},
+            {kInputFileDigestsKey, silo_input_file_digests(o.silo_args)}};
 }
 
 struct SearchStopped {};  // a signal or a suspended run stopped the campaign: the same command continues it

@@ -78,7 +78,7 @@ SiloRunPlan silo_plan(const VibrationCli& o, const RunSpec& r) {
 json campaign_settings(const VibrationCli& o) {
     json s = {{"thetas_deg", o.thetas},     {"frequencies_hz", o.frequencies}, {"amplitude_m", o.amplitude},
               {"direction", o.direction},   {"repeats", o.repeats},           {"first_seed", o.first_seed},
-              {"silo_args", o.silo_args}};
+              {"silo_args", o.silo_args},   {kInputFileDigestsKey, silo_input_file_digests(o.silo_args)}};
     // absent for the whole bin: sweeps from before --part continue
     if (kernel::silo::vibrating_part_named(o.part) != kernel::silo::VibratingPart::bin) s["part"] = o.part;
     return s;

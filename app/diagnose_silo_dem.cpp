@@ -456,8 +456,10 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
     const an::SiloMeasurements& data = in.data;
     SiloDemCampaign campaign(a, data, in.declared);
     campaign.check_settings();  // silo's own checks of every condition and the material, nothing written
+    // (the materials are files of the campaign named by their digest; a --geometry after -- is the user's file)
     const json settings{{"command", "diagnose --model silo-dem"}, {"silo_args", a.silo_args},
-                        {"first_seed", a.first_seed}, {"prediction_seeds", a.seeds}};
+                        {"first_seed", a.first_seed}, {"prediction_seeds", a.seeds},
+                        {kInputFileDigestsKey, silo_input_file_digests(a.silo_args)}};
     // runs are named by material, condition and seed, so more (or other) prediction seeds reuse the runs already made:
     // the design for separating a rival asks for exactly that (--seeds m)
     open_silo_campaign(a.campaign, settings, "diagnose silo-dem", {"first_seed", "prediction_seeds"});

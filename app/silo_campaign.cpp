@@ -170,6 +170,38 @@ void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
     }
 }
 
+json silo_input_file_digests(const std::vector<std::string>& silo_args) {
+    json digests = json::object();
+    for (std::size_t i = 0; i < silo_args.size(); ++i)
+        for (const std::string option : {"--material", "--geometry"}) {
+            std::string file;
+            if (silo_args[i] == option && i + 1 < silo_args.size())
+                file = silo_args[i + 1];
+            else if (silo_args[i].rfind(option + "=", 0) == 0)
+                file = silo_args[i].substr(option.size() + 1);
+            else
+                continue;
+            digests[option] = orchestrator::sha256_hex(orchestrator::read_text_file(file));
+        }
+    return digests;
+}
+
+namespace {
+// The top-level settings whose values differ between two campaign.json objects, e.g. "amplitude_m, input_files_sha256"
+std::string differing_settings(const json& stored, const json& now) {
+    std::string keys;
+    auto add = [&](const std::string& key) {
+        if (keys.find(key) == std::string::npos) keys += (keys.empty() ? "" : ", ") + key;
+    };
+    if (!stored.is_object() || !now.is_object()) return "the whole file";
+    for (const auto& [key, value] : now.items())
+        if (!stored.contains(key) || stored[key] != value) add(key);
+    for (const auto& [key, value] : stored.items())
+        if (!now.contains(key)) add(key);
+    return keys;
+}
+}  // namespace
+
 void open_silo_campaign(const fs::path& dir, const json& settings, const std::string& command,
                         const std::vector<std::string>& may_change) {
     const fs::path settings_file = dir / "campaign.json";
@@ -194,9 +226,27 @@ void open_silo_campaign(const fs::path& dir, const json& settings, const std::st
             throw UserError("campaign = '" + dir.string() + "' holds a " +
                             (stored_command.empty() ? "campaign of another command" : stored_command + " campaign") +
                             " (" + settings_file.string() + "), not a " + command + " one: give another --campaign");
-        if (stored != now)
+        // made before its input files' digests: it takes the files as they are now (what it ran with is not known)
+        const bool without_digests = stored.is_object() && !stored.contains(kInputFileDigestsKey) &&
+                                     now.contains(kInputFileDigestsKey);
+        if (without_digests) now.erase(kInputFileDigestsKey);
+        if (stored != now) {
+            const std::string differ = differing_settings(stored, now);
             throw UserError("campaign = '" + dir.string() + "' holds a " + command + " campaign with other settings (" +
-                            settings_file.string() + "): give another --campaign, or the same settings to continue it");
+                            settings_file.string() + "; they differ in " + differ + ")" +
+                            (differ.find(kInputFileDigestsKey) != std::string::npos
+                                 ? ": a --material or --geometry file was changed since the campaign began; its runs "
+                                   "are of the file as it was"
+                                 : "") +
+                            ": give another --campaign, or the same settings to continue it");
+        }
+        if (without_digests) {
+            json updated = read_json_file(settings_file.string(), "campaign settings");
+            updated[kInputFileDigestsKey] = settings[kInputFileDigestsKey];
+            orchestrator::write_text_file_atomically(settings_file, updated.dump(1) + "\n");
+            std::cout << "note: " << settings_file.string() << " was made before demcal recorded its input files' "
+                         "digests; it takes them as they are now\n";
+        }
         return;
     }
     fs::create_directories(dir / "runs");

@@ -27,8 +27,20 @@ void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const 
 // message. Call with the distinct settings only (repeats differing by seed need one check).
 void check_silo_runs(const std::vector<SiloRunPlan>& plans);
 
+// The key under which a campaign's settings hold silo_input_file_digests.
+inline constexpr const char* kInputFileDigestsKey = "input_files_sha256";
+
+// The SHA-256 of each input file the silo options name (--material, --geometry; "--opt FILE" or "--opt=FILE"), by
+// option: a campaign's settings hold them, so that a material or geometry file edited in place is a new campaign, not
+// the old runs reused under the same option text (a sweep reported 155 g/s from runs of the unedited material, where
+// the edited one discharges 75 g/s). Call after the files were checked (silo --check): a file that cannot be read
+// throws.
+nlohmann::json silo_input_file_digests(const std::vector<std::string>& silo_args);
+
 // DIR/campaign.json: created with `settings` (and DIR/runs) when absent; when present it must hold the same settings,
-// else UserError (another campaign lives there). The keys in `may_change` (a sweep's grid: more angles, frequencies or
+// else UserError naming the settings that differ (another campaign lives there, or its input files changed). A
+// campaign.json from before the input files' digests (no kInputFileDigestsKey) takes the files' present digests, with
+// a note. The keys in `may_change` (a sweep's grid: more angles, frequencies or
 // seeds add runs to the same campaign) are left out of the comparison. Call after every check of the input.
 void open_silo_campaign(const std::filesystem::path& dir, const nlohmann::json& settings, const std::string& command,
                         const std::vector<std::string>& may_change = {});

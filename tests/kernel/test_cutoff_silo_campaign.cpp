@@ -12,6 +12,7 @@
 #include <thread>
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -27,9 +28,10 @@ TEST_CASE("demcal cutoff in the silo: runs kept in a campaign, the same command 
     const fs::path dir = fs::temp_directory_path() / ("demcal-test-cutoff-campaign-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
-    const std::string silo = " -- --material '" + std::string(DEMCAL_SOURCE_DIR) +
-                             "/examples/materials/silo_meal.json' --theta 30 --particles 300 --stiffness-scale 0.01 "
-                             "--fill-time 0.3 --threads 1";
+    const fs::path material = dir / "meal.json";  // a copy, edited below
+    fs::copy_file(fs::path(DEMCAL_SOURCE_DIR) / "examples/materials/silo_meal.json", material);
+    const std::string silo = " -- --material '" + material.string() +
+                             "' --theta 30 --particles 300 --stiffness-scale 0.01 --fill-time 0.3 --threads 1";
     const std::string search = "cutoff --amplitude 2.2e-4 --bracket 0,400 --tol 200 --seeds 1,2 --jobs 2 --campaign '" +
                                (dir / "c").string() + "' --json '";
     // no arch: "no cut-off found" (exit 1), both seeds run at 0 Hz and kept
@@ -54,6 +56,26 @@ TEST_CASE("demcal cutoff in the silo: runs kept in a campaign, the same command 
     CHECK_THAT(read_file(dir / "again.log"), !Catch::Contains("[1/2]"));
     const auto again = nlohmann::json::parse(read_file(dir / "again.json"));
     CHECK(again["runs"] == first["runs"]);
+
+    // a campaign from before the input files' digests takes the files as they are, with a note, and runs nothing
+    auto stored = nlohmann::json::parse(read_file(dir / "c" / "campaign.json"));
+    REQUIRE(stored.contains("input_files_sha256"));
+    CHECK(stored["input_files_sha256"].contains("--material"));
+    stored.erase("input_files_sha256");
+    std::ofstream(dir / "c" / "campaign.json") << stored.dump(1);
+    CHECK(run_demcal_command(search + (dir / "old.json").string() + "'" + silo, dir / "old.log") == 1);
+    CHECK_THAT(read_file(dir / "old.log"), Catch::Contains("takes them as they are now") && !Catch::Contains("[1/2]"));
+    CHECK(nlohmann::json::parse(read_file(dir / "c" / "campaign.json")).contains("input_files_sha256"));
+
+    // the material file edited in place: its old runs were reused under the same option text (a sweep reported the
+    // unedited material's rate); now refused, the reason named, nothing run or written
+    auto meal = nlohmann::json::parse(read_file(material));
+    meal["grain"]["density_kg_m3"] = 1400;
+    std::ofstream(material) << meal.dump(1);
+    CHECK(run_demcal_command(search + (dir / "edited.json").string() + "'" + silo, dir / "edited.log") == 2);
+    CHECK_THAT(read_file(dir / "edited.log"), Catch::Contains("they differ in input_files_sha256") &&
+                                                  Catch::Contains("a --material or --geometry file was changed"));
+    CHECK_FALSE(fs::exists(dir / "edited.json"));
 
     // another amplitude is another campaign: refused in this folder, nothing written
     CHECK(run_demcal_command("cutoff --amplitude 1e-4 --campaign '" + (dir / "c").string() + "'" + silo,
