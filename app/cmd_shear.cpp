@@ -226,8 +226,14 @@ void print_status(const std::string& dir) {
 }
 
 void run_resume(const ShearCliOptions& opt) {
-    if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite"))
-        throw UserError("--campaign = '" + opt.campaign_dir + "' holds no campaign.sqlite");
+    if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite")) {
+        // a silo sweep's folder (vibration, cutoff, diagnose silo-dem) is continued by its own command, run again
+        const std::string what = fs::exists(fs::path(opt.campaign_dir) / "campaign.json")
+                                     ? ": it holds a silo sweep (campaign.json of demcal vibration, cutoff or diagnose "
+                                       "silo-dem), which the same command, run again, continues"
+                                     : "";
+        throw UserError("resume: DIR = '" + opt.campaign_dir + "' holds no campaign.sqlite" + what);
+    }
     if (opt.yade_given) {  // void where every unfinished campaign runs on the kernel (it was silently ignored)
         bool unfinished = false, on_yade = false;
         for (const auto& o : inspect_campaigns(opt.campaign_dir)) {
