@@ -206,6 +206,12 @@ Model failure_line_model(const MeasuredData& d, Setting& s) {
                                     " Pa: a failure line needs at least two different normal stresses");
     const auto [lowest, highest] = std::minmax_element(sigma.begin(), sigma.end());
     check_normal_stress_spread(*lowest, *highest, "sigma_Pa");  // 5000, 5000.0000001, ... gave mu_b = 3.7e8
+    // a shear strength that falls with the normal stress is no bulk solid's: mu_b = -0.98 was reported as determined
+    if (const FailureLine line = fit_failure_line(sigma, tau); line.mu_b_high < 0)
+        throw std::invalid_argument("sigma_Pa, tau_Pa: the failure line's slope mu_b = " + short_number(line.mu_b) +
+                                    " (95 % interval up to " + short_number(line.mu_b_high) +
+                                    ") is negative: the shear strength falls as the normal stress rises, which no bulk "
+                                    "solid's does (columns swapped, or a sign lost?)");
     m.relative = false;
     m.param_names = {"mu_b", "tau_c_Pa"};
     double c0 = 0, c1 = 0, c00, c01, c11, sse;

@@ -126,7 +126,7 @@ struct PlausibleRange {
 // `shown`: what precedes the value ("rho_b_kg_m3=", "data.csv: line 3, column rho_b_kg_m3: ")
 void check_in_range(const std::string& shown, double v, const PlausibleRange& r) {
     if (!(v >= r.low && v <= r.high))
-        throw std::invalid_argument(shown + number_text(v) + " outside [" + number_text(r.low) + ", " +
+        throw std::invalid_argument(shown + number_text(v, 10) + " outside [" + number_text(r.low) + ", " +
                                     number_text(r.high) + "]" + (*r.unit ? std::string(" ") + r.unit : std::string()) +
                                     " (" + r.why + ")");
 }

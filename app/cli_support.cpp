@@ -415,6 +415,21 @@ void check_paths_apart(const std::vector<NamedPath>& inputs, const std::vector<N
     }
 }
 
+std::string with_option_name(const CLI::App& app, const std::string& message) {
+    std::size_t n = 0;
+    while (n < message.size() && (std::islower(static_cast<unsigned char>(message[n])) ||
+                                  std::isdigit(static_cast<unsigned char>(message[n])) || message[n] == '_'))
+        ++n;
+    if (n == 0 || message.compare(n, 3, " = ") != 0) return message;
+    const CLI::App* command = &app;
+    for (auto subs = command->get_subcommands(); !subs.empty(); subs = command->get_subcommands())
+        command = subs.front();
+    std::string option = "--" + message.substr(0, n);
+    std::replace(option.begin(), option.end(), '_', '-');
+    if (const_cast<CLI::App*>(command)->get_option_no_throw(option) == nullptr) return message;
+    return option + message.substr(n);
+}
+
 std::string duration_text(double seconds) {
     if (!(seconds >= 0)) return "?";
     char buf[32];

@@ -86,6 +86,12 @@ void check_side_files_free(const std::string& output, const std::vector<std::str
 // the file system resolves them: relative or absolute, "..", symbolic links. Throws UserError naming both options.
 void check_paths_apart(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
 
+// A library's refusal names its own field ("tol = 400 Hz: ...", "max_window = 2 s: ..."); where the command being run
+// has an option of that name (tol -> --tol, max_window -> --max-window), the message names the option as typed
+// instead. Only a message that starts with "FIELD = " changes; `app` is the parsed command line (its deepest
+// subcommand decides).
+std::string with_option_name(const CLI::App& app, const std::string& message);
+
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);
 

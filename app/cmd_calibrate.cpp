@@ -218,6 +218,7 @@ struct CalibrateCli {
 std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
     if (o.target.empty() == o.measured.empty()) throw UserError("give exactly one of --target and --measured");
     if (!o.target.empty()) return parse_targets(o.target);
+    refuse_empty_list_items(o.measured, "--measured");
     std::vector<double> sigma, tau;
     std::stringstream items(o.measured);
     std::string item;
@@ -302,7 +303,7 @@ std::vector<ControlParameter> pick_controls(const CalibrateCli& o, const Sensiti
     return picked;
 }
 
-SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json& start) {
+SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json& start, LineKind line) {
     SensitivityStudy study;
     try {
         study = SensitivityStudy::from_json(read_json_file(file, "sensitivity"));
@@ -310,6 +311,12 @@ SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json
         throw UserError("--sensitivity = '" + file + "': " + e.what());
     }
     check_study_matches_start(study, start, file);
+    // its responses are of the line it studied: a study of the peak line steered a calibration of the residual one
+    if (study.options.line != line)
+        throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': a study of the " +
+                        to_string(study.options.line) + " failure line, and --line " + to_string(line) +
+                        ": its responses are of the other line (run the study with --line " + to_string(line) +
+                        ", or calibrate the " + to_string(study.options.line) + " line)");
     return study;
 }
 
@@ -381,7 +388,7 @@ void run_calibrate(CalibrateCli& o) {
     SensitivityStudy study;
     std::vector<ControlParameter> controls;
     if (!o.sensitivity_file.empty()) {
-        study = read_stored_study(o.sensitivity_file, start);
+        study = read_stored_study(o.sensitivity_file, start, line_kind_from_string(o.study.campaign.line));
         controls = pick_controls(o, study, targets, bounds);  // a study that cannot serve: refused before the campaign
     }
     CampaignSession session(camp, "calibrate");

@@ -312,6 +312,7 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
                              ? fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(settings.dump()).substr(0, 12))
                              : fs::path(o.campaign);
     check_output_folder(dir.string(), "--campaign");
+    check_paths_apart(silo_campaign_inputs(o.silo_args, dir), {{o.json, "--json"}});
     if (!base.materials.cohesive())
         std::printf("note: the material has no cohesion (surface_energy_J_m2 = 0): a cohesionless bed rarely arches\n");
     open_silo_campaign(dir, settings, "cutoff");

@@ -40,6 +40,7 @@ struct ShearCliOptions {
     std::string engine = "yade";
     ExecutionOptions exec;
     bool yade_given = false;  // resume: --yade typed (it applies to campaigns of the YADE engine)
+    bool max_runs_given = false;  // resume: --max-runs typed (it bounds the runs left; it was ignored)
 };
 
 // Failure line with its points and 95 % band, and the shear curves, for one campaign.
@@ -219,13 +220,25 @@ void print_campaign_status(const ShearCampaignOutcome& o, bool folder_held) {
     if (ev.peak) print_line("  peak failure line", *ev.peak);
 }
 
+// status and resume take the campaign's folder: given its campaign.sqlite (or any file), they said "'.../campaign.sqlite'
+// holds no campaign.sqlite"
+void check_campaign_folder_argument(const std::string& dir, const std::string& command) {
+    std::error_code ec;
+    if (fs::is_regular_file(dir, ec))
+        throw UserError(command + ": DIR = '" + analytics::shortened_text(dir, 200) +
+                        "' is a file, not a campaign folder: give the folder that holds it (" +
+                        analytics::shortened_text(fs::path(dir).parent_path().string(), 200) + ")");
+}
+
 void print_status(const std::string& dir) {
+    check_campaign_folder_argument(dir, "status");
     const std::vector<ShearCampaignOutcome> outs = inspect_campaigns(dir);
     for (const auto& o : outs) print_campaign_status(o, orchestrator::FolderLock::held(dir));
     if (outs.empty()) std::cout << "no campaigns in " << dir << "\n";
 }
 
 void run_resume(const ShearCliOptions& opt) {
+    check_campaign_folder_argument(opt.campaign_dir, "resume");
     if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite")) {
         // a silo sweep's folder (vibration, cutoff, diagnose silo-dem) is continued by its own command, run again
         const std::string what = fs::exists(fs::path(opt.campaign_dir) / "campaign.json")
@@ -247,6 +260,17 @@ void run_resume(const ShearCliOptions& opt) {
         if (unfinished && !on_yade)
             throw UserError("--yade = '" + analytics::shortened_text(opt.exec.yade) + "' is YADE's launcher: the "
                             "unfinished campaigns of " + opt.campaign_dir + " run on the kernel engine; omit it");
+    }
+    if (opt.max_runs_given) {  // the runs left, bounded as a new campaign's planned runs are
+        std::size_t left = 0;
+        for (const auto& o : inspect_campaigns(opt.campaign_dir))
+            left += std::size_t(std::count_if(o.runs.begin(), o.runs.end(), [](const orchestrator::RunRecord& r) {
+                return r.state != orchestrator::RunState::done;
+            }));
+        if (left > std::size_t(opt.exec.max_runs))
+            throw UserError("--max-runs = " + std::to_string(opt.exec.max_runs) + ": the campaigns of " +
+                            opt.campaign_dir + " have " + std::to_string(left) +
+                            " runs not done; resume them with a --max-runs of at least that, or without it");
     }
     find_yade(opt.exec.yade);  // before the store is opened: a bad --yade costs nothing
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
@@ -294,6 +318,7 @@ void add_shear_commands(CLI::App& app) {
     add_execution_options(resume, resume_opt->exec);
     resume->callback([resume_opt, resume] {
         resume_opt->yade_given = resume->count("--yade") > 0;
+        resume_opt->max_runs_given = resume->count("--max-runs") > 0;
         run_resume(*resume_opt);
     });
 }

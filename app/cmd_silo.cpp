@@ -312,6 +312,9 @@ ks::BinVibration vibration_from(const SiloCli& o, CLI::App& sub) {
                                 " applies to a vibrating bin: add --vibration-frequency and --vibration-amplitude");
         return {};
     }
+    if (o.vibration_frequency == 0)  // a still bin: the amplitude was recorded in the summary and did nothing
+        throw UserError("--vibration-frequency 0 is a still bin: --vibration-amplitude and the other --vibration "
+                        "options do nothing; leave them out, or give a frequency above 0");
     ks::BinVibration v;
     v.frequency = o.vibration_frequency;
     v.amplitude = o.vibration_amplitude;

@@ -48,6 +48,7 @@ struct VibrationCli {
     int jobs = 1;  // runs at once: one locally (each takes the cores its --threads gives it), SLURM array slots
     std::string executor = "local", partition;
     std::vector<std::string> silo_args;  // after --: passed to every `demcal silo`
+    std::vector<std::string> vibration_options_given;  // --amplitude, --direction, --part as typed (void in a still bin)
 };
 
 struct RunSpec {
@@ -113,6 +114,10 @@ void check_options(const VibrationCli& o) {
     bool vibrating = false;
     for (double f : o.frequencies) vibrating = vibrating || f > 0;
     if (vibrating && !(o.amplitude > 0)) throw UserError("--amplitude: a frequency above 0 needs an amplitude > 0 m");
+    if (!vibrating && !o.vibration_options_given.empty())  // every cell a still bin: they were accepted and ignored
+        throw UserError(o.vibration_options_given.front() +
+                        " applies to a vibrating bin, and every --frequency is 0 (a still bin): leave it out, or add "
+                        "a frequency above 0");
     if (o.direction != "x" && o.direction != "z")
         throw UserError("--direction = '" + o.direction.substr(0, 20) + "': x (perpendicular to the axis) or z");
     if (!kernel::silo::vibrating_part_named(o.part))
@@ -376,6 +381,16 @@ int run(const VibrationCli& o) {
     for (const RunSpec& r : runs) plans.push_back(silo_plan(o, r));
     // every cell's settings checked by silo itself before anything is written (the repeats differ by seed only)
     check_silo_runs({plans.begin(), plans.begin() + std::ptrdiff_t(o.thetas.size() * o.frequencies.size())});
+    // the sweep's reports go into its folder: an input file kept there under one of their names would be replaced
+    std::vector<NamedPath> reports;
+    for (const char* name : {"vibration.json", "vibration.md", "vibration.png"})
+        reports.push_back({(dir / name).string(), "the sweep's report (--campaign)"});
+    for (double theta : o.thetas) {
+        std::ostringstream name;  // as plot_rates names them
+        name << "vibration_theta" << theta << ".dat";
+        reports.push_back({(dir / name.str()).string(), "the sweep's table (--campaign)"});
+    }
+    check_paths_apart(silo_campaign_inputs(o.silo_args, dir), reports);
     // a run is its angle, frequency and seed under the shared settings: a grid that grows (or shrinks) is the same
     // campaign, its finished runs reused
     open_silo_campaign(dir, campaign_settings(o), "vibration", {"thetas_deg", "frequencies_hz", "repeats", "first_seed"});
@@ -435,7 +450,9 @@ void add_vibration_command(CLI::App& app) {
     sub->footer("Example: demcal vibration --theta 10,30,60 --frequency 0,50,100,145 --amplitude 1.1e-4 --repeats 3 "
                 "--campaign vib -- --geometry examples/silo/reduced_conical_70deg.json --particles 4000 "
                 "--stiffness-scale 0.001 --fill-time 0.5 --threads 1 --no-plots");
-    sub->callback([o] {
+    sub->callback([o, sub] {
+        for (const char* option : {"--amplitude", "--direction", "--part"})
+            if (sub->count(option)) o->vibration_options_given.push_back(option);
         const int status = run(*o);
         if (status != 0) throw CLI::RuntimeError(status);
     });

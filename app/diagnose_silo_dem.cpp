@@ -333,8 +333,9 @@ SiloDemInputs read_silo_dem_inputs(const SiloDemArgs& a) {
     // outputs first (issue 23): a path that cannot be written is refused before any run
     check_output_file_in_new_folders(a.json_out, "--json");
     check_output_file_in_new_folders(a.report_out, "--report");
-    check_paths_apart({{a.data, "--data"}, {a.material, "--material"}},
-                      {{a.json_out, "--json"}, {a.report_out, "--report"}, {a.campaign, "--campaign"}});
+    std::vector<NamedPath> inputs = silo_campaign_inputs(a.silo_args, a.campaign);
+    inputs.insert(inputs.end(), {{a.data, "--data"}, {a.material, "--material"}});
+    check_paths_apart(inputs, {{a.json_out, "--json"}, {a.report_out, "--report"}, {a.campaign, "--campaign"}});
     if (fs::exists(a.campaign) && !fs::is_directory(a.campaign))
         throw UserError("--campaign = '" + a.campaign + "' is a file; give a folder");
     check_output_file_in_new_folders((fs::path(a.campaign) / "campaign.json").string(), "--campaign");

@@ -67,7 +67,7 @@ int run_command(int argc, char** argv) {
         // --help and --version exit 0; a malformed command line is bad input like any other: exit 2
         return app.exit(e) == 0 ? 0 : 2;
     } catch (const demcal::UserError& e) {
-        return failed(2, "error", e.what());
+        return failed(2, "error", demcal::with_option_name(app, e.what()));
     } catch (const demcal::orchestrator::CampaignSuspended& e) {
         return failed(demcal::orchestrator::kExitCampaignSuspended, "stopped", e.what());
     } catch (const std::filesystem::filesystem_error& e) {
@@ -79,7 +79,7 @@ int run_command(int argc, char** argv) {
         return failed(2, "error", "'" + e.path1().string() + "': " + e.code().message() +
                                       " (a file where a folder belongs, a link loop or a read-only folder in the path?)");
     } catch (const std::invalid_argument& e) {  // the libraries' word for bad input
-        return failed(2, "error", e.what());
+        return failed(2, "error", demcal::with_option_name(app, e.what()));
     } catch (const std::exception& e) {
         return failed(1, "failed", e.what());
     }

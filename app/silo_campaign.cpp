@@ -170,19 +170,28 @@ void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
     }
 }
 
-json silo_input_file_digests(const std::vector<std::string>& silo_args) {
-    json digests = json::object();
+std::vector<std::pair<std::string, std::string>> silo_input_files(const std::vector<std::string>& silo_args) {
+    std::vector<std::pair<std::string, std::string>> files;
     for (std::size_t i = 0; i < silo_args.size(); ++i)
         for (const std::string option : {"--material", "--geometry"}) {
-            std::string file;
             if (silo_args[i] == option && i + 1 < silo_args.size())
-                file = silo_args[i + 1];
+                files.emplace_back(option, silo_args[i + 1]);
             else if (silo_args[i].rfind(option + "=", 0) == 0)
-                file = silo_args[i].substr(option.size() + 1);
-            else
-                continue;
-            digests[option] = orchestrator::sha256_hex(orchestrator::read_text_file(file));
+                files.emplace_back(option, silo_args[i].substr(option.size() + 1));
         }
+    return files;
+}
+
+std::vector<NamedPath> silo_campaign_inputs(const std::vector<std::string>& silo_args, const fs::path& dir) {
+    std::vector<NamedPath> inputs{{(dir / "campaign.json").string(), "the campaign's settings (--campaign)"}};
+    for (const auto& [option, file] : silo_input_files(silo_args)) inputs.push_back({file, option + " (after --)"});
+    return inputs;
+}
+
+json silo_input_file_digests(const std::vector<std::string>& silo_args) {
+    json digests = json::object();
+    for (const auto& [option, file] : silo_input_files(silo_args))
+        digests[option] = orchestrator::sha256_hex(orchestrator::read_text_file(file));
     return digests;
 }
 

@@ -4,11 +4,14 @@
 // finished runs (summary.json) are read, suspended ones (checkpoint.bin) resumed with `demcal silo --resume`, failed
 // ones (a `failed` marker) left alone, the rest run, up to `jobs` at a time.
 #pragma once
+#include "app/cli_support.hpp"  // NamedPath
+
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace demcal {
@@ -26,6 +29,16 @@ void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const 
 // Checks each plan's settings with `demcal silo --check` (nothing written); throws UserError naming the run and silo's
 // message. Call with the distinct settings only (repeats differing by seed need one check).
 void check_silo_runs(const std::vector<SiloRunPlan>& plans);
+
+// The input files the silo options name: (option, path) for --material and --geometry, given as "--opt FILE" or
+// "--opt=FILE".
+std::vector<std::pair<std::string, std::string>> silo_input_files(const std::vector<std::string>& silo_args);
+
+// What a command's own outputs (--json, --report) must never land on: the silo options' input files and the campaign's
+// settings file DIR/campaign.json (`cutoff --json` on the --material file replaced the material with its result).
+// For check_paths_apart's inputs.
+std::vector<NamedPath> silo_campaign_inputs(const std::vector<std::string>& silo_args,
+                                            const std::filesystem::path& dir);
 
 // The key under which a campaign's settings hold silo_input_file_digests.
 inline constexpr const char* kInputFileDigestsKey = "input_files_sha256";

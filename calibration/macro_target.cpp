@@ -2,6 +2,7 @@
 
 #include "analytics/number_text.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -77,11 +78,15 @@ double MacroTarget::acceptance(double tolerance) const {
     return std::max(tolerance * std::fabs(value), half_width.value_or(0.0));
 }
 
+void refuse_empty_list_items(const std::string& text, const std::string& option) {
+    if (!text.empty() && (text.back() == ',' || text.front() == ',' || text.find(",,") != std::string::npos))
+        throw std::invalid_argument(option + " = '" + analytics::shortened_text(text) +
+                                    "' has an empty item (two commas in a row, or one at an end)");
+}
+
 std::vector<MacroTarget> parse_targets(const std::string& text) {
     std::vector<MacroTarget> targets;
-    if (!text.empty() && (text.back() == ',' || text.front() == ',' || text.find(",,") != std::string::npos))
-        throw std::invalid_argument("target = '" + analytics::shortened_text(text) +
-                                    "' has an empty item (two commas in a row, or one at an end)");
+    refuse_empty_list_items(text, "target");
     std::stringstream items(text);
     std::string item;
     while (std::getline(items, item, ',')) {
@@ -122,7 +127,17 @@ std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigm
         analytics::check_measured_stress(sigma[i], point + " SIGMA");
         analytics::check_measured_stress(tau[i], point + " TAU");
     }
+    if (!sigma.empty())
+        analytics::check_normal_stress_spread(*std::min_element(sigma.begin(), sigma.end()),
+                                              *std::max_element(sigma.begin(), sigma.end()),
+                                              "the measured failure line's normal stresses");
     const auto line = analytics::fit_failure_line(sigma, tau, confidence);
+    // a line may cross 0 a little below (tau_c < 0 within its interval is noise); wholly below 0 it is not a bulk
+    // solid's (tau_c = -37 kPa from points whose shear stress rose faster than any friction explains)
+    if (line.tau_c_high < 0)
+        throw std::invalid_argument("the measured failure line's tau_c = " + analytics::number_text(line.tau_c) +
+                                    " Pa, its 95 % interval up to " + analytics::number_text(line.tau_c_high) +
+                                    " Pa: below 0, no bulk solid's cohesion (the points' stresses swapped or mistyped?)");
     std::vector<MacroTarget> targets;
     for (const auto& q : macro_quantities()) {
         targets.push_back({q, macro_value(line, q), macro_half_width(line, q)});

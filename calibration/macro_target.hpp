@@ -40,6 +40,9 @@ struct MacroTarget {
 };
 
 // Parses "mu_b=0.55,tau_c=800"; throws std::invalid_argument naming the item.
+// Refuses (std::invalid_argument naming `option`) a comma-separated list with an empty item: "a,,b", ",a", "a,".
+void refuse_empty_list_items(const std::string& text, const std::string& option);
+
 std::vector<MacroTarget> parse_targets(const std::string& text);
 // Targets from a measured failure line (normal and shear stresses [Pa]), with its confidence half-widths.
 std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigma, std::span<const double> tau,

@@ -108,7 +108,10 @@ std::vector<double> sensitivity_levels(const nlohmann::json& base, const std::st
         throw std::invalid_argument("range of " + name + " = " + number_text(lo) + ":" + number_text(hi) +
                                     " leaves its admissible range " + (spec.min_exclusive ? "(" : "[") +
                                     number_text(spec.min) + ", " + number_text(spec.max) +
-                                    (spec.max_exclusive ? ")" : "]") + " " + spec.unit);
+                                    (spec.max_exclusive ? ")" : "]") +
+                                    (std::string(spec.unit).empty() || std::string(spec.unit) == "-"  // dimensionless
+                                         ? std::string()
+                                         : " " + std::string(spec.unit)));
     std::vector<double> values;
     for (int i = 0; i < options.levels; ++i)
         values.push_back(round_significant(lo + (hi - lo) * i / (options.levels - 1)));

@@ -12,6 +12,13 @@
 
 namespace demcal::kernel {
 
+/// Hertz's largest overlap in an undamped head-on impact at `speed` [m/s]: 1/2 m* v^2 = 8/15 E* sqrt(R*) delta^(5/2),
+/// so delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) [m]. A case whose bodies would overlap by more than a radius at the
+/// speeds it produces lets them pass through each other (kernel/silo validate, kernel/cases/cohesive_hopper validate).
+inline double hertz_impact_overlap(double m_star, double r_star, double e_star, double speed) {
+  return std::pow(15 * m_star * speed * speed / (16 * e_star * std::sqrt(r_star)), 0.4);
+}
+
 struct HertzNormal {
   /// Per material pair, set by the user.
   struct Params {

@@ -2,6 +2,7 @@
 #include "kernel/silo/input_error.hpp"
 
 #include "kernel/clump.hpp"
+#include "kernel/contact/hertz_normal.hpp"
 #include "kernel/process_time.hpp"
 #include "kernel/simulation.hpp"
 #include "kernel/walls.hpp"
@@ -428,11 +429,6 @@ void validate_run_control(const SiloCaseSettings& s) {
         reject_setting("wall_limit", s.wall_limit, "needs a checkpoint file: a run stopped at the limit resumes from it");
     if (!(s.steady_lower >= 0 && s.steady_lower < s.steady_upper && s.steady_upper <= 1))
         reject_setting("steady_lower", s.steady_lower, "the steady window must satisfy 0 <= lower < upper <= 1");
-}
-
-// Hertz's overlap of a head-on impact at `speed`: delta = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5).
-double hertz_impact_overlap(double m_star, double r_star, double e_star, double speed) {
-  return std::pow(15 * m_star * speed * speed / (16 * e_star * std::sqrt(r_star)), 0.4);
 }
 
 void validate_contact_softness(const SiloCaseSettings& s) {

@@ -107,6 +107,13 @@ TEST_CASE("diagnose of degenerate data - identical rows get no effect and are no
     std::fill(sigma.values.begin(), sigma.values.end(), 15000.0);
     std::fill(sigma.text.begin(), sigma.text.end(), std::string("15000"));
     CHECK_THROWS_WITH(diagnose(shear, "failure-line"), Catch::Contains("sigma_Pa: every row has the normal stress 15000"));
+    // a shear strength that falls as the normal stress rises (the columns swapped) is no failure line of a bulk solid
+    auto falling = make_synthetic_set(spec("failure-line", "none", 0, 3));
+    auto& tau = const_cast<demcal::analytics::DataColumn&>(falling.at("tau_Pa"));
+    const auto& s = falling.at("sigma_Pa").values;
+    for (std::size_t r = 0; r < tau.values.size(); ++r) tau.values[r] = 2e5 - 0.9 * s[r] + 50.0 * (r % 3);
+    CHECK_THROWS_WITH(diagnose(falling, "failure-line"), Catch::Contains("the failure line's slope mu_b = -0.9") &&
+                                                           Catch::Contains("is negative"));
 }
 
 TEST_CASE("the JSON result has the documented shape", "[diagnose]") {

@@ -221,6 +221,9 @@ TEST_CASE("absurd but finite geometries are refused with the field and its plaus
         INFO(c.key << " = " << c.value);
         CHECK_THROWS_WITH(geometry_from_json(j), Catch::Contains(std::string(c.key) + "=") && Catch::Contains("outside ["));
     }
+    auto just_over = conical;  // the value shown as given: "D_m=100 outside [0, 100]" contradicted itself
+    just_over["D_m"] = 100.0001;
+    CHECK_THROWS_WITH(geometry_from_json(just_over), Catch::Contains("D_m=100.0001 outside [0, 100]"));
     auto huge = conical;  // a large silo inside the bounds is fine
     huge["D_m"] = 40.0;
     huge["outlet_m"] = 0.5;

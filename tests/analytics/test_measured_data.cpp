@@ -101,7 +101,7 @@ TEST_CASE("bad discharge files name the line and the column", "[measured]") {
     // finite but absurd values were diagnosed as data: the same bounds as a geometry file's (predict)
     fails_with("conical,0.105,,,0.035,30,0.0055,1e90,0.171,anna,12.5\n",
                "line 3, column rho_b_kg_m3: 1e+90 outside [10, 20000] kg/m^3");
-    fails_with("conical,0.105,,,0.035,30,0.0055,780,5e7,anna,12.5\n", "line 3, column W_kg_s: 5e+07 outside");
+    fails_with("conical,0.105,,,0.035,30,0.0055,780,5e7,anna,12.5\n", "line 3, column W_kg_s: 50000000 outside");
     fails_with("conical,1e4,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column D_m: 10000 outside [0, 100] m");
     fails_with("conical,0.105,,,0.035,30,1e-9,780,0.171,anna,12.5\n", "line 3, column d_p_m: 1e-09 outside");
     fails_with("conical,,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column D_m: missing value");

@@ -58,6 +58,17 @@ TEST_CASE("cohesive hopper: bad settings and searches name the field and the val
   c.frequency = 900;
   c.young = 5e4;  // a long time step: too few steps per period
   CHECK_THROWS_WITH(validate(c), Catch::Matchers::Contains("20 time steps per period"));
+  // grains that a wall or a fall pushes more than a radius into another body pass through it (Hertz's impact overlap)
+  c = {};
+  c.frequency = 1000;
+  c.amplitude = 0.01;  // walls at 63 m/s
+  CHECK_THROWS_WITH(validate(c), Catch::Matchers::Contains("amplitude = 0.01: at 1000 Hz the walls move at up to") &&
+                                     Catch::Matchers::Contains("radii and pass through"));
+  c.amplitude = 1.1e-4;  // the seed's amplitude at the same frequency: 0.7 m/s
+  CHECK_NOTHROW(validate(c));
+  c = {};
+  c.young = 1e3;
+  CHECK_THROWS_WITH(validate(c), Catch::Matchers::Contains("young = 1000: the grains are so soft that one falling"));
   c = {};
   CutoffSearch s;
   s.lo = 300;
@@ -88,7 +99,7 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
   fs::create_directories(dir);
   const std::string json = (dir / "cutoff.json").string();
   const std::pair<std::string, std::string> cases[] = {
-      {"--bracket 400,0", "bracket"},     {"--bracket 0,x", "--bracket"}, {"--tol 1000", "tol"},
+      {"--bracket 400,0", "bracket"},     {"--bracket 0,x", "--bracket"}, {"--tol 1000", "--tol = 1000 Hz"},
       {"--bond-number nan", "--bond-number"}, {"--seeds -1", "--seeds"},   {"--amplitude 1", "--amplitude"},
       {"--json " + dir.string(), "--json"},
       {"--window 0.5", "window = 0.5 s: shorter than 1 s"},  {"--criterion half", "--criterion"},
@@ -96,10 +107,10 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
       {"--criterion ''", "--criterion: an empty value"},
       {"--window 0.5 -- --theta 30", "window = 0.5 s"},
       // the longest window: not below the first, and only by the criterion a longer window can decide
-      {"--window 5 --max-window 2", "max_window = 2 s: must be in [window, 60] s"},
-      {"--criterion half-within-window --max-window 10", "max_window = 10 s: a longer window decides runs by"},
+      {"--window 5 --max-window 2", "--max-window = 2 s: must be in [window, 60] s"},
+      {"--criterion half-within-window --max-window 10", "--max-window = 10 s: a longer window decides runs by"},
       {"--max-window 61", "--max-window"},
-      {"--window 5 --max-window 2 -- --theta 30", "max_window = 2 s"},
+      {"--window 5 --max-window 2 -- --theta 30", "--max-window = 2 s"},
       // the silo case (options after --): its own options stay with demcal silo, the search's with cutoff
       {"--bond-number 5 -- --theta 30", "--bond-number applies to the small hopper"},
       {"-- --theta 30 --seed 3", "silo option --seed after --: demcal cutoff sets it"},
@@ -108,6 +119,9 @@ TEST_CASE("demcal cutoff: bad input exits 2 naming the option before any run or 
       {"-- --theta 30 --colour red", "silo options of demcal cutoff"},
       {"-- --theta 95", "theta"},
       {"--bracket 0,5000 -- --theta 30", "bracket"},
+      // walls shaking at 63 m/s through 5 MPa grains: they passed through, and a cut-off was reported
+      {"--amplitude 0.01 --grains 200 --window 1 --max-window 1 --bracket 0,1000 --tol 400",
+       "--amplitude = 0.01: at 1000 Hz the walls move at up to 62.8"},
       {"--bracket 0,900 -- --theta 30 --stiffness-scale 1e-3", "vibration_frequency"},
       {"--bracket 0,400 -- --theta 30 --stiffness-scale 1e-6", "--stiffness-scale = 1e-06"}};
   for (const auto& [args, expect] : cases) {

@@ -45,6 +45,10 @@ TEST_CASE("a shear campaign stopped by SIGTERM or SIGHUP stops its runs, and res
     // YADE's launcher on a resume of kernel campaigns is a void option (it was ignored, exit 0)
     CHECK(test::run_demcal({"resume", camp.string(), "--yade", "/usr/bin/yade"}, dir / "yade.log") == 2);
     CHECK_THAT(test::read_file(dir / "yade.log"), Catch::Matchers::Contains("run on the kernel engine; omit it"));
+    // --max-runs bounds the runs left (it was accepted and ignored): at least five of six are not done
+    CHECK(test::run_demcal({"resume", camp.string(), "--max-runs", "1"}, dir / "max.log") == 2);
+    CHECK_THAT(test::read_file(dir / "max.log"), Catch::Matchers::Contains("--max-runs = 1: the campaigns of") &&
+                                                     Catch::Matchers::Contains("runs not done"));
     REQUIRE(test::run_demcal({"resume", camp.string()}, dir / "resume.log") == 0);
     CHECK_FALSE(test::find_file(camp, "failure_line_", ".json").empty());
     fs::remove_all(dir);

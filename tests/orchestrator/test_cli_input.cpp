@@ -60,6 +60,14 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800: tau_c must be >= 0"},
         {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
          "measured point 1 (5000:-7000) TAU: -7000 Pa is negative"},
+        // a measured line the README's rules refuse elsewhere: stresses 5 % apart (tau_c = -37 kPa was calibrated
+        // against), an intercept wholly below 0, a trailing empty item (taken as nothing)
+        {{"calibrate", "--start", tiny, "--measured", "4e3:3e3,4.1e3:4e3,4.2e3:5e3"},
+         "the measured failure line's normal stresses: 4000 to 4200 Pa"},
+        {{"calibrate", "--start", tiny, "--measured", "5e3:1000,1e4:6000,2e4:16000,5e3:1100,1e4:6100,2e4:16100"},
+         "Pa: below 0, no bulk solid's cohesion"},
+        {{"calibrate", "--start", tiny, "--measured", "4e3:3e3,6e3:4e3,8e3:5e3,"},
+         "--measured = '4e3:3e3,6e3:4e3,8e3:5e3,' has an empty item"},
         // a stress no shear cell reaches (kPa typed as Pa twice) was fitted as a line
         {{"calibrate", "--start", tiny, "--measured", "5e3:4e3,1e4:8e3,2e13:13000"},
          "measured point 3 (2e+13:13000) SIGMA: 2e+13 Pa is above 1e+09 Pa"},

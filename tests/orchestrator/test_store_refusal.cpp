@@ -169,6 +169,13 @@ TEST_CASE("status and resume on a folder without a store refuse it as holding no
         }
         CHECK(fs::is_empty(dir / "empty"));
         CHECK_FALSE(fs::exists(dir / "missing"));
+        // the store file itself given for its folder: named as a file, the folder to give named
+        std::ofstream(dir / "campaign.sqlite") << "";
+        CHECK(test::run_demcal({command, (dir / "campaign.sqlite").string()}, dir / "out.log") == 2);
+        CHECK_THAT(test::read_file(dir / "out.log"),
+                   Contains(command + ": DIR = '") && Contains("is a file, not a campaign folder"));
+        CHECK(fs::file_size(dir / "campaign.sqlite") == 0);
+        fs::remove(dir / "campaign.sqlite");
     }
     fs::remove_all(dir);
 }
