@@ -400,6 +400,7 @@ int run(const CutoffCli& o, CLI::App& sub) {
                     o.base.bond_number, o.base.theta_deg, o.base.amplitude, search.lo, search.hi, search.tol,
                     search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(),
                     ladder_text(kc::window_ladder(o.base.window, search.longest_window)).c_str());
+        std::fflush(stdout);  // before minutes of runs: a search stopped by a signal keeps what it printed
         res = kc::find_cutoff(o.base, search, report);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
