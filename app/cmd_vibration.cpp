@@ -207,6 +207,13 @@ std::string change_text(const PairedChange& c) {
 json change_json(const PairedChange& c) { return {{"mean_pct", c.mean}, {"se_pct", c.se}, {"pairs", c.pairs}}; }
 
 // Rate against frequency, one line per angle, the SD as error bars.
+// The table of one angle's rates: the runs' own spelling of the angle (RunSpec::name), distinct for distinct cells.
+std::string rate_table_name(double theta) {
+    std::ostringstream name;
+    name << "vibration_theta" << theta << ".dat";
+    return name.str();
+}
+
 void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<double, std::string>& data_by_theta) {
     if (data_by_theta.empty()) return;
     std::ostringstream body;
@@ -215,9 +222,7 @@ void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<doubl
          << o.part << "'\nplot ";
     bool first = true;
     for (const auto& [theta, data] : data_by_theta) {
-        std::ostringstream name;  // the runs' own spelling of the angle (RunSpec::name): distinct for distinct cells
-        name << "vibration_theta" << theta << ".dat";
-        const fs::path file = dir / name.str();
+        const fs::path file = dir / rate_table_name(theta);
         write_result_file(file, data);
         body << (first ? "" : ", ") << gnuplot_quote(file) << " using 1:2:3 with yerrorlines title 'theta = "
              << theta << " deg'";
@@ -385,11 +390,8 @@ int run(const VibrationCli& o) {
     std::vector<NamedPath> reports;
     for (const char* name : {"vibration.json", "vibration.md", "vibration.png"})
         reports.push_back({(dir / name).string(), "the sweep's report (--campaign)"});
-    for (double theta : o.thetas) {
-        std::ostringstream name;  // as plot_rates names them
-        name << "vibration_theta" << theta << ".dat";
-        reports.push_back({(dir / name.str()).string(), "the sweep's table (--campaign)"});
-    }
+    for (double theta : o.thetas)
+        reports.push_back({(dir / rate_table_name(theta)).string(), "the sweep's table (--campaign)"});
     check_paths_apart(silo_campaign_inputs(o.silo_args, dir), reports);
     // a run is its angle, frequency and seed under the shared settings: a grid that grows (or shrinks) is the same
     // campaign, its finished runs reused

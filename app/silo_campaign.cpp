@@ -24,6 +24,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <set>
 #include <sstream>
 
 extern char** environ;
@@ -198,16 +199,15 @@ json silo_input_file_digests(const std::vector<std::string>& silo_args) {
 namespace {
 // The top-level settings whose values differ between two campaign.json objects, e.g. "amplitude_m, input_files_sha256"
 std::string differing_settings(const json& stored, const json& now) {
-    std::string keys;
-    auto add = [&](const std::string& key) {
-        if (keys.find(key) == std::string::npos) keys += (keys.empty() ? "" : ", ") + key;
-    };
     if (!stored.is_object() || !now.is_object()) return "the whole file";
+    std::set<std::string> keys;  // (sorted, each once)
     for (const auto& [key, value] : now.items())
-        if (!stored.contains(key) || stored[key] != value) add(key);
+        if (!stored.contains(key) || stored[key] != value) keys.insert(key);
     for (const auto& [key, value] : stored.items())
-        if (!now.contains(key)) add(key);
-    return keys;
+        if (!now.contains(key)) keys.insert(key);
+    std::string text;
+    for (const auto& key : keys) text += (text.empty() ? "" : ", ") + key;
+    return text;
 }
 }  // namespace
 
