@@ -34,6 +34,24 @@ void holm(std::vector<CandidateTest>& tests) {
 
 // --- the search -------------------------------------------------------------------------------------------------
 
+// The base model's parameters the data do not pin down, e.g. "k = 1.28 +/- 6.4e+05": a standard error that is not
+// finite, or 0 where the fit has residuals (a column GSL's covariance drops: k = 1.27 +/- 0 from one condition), or
+// more than kMaxRelativeStdError times the estimate (C = 0.62 +/- 1.1e5 where only the density varied). A model's own
+// constants are never near 0, so the ratio is a fair test for them. Empty when every one is determined.
+constexpr double kMaxRelativeStdError = 10;
+std::string unidentified_parameters(const Model& m, const LeastSquaresFit& fit) {
+    std::string why;
+    for (std::size_t i = 0; i < fit.std_errors.size() && i < m.param_names.size(); ++i) {
+        const double se = fit.std_errors[i], value = fit.params[i];
+        const bool undetermined = !std::isfinite(se) || (se == 0 && fit.sse > 0) ||
+                                  se > kMaxRelativeStdError * std::fabs(value);
+        if (undetermined)
+            why += (why.empty() ? "" : ", ") + m.param_names[i] + " = " + short_number(value) + " +/- " +
+                   short_number(se);
+    }
+    return why;
+}
+
 // The base model fitted to s.rows, restarted once when GSL stops at its iteration limit.
 LeastSquaresFit fit_base(const Setting& s, const Model& m, std::vector<std::string>& undetermined) {
     LeastSquaresFit fit = fit_extended(s, m, m.start);
@@ -381,12 +399,9 @@ void report_fits(Setting& s, const Model& base, const SearchWithoutOutliers& fou
     const bool no_effect = search.model.terms.empty();  // then before and after are one fit
     const Scored before = no_effect && !dropped ? with_all : score(s, base, search.base_fit.params);
     const Scored after = no_effect ? before : dropped ? score(s, search.model, search.fit.params) : with_all;
-    for (double se : before.fit.std_errors)
-        if (!std::isfinite(se)) {
-            result.undetermined.push_back("some parameters of " + result.model +
-                                      " are not identifiable from these data (singular covariance)");
-            break;
-        }
+    if (const std::string why = unidentified_parameters(base, before.fit); !why.empty())
+        result.undetermined.push_back("some parameters of " + result.model + " are not identifiable from these data (" +
+                                      why + ")");
     result.params_before = estimates(base, before.fit);
     result.fitted_before = before.fitted;
     result.before = before.errors;

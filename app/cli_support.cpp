@@ -420,7 +420,7 @@ std::string with_option_name(const CLI::App& app, const std::string& message) {
     while (n < message.size() && (std::islower(static_cast<unsigned char>(message[n])) ||
                                   std::isdigit(static_cast<unsigned char>(message[n])) || message[n] == '_'))
         ++n;
-    if (n == 0 || message.compare(n, 3, " = ") != 0) return message;
+    if (n == 0 || (message.compare(n, 3, " = ") != 0 && message.compare(n, 2, ": ") != 0)) return message;
     const CLI::App* command = &app;
     for (auto subs = command->get_subcommands(); !subs.empty(); subs = command->get_subcommands())
         command = subs.front();
@@ -543,15 +543,24 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
 }  // namespace
 
 void check_command_line_shape(const CLI::App& app, int argc, const char* const* argv) {
-    if (argc > 1 && argv[1][0] != '-') {
+    // the command, and the subcommand of a command that has them (crosscheck shear|silo: "crosscheck sheer" said
+    // only "A subcommand is required")
+    const CLI::App* level = &app;
+    std::string path = "demcal";
+    for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
+        const auto subs = level->get_subcommands([](const CLI::App*) { return true; });
+        if (subs.empty()) break;
         std::string known;
-        bool found = false;
-        for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
-            found = found || sub->check_name(argv[1]);
+        const CLI::App* found = nullptr;
+        for (const CLI::App* sub : subs) {
+            if (!found && sub->check_name(argv[i])) found = sub;
             known += (known.empty() ? "" : ", ") + sub->get_name();
         }
         if (!found)
-            throw UserError("'" + analytics::shortened_text(argv[1]) + "' is not a demcal command (" + known + ")");
+            throw UserError("'" + analytics::shortened_text(argv[i]) + "' is not a " +
+                            (level == &app ? "demcal command" : "subcommand of " + path) + " (" + known + ")");
+        level = found;
+        path += " " + found->get_name();
     }
     check_options_known(app, argc, argv);
     std::map<std::string, std::string> lists;

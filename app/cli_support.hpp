@@ -88,7 +88,7 @@ void check_paths_apart(const std::vector<NamedPath>& inputs, const std::vector<N
 
 // A library's refusal names its own field ("tol = 400 Hz: ...", "max_window = 2 s: ..."); where the command being run
 // has an option of that name (tol -> --tol, max_window -> --max-window), the message names the option as typed
-// instead. Only a message that starts with "FIELD = " changes; `app` is the parsed command line (its deepest
+// instead. Only a message that starts with "FIELD = " or "FIELD: " changes; `app` is the parsed command line (its deepest
 // subcommand decides).
 std::string with_option_name(const CLI::App& app, const std::string& message);
 

@@ -192,7 +192,8 @@ fs::path crosscheck_dir(const CrosscheckOptions& opt) {
 struct EngineRuns {
     std::map<ShearEngine, calibration::FailureLineEvaluation> ev;
     std::map<ShearEngine, RunCost> cost;
-    bool interrupted = false, failed = false, infrastructure_failure = false;
+    bool interrupted = false, failed = false;
+    std::string infrastructure_failure;  // why a simulator could not be started (empty: it could)
 };
 
 EngineRuns run_engines(ShearCampaignRunner& runner, const std::map<ShearEngine, ShearCampaignSpec>& specs) {
@@ -203,7 +204,7 @@ EngineRuns run_engines(ShearCampaignRunner& runner, const std::map<ShearEngine, 
         r.cost[e] = cost_of(r.ev[e].outcome);
         r.interrupted = r.interrupted || r.ev[e].outcome.interrupted;
         r.failed = r.failed || r.ev[e].outcome.failed > 0;
-        r.infrastructure_failure = r.infrastructure_failure || !r.ev[e].outcome.infrastructure_failure.empty();
+        if (r.infrastructure_failure.empty()) r.infrastructure_failure = r.ev[e].outcome.infrastructure_failure;
         if (r.interrupted) break;
     }
     return r;
@@ -267,7 +268,12 @@ int run_crosscheck(const CrosscheckOptions& opt) {
         std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
     }
     std::cout << "\nresults: " << report.string() << ", " << (dir / "crosscheck.md").string() << "\n";
-    if (r.infrastructure_failure) return kExitResumeLater;
+    if (!r.infrastructure_failure.empty()) {  // (it exited 75 with the report's line as its last word)
+        std::cout << "the simulator could not be started (" << r.infrastructure_failure
+                  << "); the runs it hit stay pending: fix what stops it (--yade for another YADE), then run the same "
+                     "command again\n";
+        return kExitResumeLater;
+    }
     return r.failed ? 1 : 0;
 }
 

@@ -6,6 +6,7 @@
 #include "app/gnuplot.hpp"
 #include "app/result_files.hpp"
 #include "app/shear_report.hpp"
+#include "app/silo_campaign.hpp"
 #include "analytics/failure_line.hpp"
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/folder_lock.hpp"
@@ -20,6 +21,7 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 namespace demcal {
@@ -146,7 +148,17 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
             std::cerr << "demcal: warning: plot not written: " << e.what() << "\n";
         }
     } else {
-        std::cout << "no failure line: fewer than 3 finished runs on 2 normal stresses\n";
+        // what the campaign has, not a fixed text ("fewer than 3 finished runs on 2 normal stresses" of 0 runs on 3)
+        std::set<double> stresses;
+        std::size_t done = 0;
+        for (const auto& r : outcome.runs)
+            if (r.state == orchestrator::RunState::done) {
+                ++done;
+                if (r.label.contains("normal_stress")) stresses.insert(r.label["normal_stress"].get<double>());
+            }
+        std::cout << "no failure line: " << done << " finished run" << (done == 1 ? "" : "s") << " on "
+                  << stresses.size() << " normal stress" << (stresses.size() == 1 ? "" : "es")
+                  << " (a line needs 3 runs on at least 2)\n";
     }
     keep_results();  // this campaign's report is whole: a later campaign's failure (resume) does not take it
     if (outcome.interrupted) return kExitResumeLater;
@@ -232,6 +244,8 @@ void check_campaign_folder_argument(const std::string& dir, const std::string& c
 
 void print_status(const std::string& dir) {
     check_campaign_folder_argument(dir, "status");
+    if (!fs::exists(fs::path(dir) / "campaign.sqlite") && fs::exists(fs::path(dir) / "campaign.json"))
+        return print_silo_sweep_status(dir);  // a vibration, cutoff or diagnose silo-dem sweep
     const std::vector<ShearCampaignOutcome> outs = inspect_campaigns(dir);
     for (const auto& o : outs) print_campaign_status(o, orchestrator::FolderLock::held(dir));
     if (outs.empty()) std::cout << "no campaigns in " << dir << "\n";

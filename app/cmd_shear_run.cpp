@@ -39,6 +39,8 @@ nlohmann::json checked_run_params(const nlohmann::json& raw, const std::string& 
         material.erase(per_run);
     }
     if (!raw["seed"].is_number_integer()) throw std::invalid_argument(where + ": field 'seed' must be an integer");
+    // checked as read: get<long> wrapped 18446744073709551615 to -1, which the message then showed
+    orchestrator::check_shear_param_value("seed", raw["seed"], where);
     if (!raw["normal_stress"].is_number()) throw std::invalid_argument(where + ": field 'normal_stress' must be a number");
     return orchestrator::make_run_params(orchestrator::validate_material(material, where),
                                          raw["normal_stress"].get<double>(), raw["seed"].get<long>(), where);

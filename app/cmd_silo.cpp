@@ -241,8 +241,14 @@ ks::SiloGeometry geometry_from(const SiloCli& o, CLI::App& sub, std::map<std::st
     GeometryGiven cli = geometry_options(o, sub);
     given.merge_slot_width();
     cli.merge_slot_width();
-    if (cli.rect) {  // the command line's shape wins: the file's diameter of a conical silo no longer applies
-        if (!given.rect.value_or(false)) given.values.erase("D_m");
+    if (cli.rect) {
+        // a file of a conical silo under --rect: its diameter was dropped and its circular outlet taken for a slot
+        if (given.rect.has_value() && !*given.rect)
+            throw UserError("--rect: the --geometry file is a conical silo (" + given.rect_source +
+                            " = \"conical\"); give a rectangular geometry file, or leave --rect out");
+        if (const auto d = given.values.find("D_m"); d != given.values.end())
+            throw UserError("--rect: the --geometry file gives the diameter of a conical silo (" + d->second.source +
+                            "); give a rectangular geometry file, or leave --rect out");
         given.rect = cli.rect;
         given.rect_source = cli.rect_source;
     }

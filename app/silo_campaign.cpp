@@ -262,6 +262,31 @@ void open_silo_campaign(const fs::path& dir, const json& settings, const std::st
     orchestrator::write_text_file_atomically(settings_file, settings.dump(1) + "\n");
 }
 
+void print_silo_sweep_status(const fs::path& dir) {
+    const json settings = read_json_file((dir / "campaign.json").string(), "campaign settings");
+    // cutoff's and diagnose silo-dem's settings name their command; a vibration sweep's hold its grid
+    const std::string command = settings.is_object() && settings.contains("command") && settings["command"].is_string()
+                                    ? settings["command"].get<std::string>()
+                                    : settings.is_object() && settings.contains("frequencies_hz") ? "vibration"
+                                                                                                   : "(unknown)";
+    std::size_t finished = 0, failed = 0, suspended = 0, begun = 0;
+    std::error_code ec;
+    if (fs::is_directory(dir / "runs", ec))
+        for (const auto& entry : fs::directory_iterator(dir / "runs", ec)) {
+            if (!entry.is_directory()) continue;
+            const fs::path rd = entry.path();
+            if (fs::exists(rd / "summary.json")) ++finished;
+            else if (fs::exists(rd / "failed")) ++failed;
+            else if (fs::exists(rd / "checkpoint.bin")) ++suspended;
+            else ++begun;
+        }
+    std::cout << dir.string() << ": a silo sweep of demcal " << command << " (campaign.json), "
+              << (finished + failed + suspended + begun) << " run folders: " << finished << " finished, " << failed
+              << " failed, " << suspended << " suspended (a checkpoint), " << begun << " begun"
+              << (orchestrator::FolderLock::held(dir) ? "; a demcal is running it now" : "")
+              << "\n  the same demcal " << command << " command continues it (its finished runs are reused)\n";
+}
+
 SiloRunSummary::SiloRunSummary(json summary, fs::path file) : j_(std::move(summary)), file_(std::move(file)) {}
 
 void SiloRunSummary::fail(const std::string& field, const std::string& why) const {

@@ -58,6 +58,10 @@ nlohmann::json silo_input_file_digests(const std::vector<std::string>& silo_args
 void open_silo_campaign(const std::filesystem::path& dir, const nlohmann::json& settings, const std::string& command,
                         const std::vector<std::string>& may_change = {});
 
+// `demcal status` of a silo sweep's folder (DIR/campaign.json): which command made it and its runs by state (finished,
+// failed, suspended with a checkpoint, begun), read from the run folders; nothing written.
+void print_silo_sweep_status(const std::filesystem::path& dir);
+
 struct SiloCampaignOutcome {
     std::size_t finished = 0;  // with a summary.json (before or now)
     std::size_t failed = 0;    // a `failed` marker (before or now)

@@ -29,7 +29,9 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& w
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
         ::close(fd_);
         fd_ = -1;
-        throw std::runtime_error(what + " " + folder.string() + " is in use by another demcal process");
+        // refused at once, as bad input (exit 2) whatever the command: a shear campaign's said "failed" (exit 1), a
+        // silo run's "error" (2)
+        throw std::invalid_argument(what + " " + folder.string() + " is in use by another demcal process");
     }
 }
 

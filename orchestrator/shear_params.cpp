@@ -172,6 +172,24 @@ double unit_union_volume(int n, double spacing) {
 // step 2000 times sand-tiny's. 1e8 steps: hours for sand-tiny's 525 particles (the kernel makes about 1e4 of its steps
 // a second) and weeks for the seed's box at r = 1 mm, while shearing sand.json at a laboratory speed (1 mm/min)
 // takes 5e7.
+// Both engines take one step at least per sample (shear_steps = max(samples, travel / (v dt))): more samples than the
+// travel's steps moved the frame past shear_displacement (samples 20000 on sand-tiny: 6.56 mm for 4 mm, and a peak line
+// of 2530 Pa against 1533; at 100000 the frame left the box). The fewest steps the travel can take is at the largest
+// time step a run can draw, that of a smallest sphere as large as r (1 + radius_spread).
+static void check_samples_within_travel(const nlohmann::json& m, const std::string& where) {
+    auto d = [&](const char* k) { return m.at(k).get<double>(); };
+    const double largest_step = d("timestep_fraction") * d("particle_radius") * (1 + d("radius_spread")) *
+                                std::sqrt(d("density") / d("young_modulus"));
+    const double fewest_steps = std::floor(d("shear_displacement") / (d("shear_velocity") * largest_step));
+    if (d("samples") <= fewest_steps) return;
+    throw std::invalid_argument(where + ": samples = " + analytics::number_text(d("samples")) +
+                                " is more than the shear's time steps (at least " +
+                                analytics::number_text(fewest_steps, 12) +
+                                ": shear_displacement / (shear_velocity x time step)); a sample takes one step at "
+                                "least, so the frame would travel past shear_displacement: at most " +
+                                analytics::number_text(fewest_steps, 12));
+}
+
 void check_work(const nlohmann::json& m, std::optional<double> normal_stress, const std::string& where) {
     const ShearRunWork w = estimate_shear_work(m, normal_stress);
     auto v = [&](const char* k) { return analytics::number_text(m.at(k).get<double>()); };
@@ -181,6 +199,7 @@ void check_work(const nlohmann::json& m, std::optional<double> normal_stress, co
             ") gives about " + analytics::number_text(w.particles, 2) + " particles in the " + v("box_length") + " x " +
             v("box_width") + " x " + v("box_height") + " m box (box_length x box_width x box_height; limit " +
             analytics::number_text(kMaxShearParticles) + " particles per run)");
+    check_samples_within_travel(m, where);
     if (w.steps() <= kMaxShearSteps) return;
     std::string phase;  // the phase that takes the most steps, with the fields that set it
     if (w.shear_steps >= w.growth_steps && w.shear_steps >= w.consolidation_steps)
@@ -326,6 +345,12 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
     check_overlap(out, self_weight_stress(out), where + " (at the box's own weight, the least stress it holds)");
     check_work(out, std::nullopt, where);
     return out;
+}
+
+void check_shear_param_value(const std::string& name, const nlohmann::json& value, const std::string& where) {
+    const ParamSpec* spec = find_shear_param(name);
+    if (!spec) throw std::logic_error("no shear parameter " + name);
+    check_value(*spec, value, where);
 }
 
 nlohmann::json make_run_params(const nlohmann::json& validated_material, double normal_stress, long seed,

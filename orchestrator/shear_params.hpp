@@ -40,6 +40,10 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
 // A complete run: a validated material plus normal_stress and seed; refuses a normal stress that squeezes the
 // particles into each other (against young_modulus) or whose consolidation takes more steps than the limit. Throws
 // like validate_material. Every campaign checks each of its runs with it before it starts, and so does shear-run.
+// Checks one value against its parameter's row of the table, as read (an integer above 2^63 shown as it was typed,
+// not wrapped by a conversion); throws std::invalid_argument naming `where`, the field and the range.
+void check_shear_param_value(const std::string& name, const nlohmann::json& value, const std::string& where);
+
 nlohmann::json make_run_params(const nlohmann::json& validated_material, double normal_stress, long seed,
                                const std::string& where = "run");
 

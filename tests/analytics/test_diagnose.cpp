@@ -185,3 +185,34 @@ TEST_CASE("write the example data sets", "[.][write-examples]") {
     write(spec("oldal", "outlier", 0.3, 42), "oldal_outlier.csv");
     write(spec("beverloo", "hopper_angle+vibration_by_mode", 0.25, 42), "beverloo_angle_vibration.csv");
 }
+
+TEST_CASE("parameters the data cannot pin down are reported not determined, not as a fit", "[diagnose]") {
+    auto load = [](const std::string& csv) {
+        std::istringstream in(csv);
+        auto data = parse_csv(in, "set.csv");
+        validate_measured(data, MeasuredKind::discharge);
+        return data;
+    };
+    const std::string header = "geometry,D_m,outlet_m,theta_deg,d_p_m,rho_b_kg_m3,W_kg_s\n";
+    // one condition repeated: Beverloo's C and k trade against each other (k = 1.27 +/- 0 was "determined")
+    std::string one = header;
+    for (int i = 0; i < 5; ++i) one += "conical,0.105,0.05,60,0.005,780,0.60" + std::to_string(i + 1) + "\n";
+    // only the bulk density varies: W is proportional to it for any k (C = 0.62 +/- 1.1e5 was "determined")
+    std::string density = header;
+    for (int i = 0; i < 6; ++i)
+        density += "conical,0.105,0.05,60,0.005," + std::to_string(700 + 50 * i) + "," +
+                   std::to_string(0.000777 * (700 + 50 * i) * (1 + 0.002 * (i % 2))) + "\n";
+    for (const std::string& csv : {one, density}) {
+        INFO(csv);
+        const auto r = diagnose(load(csv), "beverloo");
+        CHECK(r.to_json().at("determined") == false);
+        bool said = false;
+        for (const auto& w : r.undetermined) said = said || w.find("are not identifiable from these data") != std::string::npos;
+        CHECK(said);
+    }
+    // the committed example with its conditions varied stays determined
+    std::ifstream file(std::string(DEMCAL_SOURCE_DIR) + "/examples/diagnose/beverloo_hopper_angle.csv");
+    std::stringstream text;
+    text << file.rdbuf();
+    CHECK(diagnose(load(text.str()), "beverloo").to_json().at("determined") == true);
+}

@@ -51,6 +51,11 @@ TEST_CASE("demcal cutoff in the silo: runs kept in a campaign, the same command 
     CHECK(first["seeds"].size() == 2);
     CHECK(first["campaign"] == (dir / "c").string());
 
+    // status reads a sweep's folder (it said "holds no campaign.sqlite", which resume recognised)
+    CHECK(run_demcal_command("status '" + (dir / "c").string() + "'", dir / "status.log") == 0);
+    CHECK_THAT(read_file(dir / "status.log"), Catch::Contains("a silo sweep of demcal cutoff (campaign.json), 2 run "
+                                                              "folders: 2 finished, 0 failed"));
+
     // the same search again: nothing runs, the same answers
     CHECK(run_demcal_command(search + (dir / "again.json").string() + "'" + silo, dir / "again.log") == 1);
     CHECK_THAT(read_file(dir / "again.log"), !Catch::Contains("[1/2]"));

@@ -157,8 +157,12 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
           GeometryCase{R"({"shape": "rectangular", "theta_deg": 30, "outlet_m": 0.03, "a_m": 0.02})", "",
                        "both set the outlet (slot) width"},
           GeometryCase{R"({"theta_deg": "30"})", "", R"(theta_deg = "30": must be a number)"},
-          // --rect over a conical file drops its D_m (the command line's shape wins); the rest stands
-          GeometryCase{R"({"theta_deg": 30, "D_m": 0.105})", "--rect --c 0.02", "--c = 0.02: the silo width c"}}) {
+          // --rect over a conical file: its D_m was dropped and its circular outlet run as a slot (probe 58b)
+          GeometryCase{R"({"theta_deg": 30, "D_m": 0.105})", "--rect --c 0.1",
+                       "--rect: the --geometry file gives the diameter of a conical silo"},
+          GeometryCase{R"({"shape": "conical", "theta_deg": 30})", "--rect", "--rect: the --geometry file is a conical"},
+          // a file of neither shape's own keys takes --rect, and the rest of the rules stand
+          GeometryCase{R"({"theta_deg": 30})", "--rect --c 0.02", "--c = 0.02: the silo width c"}}) {
         INFO(c.json + " " + c.options);
         std::ofstream(dir / "g.json") << c.json;
         const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' " + c.options + " --out '" +
@@ -218,6 +222,15 @@ TEST_CASE("demcal silo: an output folder another demcal holds is refused at once
                                   "--threads 1 > '" + (dir / "sweep.log").string() + "' 2>&1";
         CHECK(WEXITSTATUS(std::system(sweep.c_str())) == 2);
         CHECK_THAT(read_file(dir / "sweep.log"), Catch::Matchers::Contains("is in use by another demcal process"));
+        // a shear campaign in a held folder: the same refusal and exit code (it exited 1, "failed")
+        fs::create_directories(dir / "shear");
+        const demcal::orchestrator::FolderLock shear_campaign(dir / "shear", "test");
+        const std::string shear = "'" + std::string(DEMCAL_BINARY) + "' shear '" + std::string(DEMCAL_SOURCE_DIR) +
+                                  "/examples/materials/sand-tiny.json' -s 3e3,5e3 -r 2 --engine kernel --campaign '" +
+                                  (dir / "shear").string() + "' > '" + (dir / "shear.log").string() + "' 2>&1";
+        CHECK(WEXITSTATUS(std::system(shear.c_str())) == 2);
+        CHECK_THAT(read_file(dir / "shear.log"), Catch::Matchers::Contains("demcal: error: ") &&
+                                                     Catch::Matchers::Contains("is in use by another demcal process"));
     }
     CHECK_FALSE(fs::exists(dir / "out" / "summary.json"));
     fs::remove_all(dir);

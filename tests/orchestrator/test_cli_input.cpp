@@ -243,6 +243,8 @@ TEST_CASE("a simulator that cannot start leaves the runs pending, and a resume w
     INFO(test::read_file(dir / "out.log"));
     CHECK(rc == 75);
     CHECK_THAT(test::read_file(dir / "out.log"), Contains("could not be started") && Contains(expect));
+    // what the campaign has (it said "fewer than 3 finished runs on 2 normal stresses" of 0 runs on 3)
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("no failure line: 0 finished runs on 0 normal stresses"));
     const auto runs = test::stored_runs(campaign);
     for (const auto& r : runs) CHECK(r.state == orchestrator::RunState::pending);
     // the first run that did not start stops the campaign: no other run is tried
@@ -267,6 +269,13 @@ TEST_CASE("a study stopped by a simulator that cannot start exits 75 as a shear 
     CHECK(rc == 75);  // was 1, "failed", for the same stop that a shear campaign reports as "resume later"
     CHECK_THAT(test::read_file(dir / "out.log"), Contains("demcal: stopped: the simulator could not be started"));
     for (const auto& r : test::stored_runs(dir / "campaign")) CHECK(r.state == orchestrator::RunState::pending);
+    // a crosscheck exited 75 saying nothing of why (its report's line was its last word)
+    CHECK(test::run_demcal({"crosscheck", "shear", tiny, "-s", "3e3,4e3,5e3", "-r", "1", "--yade",
+                            (dir / "broken-yade").string(), "--retries", "0", "-j", "1", "-c",
+                            (dir / "cross").string()},
+                           dir / "cross.log") == 75);
+    CHECK_THAT(test::read_file(dir / "cross.log"),
+               Contains("the simulator could not be started") && Contains("run the same command again"));
     fs::remove_all(dir);
 }
 

@@ -644,6 +644,7 @@ TEST_CASE("probe 44: a command, a list item or a design a user mistyped is refus
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
     const std::string camp = (dir / "camp").string();
     refused({{{"shaer", tiny}, {"'shaer' is not a demcal command", "shear, status"}},
+             {{"crosscheck", "sheer", tiny}, {"'sheer' is not a subcommand of demcal crosscheck (", "shear", "silo"}},
              {{"shear", tiny, "-s", "5e3,,1e4,2e4", "-c", camp}, {"--normal-stress", "'5e3,,1e4,2e4' has an empty item"}},
              {{"shear", tiny, "--normal-stress=5e3,1e4,", "-c", camp}, {"--normal-stress", "empty item"}},
              {{"vibration", "--theta", "30,,50", "--frequency", "0", "--campaign", camp}, {"--theta", "empty item"}},

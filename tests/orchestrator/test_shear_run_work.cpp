@@ -97,6 +97,11 @@ TEST_CASE("shear-run refuses a run of absurdly many time steps, naming the field
     shear_run_refuses(dir, "normal_stress", 100, {"normal_stress = 100 Pa", "about 260 Pa"});
     // lighter than any granular solid: a lower bound of the table
     shear_run_refuses(dir, "density", 1e-3, {"'density' = 0.001", "[10, 100000]"});
+    // more samples than the shear's steps: one step each moved the frame past shear_displacement (probe 58b: 6.56
+    // mm for 4 mm, a peak line of 2530 Pa against 1533; at 100000 the frame left the box)
+    shear_run_refuses(dir, "samples", 20000, {"samples = 20000 is more than the shear's time steps", "at most"});
+    // a seed above 2^63 was shown wrapped ("'seed' = -1 is outside ..."): as typed now
+    shear_run_refuses(dir, "seed", nlohmann::json(18446744073709551615ULL), {"'seed' = 18446744073709551615"});
     fs::remove_all(dir);
 }
 

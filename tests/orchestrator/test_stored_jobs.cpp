@@ -96,7 +96,8 @@ TEST_CASE("stored jobs: reuse, failure for good on exit 2, retry of other failur
     }
     CampaignDirectory d(root, stored_job_result);  // ... and without its result: back to pending
     CHECK(d.store().run(jobs[2].hash)->state == RunState::pending);
-    CHECK_THROWS_AS(CampaignDirectory(root, stored_job_result), std::runtime_error);  // the lock is held
+    // the lock is held: refused as bad input (exit 2 in every command), naming the folder
+    CHECK_THROWS_AS(CampaignDirectory(root, stored_job_result), std::invalid_argument);
     fs::remove_all(root);
 }
 
