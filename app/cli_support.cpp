@@ -426,7 +426,7 @@ std::string with_option_name(const CLI::App& app, const std::string& message) {
         command = subs.front();
     std::string option = "--" + message.substr(0, n);
     std::replace(option.begin(), option.end(), '_', '-');
-    if (const_cast<CLI::App*>(command)->get_option_no_throw(option) == nullptr) return message;
+    if (command->get_option_no_throw(option) == nullptr) return message;
     return option + message.substr(n);
 }
 
