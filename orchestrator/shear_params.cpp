@@ -163,6 +163,13 @@ double unit_union_volume(int n, double spacing) {
     return n * sphere - (n - 1) * M_PI * (4 + spacing) * std::pow(2 - spacing, 2.0) / 12.0;
 }
 
+// The box's time step when its smallest sphere has radius smallest_radius: timestep_fraction of that sphere's
+// elastic wave crossing time, r sqrt(density / young_modulus), as both engines set it.
+static double shear_timestep(const nlohmann::json& m, double smallest_radius) {
+    return m.at("timestep_fraction").get<double>() * smallest_radius *
+           std::sqrt(m.at("density").get<double>() / m.at("young_modulus").get<double>());
+}
+
 // What one run may cost. Values each in their range can still make a run that ends on no machine: 1 um grains in a
 // 4 cm box (4e12 particles), a time step fraction of 1e-12 or a shear velocity of 1 nm/s (1e12 steps); they were
 // planned and started, and ran until killed. The limits lie far above every run of the repository (sand-tiny: 525
@@ -178,8 +185,7 @@ double unit_union_volume(int n, double spacing) {
 // time step a run can draw, that of a smallest sphere as large as r (1 + radius_spread).
 static void check_samples_within_travel(const nlohmann::json& m, const std::string& where) {
     auto d = [&](const char* k) { return m.at(k).get<double>(); };
-    const double largest_step = d("timestep_fraction") * d("particle_radius") * (1 + d("radius_spread")) *
-                                std::sqrt(d("density") / d("young_modulus"));
+    const double largest_step = shear_timestep(m, d("particle_radius") * (1 + d("radius_spread")));
     const double fewest_steps = std::floor(d("shear_displacement") / (d("shear_velocity") * largest_step));
     if (d("samples") <= fewest_steps) return;
     throw std::invalid_argument(where + ": samples = " + analytics::number_text(d("samples")) +
@@ -298,7 +304,7 @@ ShearRunWork estimate_shear_work(const nlohmann::json& m, std::optional<double> 
     // the cloud starts shrunk by size_factor; the time step is the smallest sphere's, r (1 - spread) at full size
     const double size_factor = std::cbrt(kCloudSolidFraction * unit_union_volume(n, spacing) /
                                          (kGrownSolidFraction * 4.0 / 3.0 * M_PI * std::pow(form, 3.0)));
-    w.timestep = d("timestep_fraction") * r * (1 - spread) * std::sqrt(d("density") / d("young_modulus"));
+    w.timestep = shear_timestep(m, r * (1 - spread));
     w.growth_steps = std::ceil(r * std::log(1 / size_factor) / (kGrowthSurfaceSpeed * size_factor * w.timestep));
     w.shear_steps = std::max(d("samples"), std::ceil(d("shear_displacement") / (d("shear_velocity") * w.timestep)));
     if (normal_stress) {
