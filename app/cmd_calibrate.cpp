@@ -166,7 +166,9 @@ SensitivityStudy run_study(const nlohmann::json& base, const SensitivityCli& o, 
                                                                   : options.params.size())
               << " parameters x " << options.levels << " levels, failure lines at " << o.campaign.normal_stresses.size()
               << " normal stresses x " << o.campaign.replicates << " packings" << std::endl;
-    return run_sensitivity_study(base, evaluate, options, print_level);
+    SensitivityStudy study = run_sensitivity_study(base, evaluate, options, print_level);
+    study.campaign = StudyCampaign::of(settings_of(o.campaign, "sensitivity"));
+    return study;
 }
 
 void add_sensitivity(CLI::App& app) {
@@ -303,7 +305,8 @@ std::vector<ControlParameter> pick_controls(const CalibrateCli& o, const Sensiti
     return picked;
 }
 
-SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json& start, LineKind line) {
+SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json& start, LineKind line,
+                                   const CampaignCli& campaign) {
     SensitivityStudy study;
     try {
         study = SensitivityStudy::from_json(read_json_file(file, "sensitivity"));
@@ -317,6 +320,22 @@ SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json
                         to_string(study.options.line) + " failure line, and --line " + to_string(line) +
                         ": its responses are of the other line (run the study with --line " + to_string(line) +
                         ", or calibrate the " + to_string(study.options.line) + " line)");
+    if (!study.campaign) {
+        std::cerr << "demcal: warning: --sensitivity = '" << analytics::shortened_text(file, 200)
+                  << "' does not record the engine, normal stresses and YADE script its lines ran on (written "
+                     "before demcal recorded them): not checked against this calibration's\n";
+        return study;
+    }
+    StudyCampaign here;
+    try {
+        here = StudyCampaign::of(settings_of(campaign, "calibrate"));
+    } catch (const std::exception& e) {
+        throw UserError("--template = '" + analytics::shortened_text(campaign.template_path, 200) + "': " + e.what());
+    }
+    if (const std::string why = study.campaign->difference_from(here); !why.empty())
+        throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': " + why +
+                        ": its responses hold for the campaign it ran (calibrate with the same options, or run the "
+                        "study for these)");
     return study;
 }
 
@@ -388,7 +407,8 @@ void run_calibrate(CalibrateCli& o) {
     SensitivityStudy study;
     std::vector<ControlParameter> controls;
     if (!o.sensitivity_file.empty()) {
-        study = read_stored_study(o.sensitivity_file, start, line_kind_from_string(o.study.campaign.line));
+        study = read_stored_study(o.sensitivity_file, start, line_kind_from_string(o.study.campaign.line),
+                                  o.study.campaign);
         controls = pick_controls(o, study, targets, bounds);  // a study that cannot serve: refused before the campaign
     }
     CampaignSession session(camp, "calibrate");

@@ -2,6 +2,8 @@
 
 #include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"  // json_value_text
+#include "orchestrator/run_identity.hpp"  // sha256_hex, read_text_file
+#include "orchestrator/shear_campaign.hpp"  // to_string(ShearEngine)
 #include "orchestrator/shear_params.hpp"
 
 #include <algorithm>
@@ -200,6 +202,34 @@ SensitivityStudy run_sensitivity_study(const nlohmann::json& base, const Failure
     return study;
 }
 
+StudyCampaign StudyCampaign::of(const CampaignSettings& c) {
+    StudyCampaign out{orchestrator::to_string(c.engine), c.normal_stresses, ""};
+    std::sort(out.normal_stresses.begin(), out.normal_stresses.end());
+    if (!c.template_path.empty()) out.template_sha256 = orchestrator::sha256_hex(orchestrator::read_text_file(c.template_path));
+    return out;
+}
+
+std::string StudyCampaign::difference_from(const StudyCampaign& here) const {
+    auto stresses = [](const std::vector<double>& v) {
+        std::string t;
+        for (double x : v) {
+            if (!t.empty()) t += ",";
+            t += analytics::number_text(x);
+        }
+        return t;
+    };
+    if (engine != here.engine) return "its lines ran on --engine " + engine + ", this calibration on " + here.engine;
+    if (normal_stresses != here.normal_stresses)
+        return "its lines ran at --normal-stress " + stresses(normal_stresses) + " Pa, this calibration's at " +
+               stresses(here.normal_stresses) + " Pa";
+    if (template_sha256 != here.template_sha256)
+        return std::string("its lines ran on ") +
+               (template_sha256.empty() ? "the stock YADE script" : "a --template script of SHA-256 " + template_sha256) +
+               ", this calibration on " +
+               (here.template_sha256.empty() ? "the stock script" : "a --template of SHA-256 " + here.template_sha256);
+    return "";
+}
+
 nlohmann::json SensitivityStudy::to_json() const {
     nlohmann::json j = {{"schema", "demcal.sensitivity/1"},
                         {"base_material", base_material},
@@ -213,6 +243,10 @@ nlohmann::json SensitivityStudy::to_json() const {
                         {"simulations_reused", simulations_reused},
                         {"cpu_s", cpu_s},
                         {"parameters", nlohmann::json::array()}};
+    if (campaign)
+        j["campaign"] = {{"engine", campaign->engine},
+                         {"normal_stresses", campaign->normal_stresses},
+                         {"template_sha256", campaign->template_sha256}};
     for (const auto& p : parameters) {
         nlohmann::json pj = {{"name", p.name}, {"base_value", p.base_value}, {"levels", nlohmann::json::array()}};
         for (const auto& l : p.levels)
@@ -312,6 +346,26 @@ void read_study_settings(const nlohmann::json& j, SensitivityStudy& s) {
     s.cpu_s = R::optional_number(j, "cpu_s", "");
 }
 
+// The campaign the study ran on (its "campaign" object).
+StudyCampaign read_study_campaign(const nlohmann::json& c) {
+    R::only_known_keys(c, {"engine", "normal_stresses", "template_sha256"}, "campaign");
+    StudyCampaign out;
+    out.engine = R::text(c, "engine", "campaign");
+    if (out.engine != "yade" && out.engine != "kernel")
+        R::refuse("campaign.engine", c.at("engine"), "must be yade or kernel");
+    const nlohmann::json& stresses = R::array(c, "normal_stresses", "campaign", 1);
+    for (std::size_t i = 0; i < stresses.size(); ++i) {
+        const std::string where = "campaign.normal_stresses[" + std::to_string(i) + "]";
+        if (!stresses[i].is_number()) R::refuse(where, stresses[i], "must be a number");
+        const double x = stresses[i].get<double>();
+        if (!(x > 0 && x <= big)) R::refuse(where, stresses[i], "must lie in (0, 1e100] Pa");
+        out.normal_stresses.push_back(x);
+    }
+    std::sort(out.normal_stresses.begin(), out.normal_stresses.end());
+    out.template_sha256 = R::text(c, "template_sha256", "campaign");
+    return out;
+}
+
 // One level's failure line; `lw` names it in a refusal.
 SensitivityLevel read_study_level(const nlohmann::json& lj, const std::string& lw) {
     R::only_known_keys(lj,
@@ -387,10 +441,11 @@ SensitivityStudy SensitivityStudy::from_json(const nlohmann::json& j) {
                                     " is not demcal.sensitivity/1");
     R::only_known_keys(j,
                        {"schema", "base_material", "levels", "relative_span", "line", "criterion", "alpha",
-                        "evaluations", "simulations_run", "simulations_reused", "cpu_s", "parameters"},
+                        "evaluations", "simulations_run", "simulations_reused", "cpu_s", "parameters", "campaign"},
                        "");
     SensitivityStudy s;
     read_study_settings(j, s);
+    if (j.contains("campaign")) s.campaign = read_study_campaign(R::at(j, "campaign", ""));
     const nlohmann::json& parameters = R::array(j, "parameters", "", 1);
     for (std::size_t i = 0; i < parameters.size(); ++i)
         s.parameters.push_back(read_study_parameter(parameters[i], "parameters[" + std::to_string(i) + "]", s));

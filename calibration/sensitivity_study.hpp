@@ -4,9 +4,11 @@
 // their significance. The base material is one level of every parameter, so it is evaluated (and stored) once.
 #pragma once
 #include "analytics/response_shape.hpp"
+#include "calibration/campaign_evaluator.hpp"
 #include "calibration/macro_target.hpp"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,9 +47,22 @@ struct ParameterSensitivity {
     double high() const { return levels.back().value; }
 };
 
+// The campaign a study's failure lines ran on. Its responses hold for that campaign only: another engine, other
+// normal stresses (a line over another range of a curved envelope) or another YADE script give other lines, so a
+// calibration steered by the study must run the same one. Replicates and seeds only change the lines' precision.
+struct StudyCampaign {
+    std::string engine;                   // "yade" or "kernel"
+    std::vector<double> normal_stresses;  // [Pa], ascending
+    std::string template_sha256;          // SHA-256 of a --template YADE script's text; empty for the stock script
+    static StudyCampaign of(const CampaignSettings& c);  // reads the template; throws std::runtime_error if it cannot
+    // Empty when a calibration running `here` may use the study; else what differs, both values named.
+    std::string difference_from(const StudyCampaign& here) const;
+};
+
 struct SensitivityStudy {
     nlohmann::json base_material;
     SensitivityOptions options;
+    std::optional<StudyCampaign> campaign;  // absent in a study written before demcal recorded it
     std::vector<ParameterSensitivity> parameters;
     int evaluations = 0;  // failure lines computed or reused
     int simulations_run = 0, simulations_reused = 0;

@@ -9,6 +9,8 @@
 #include <algorithm>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 using namespace demcal;
@@ -81,6 +83,50 @@ TEST_CASE("the sensitivity study finds the shapes the synthetic box was built wi
     const auto again = SensitivityStudy::from_json(study.to_json());
     CHECK(again.find("young_modulus")->mu_b.shape == ResponseShape::parabolic);
     CHECK(again.table().find("bond_normal_strength") != std::string::npos);
+}
+
+TEST_CASE("a stored study keeps the campaign its lines ran on, and names what another campaign changes",
+          "[calibration]") {
+    CampaignSettings settings;
+    settings.normal_stresses = {1.5e4, 5e3, 1e4};
+    settings.replicates = 3;
+    settings.engine = orchestrator::ShearEngine::kernel;
+    const StudyCampaign ran = StudyCampaign::of(settings);
+    CHECK(ran.engine == "kernel");
+    CHECK(ran.normal_stresses == std::vector<double>{5e3, 1e4, 1.5e4});  // a set: the order typed is no difference
+    CHECK(ran.template_sha256.empty());
+    test::SyntheticShearBox box;
+    SensitivityOptions options;
+    options.params = {"friction_coefficient"};
+    SensitivityStudy study = run_sensitivity_study(test::synthetic_base_material(), box.evaluator(), options);
+    study.campaign = ran;
+    const auto again = SensitivityStudy::from_json(study.to_json());
+    REQUIRE(again.campaign);
+    CHECK(again.campaign->difference_from(ran).empty());
+    // replicates and the seed change the lines' precision only
+    settings.replicates = 1;
+    settings.base_seed = 7;
+    CHECK(ran.difference_from(StudyCampaign::of(settings)).empty());
+    settings.engine = orchestrator::ShearEngine::yade;
+    CHECK(ran.difference_from(StudyCampaign::of(settings)) == "its lines ran on --engine kernel, this calibration on yade");
+    settings.engine = orchestrator::ShearEngine::kernel;
+    settings.normal_stresses = {5e3, 1e4, 2e4};
+    CHECK(ran.difference_from(StudyCampaign::of(settings)) ==
+          "its lines ran at --normal-stress 5000,10000,15000 Pa, this calibration's at 5000,10000,20000 Pa");
+    // a YADE script of its own: told by its text, not its name
+    settings.normal_stresses = {5e3, 1e4, 1.5e4};
+    const auto script = std::filesystem::temp_directory_path() / "demcal-study-campaign-template.py";
+    std::ofstream(script) << "# a user's own shear box\n";
+    settings.template_path = script;
+    const auto scripted = StudyCampaign::of(settings);
+    CHECK(scripted.template_sha256.size() == 64);
+    CHECK(ran.difference_from(scripted).find("its lines ran on the stock YADE script, this calibration on a "
+                                             "--template of SHA-256 ") == 0);
+    // a study written before the campaign was recorded reads back without one
+    auto old = study.to_json();
+    old.erase("campaign");
+    CHECK_FALSE(SensitivityStudy::from_json(old).campaign);
+    std::filesystem::remove(script);
 }
 
 TEST_CASE("the loop recovers a hidden material's failure line in a few evaluations, far fewer than the baselines",

@@ -595,9 +595,19 @@ TEST_CASE("calibrate --sensitivity: a study of another material, or one that mov
     // a study of the peak line steering a calibration of the residual line (probe 58)
     auto residual = calibrate(test::source_path(stored).string(), "mu_b=1.3,tau_c=2e4");
     residual.insert(residual.end(), {"--line", "residual"});
+    // a study of another engine, or at other normal stresses, steered this calibration (its file did not say)
+    auto on_yade = study, at_other_stresses = study;
+    on_yade["campaign"] = {{"engine", "yade"}, {"normal_stresses", {5e3, 1e4, 1.5e4}}, {"template_sha256", ""}};
+    at_other_stresses["campaign"] = {{"engine", "kernel"}, {"normal_stresses", {2e3, 4e3, 6e3}}, {"template_sha256", ""}};
+    std::ofstream(dir / "on_yade.json") << on_yade.dump();
+    std::ofstream(dir / "at_other_stresses.json") << at_other_stresses.dump();
     refused({{calibrate((dir / "foreign.json").string(), "mu_b=1.3,tau_c=2e4"),
               {"its base material has density = 2000", "the start material"}},
-             {residual, {"a study of the peak failure line, and --line residual"}}},
+             {residual, {"a study of the peak failure line, and --line residual"}},
+             {calibrate((dir / "on_yade.json").string(), "mu_b=1.3,tau_c=2e4"),
+              {"--sensitivity = '", "its lines ran on --engine yade, this calibration on kernel"}},
+             {calibrate((dir / "at_other_stresses.json").string(), "mu_b=1.3,tau_c=2e4"),
+              {"its lines ran at --normal-stress 2000,4000,6000 Pa, this calibration's at 5000,10000,15000 Pa"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);
@@ -887,6 +897,16 @@ TEST_CASE("probe 47: a stored sensitivity study with a damaged field is refused 
               {"level = 5: unknown key"}},
              {with(damaged("unknown_level.json", [](nlohmann::json& j) { j["parameters"][1]["levels"][0]["mu"] = 0.4; })),
               {"parameters[1].levels[0].mu = 0.4: unknown key"}},
+             {with(damaged("campaign_engine.json",
+                           [](nlohmann::json& j) {
+                               j["campaign"] = {{"engine", "lammps"}, {"normal_stresses", {1e4}}, {"template_sha256", ""}};
+                           })),
+              {"campaign.engine = \"lammps\": must be yade or kernel"}},
+             {with(damaged("campaign_stress.json",
+                           [](nlohmann::json& j) {
+                               j["campaign"] = {{"engine", "kernel"}, {"normal_stresses", {1e4, -5}}, {"template_sha256", ""}};
+                           })),
+              {"campaign.normal_stresses[1] = -5: must lie in (0, 1e100] Pa"}},
              {with(damaged("count.json",
                            [](nlohmann::json& j) {
                                auto& levels = j["parameters"][0]["levels"];
