@@ -331,7 +331,8 @@ std::string cell_row(double theta, double f, double g, const CellSummary& s) {
 // Returns how many cells have a rate (a mean over at least one run whose rate was determined). `stopped`: the sweep
 // stopped before its end (a signal); the report says so and counts the runs finished (a stopped sweep's report read
 // as a whole one, n = 0 in every cell).
-int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec>& runs, bool stopped) {
+int report(const VibrationCli& o, const json& settings, const fs::path& dir, const std::vector<RunSpec>& runs,
+           bool stopped) {
     std::vector<RunResult> results;
     json all = json::array();
     for (const RunSpec& r : runs) {
@@ -364,7 +365,7 @@ int report(const VibrationCli& o, const fs::path& dir, const std::vector<RunSpec
     md << "\nChanges are paired seed by seed against the still run of the same angle and seed (the same filled bed); "
           "SE: the standard error of the pairs' mean. d ln(rate) = d ln(density) + d ln(speed) at the outlet splits a "
           "change of the rate.\n";
-    const json out = {{"settings", campaign_settings(o)}, {"complete", !stopped && finished == std::ptrdiff_t(runs.size())},
+    const json out = {{"settings", settings}, {"complete", !stopped && finished == std::ptrdiff_t(runs.size())},
                       {"stopped", stopped},         {"runs_finished", finished},
                       {"runs_planned", runs.size()}, {"cells", table},
                       {"runs", all}};
@@ -395,15 +396,17 @@ int run(const VibrationCli& o) {
     check_paths_apart(silo_campaign_inputs(o.silo_args, dir), reports);
     // a run is its angle, frequency and seed under the shared settings: a grid that grows (or shrinks) is the same
     // campaign, its finished runs reused
-    open_silo_campaign(dir, campaign_settings(o), "vibration", {"thetas_deg", "frequencies_hz", "repeats", "first_seed"});
+    // read once: the report states the settings (and input digests) the runs were checked against
+    const json settings = campaign_settings(o);
+    open_silo_campaign(dir, settings, "vibration", {"thetas_deg", "frequencies_hz", "repeats", "first_seed"});
     const SiloCampaignOutcome outcome =
         run_silo_campaign(dir, plans, o.jobs, "vibration", {o.executor, o.partition});
     if (outcome.stopped) {
-        report(o, dir, runs, true);
+        report(o, settings, dir, runs, true);
         return kExitResumeLater;
     }
     std::cout << outcome.finished << " runs finished, " << outcome.failed << " failed\n";
-    if (report(o, dir, runs, false) == 0 && outcome.finished > 0) {
+    if (report(o, settings, dir, runs, false) == 0 && outcome.finished > 0) {
         std::cout << "no cell has a rate: no run's discharge rate was determined (see each run's summary.json, "
                      "rate.message), so the sweep measured nothing (exit 1)\n";
         return 1;
