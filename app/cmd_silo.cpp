@@ -321,6 +321,9 @@ ks::BinVibration vibration_from(const SiloCli& o, CLI::App& sub) {
     if (o.vibration_frequency == 0)  // a still bin: the amplitude was recorded in the summary and did nothing
         throw UserError("--vibration-frequency 0 is a still bin: --vibration-amplitude and the other --vibration "
                         "options do nothing; leave them out, or give a frequency above 0");
+    if (o.vibration_amplitude == 0)  // the same still bin, reported as vibrating with its part and start
+        throw UserError("--vibration-amplitude 0 is a still bin: --vibration-frequency and the other --vibration "
+                        "options do nothing; leave them out, or give an amplitude above 0");
     ks::BinVibration v;
     v.frequency = o.vibration_frequency;
     v.amplitude = o.vibration_amplitude;
@@ -441,6 +444,9 @@ nlohmann::json vibration_json(const ks::SiloCaseSettings& s, const ks::SiloCaseR
             {"part", ks::to_string(v.part)},
             {"start_after_opening_s", v.start_after_opening},
             {"start_time_s", r.fill_time + v.start_after_opening},
+            // how long the walls shook while the bed discharged: 0 when the discharge ended before the start (a
+            // run "vibrating" at 4 g gave the still run's rate bit for bit)
+            {"vibrated_s", v.vibrates() ? std::max(0.0, r.discharge_time - v.start_after_opening) : 0.0},
             {"peak_acceleration_m_s2", v.peak_acceleration()},
             {"peak_acceleration_g", v.peak_acceleration() / s.gravity},
             {"note", "displacement A sin(2 pi f (t - start_time_s)) of the walls of the part (bin: every wall, "
@@ -585,6 +591,23 @@ void check_out_folder_free(const fs::path& dir) {
                             "another --out (a new or empty folder), or remove it");
 }
 
+// Refuses an exported bed in the --out folder under a name the run keeps for itself: one of kRunFiles with any ending
+// (the atomic writers' temporaries, checkpoint.bin.tmp) or a hidden name (.lock): the run removed or replaced such a
+// file, and the exported bed was gone at the end with exit 0.
+void refuse_export_among_run_files(const std::string& file, const char* option, const fs::path& out) {
+    if (file.empty()) return;
+    std::error_code ec;
+    const fs::path parent = fs::weakly_canonical(fs::absolute(fs::path(file)).parent_path(), ec);
+    if (ec || parent != fs::weakly_canonical(fs::absolute(out), ec) || ec) return;
+    const std::string name = fs::path(file).filename().string();
+    bool taken = !name.empty() && name.front() == '.';
+    for (const char* own : kRunFiles) taken = taken || name.rfind(own, 0) == 0;
+    if (taken)
+        throw UserError(std::string(option) + " = '" + analytics::shortened_text(file, 200) + "': the name " + name +
+                        " in the --out folder is the run's own (its results, their temporary files, its lock): "
+                        "give the bed another name or folder");
+}
+
 // Refuses a --vtk folder that already holds snapshots (silo_*.vtk) for a new run: it replaced a user's file of that
 // name, and a second run there overwrote the first run's first frames and left its later ones, one mixed series.
 void check_vtk_folder_free(const std::string& vtk_dir) {
@@ -639,6 +662,10 @@ void prepare_outputs(const SiloCli& o, const fs::path& dir, ks::SiloCaseSettings
         check_output_folder(s.vtk_dir, "--vtk");
         check_vtk_folder_free(s.vtk_dir);
     }
+    for (const auto& [file, option] : {std::pair{o.export_bed, "--export-bed"},
+                                       std::pair{o.export_final_bed, "--export-final-bed"},
+                                       std::pair{o.export_cloud, "--export-cloud"}})
+        refuse_export_among_run_files(file, option, dir);
     std::vector<NamedPath> outputs{{dir.string(), "--out"}};
     for (const char* name : kRunFiles) outputs.push_back({(dir / name).string(), std::string("--out's ") + name});
     outputs.insert(outputs.end(), {{o.export_bed, "--export-bed"}, {o.export_final_bed, "--export-final-bed"},

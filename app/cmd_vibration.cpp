@@ -72,7 +72,17 @@ SiloRunPlan silo_plan(const VibrationCli& o, const RunSpec& r) {
         a.insert(a.end(), {"--vibration-frequency", silo_number(r.frequency), "--vibration-amplitude",
                            silo_number(o.amplitude), "--vibration-direction", o.direction, "--vibration-part",
                            o.part});
-    a.insert(a.end(), o.silo_args.begin(), o.silo_args.end());
+    // --vibration-start after -- delays the vibrating cells' shaking; the still runs have none to delay (silo refuses
+    // it without a vibration: a sweep with a 0 Hz cell was refused naming a run, one without took it)
+    for (std::size_t i = 0; i < o.silo_args.size(); ++i) {
+        const std::string& arg = o.silo_args[i];
+        if (r.frequency == 0 && arg == "--vibration-start") {
+            ++i;  // and its value
+            continue;
+        }
+        if (r.frequency == 0 && arg.rfind("--vibration-start=", 0) == 0) continue;
+        a.push_back(arg);
+    }
     return {r.name(), a};
 }
 
@@ -127,6 +137,7 @@ void check_options(const VibrationCli& o) {
 // What one run gave (NaN where it did not: a failed run, no steady discharge, a demcal without the outlet meter).
 struct RunResult {
     bool finished = false, failed = false;
+    bool never_vibrated = false;   // a vibrating cell's run whose discharge ended before its vibration started
     double rate = NAN;             // g/s
     double outlet_density = NAN;   // kg/m^3
     double outlet_speed = NAN;     // m/s
@@ -145,9 +156,12 @@ RunResult read_run(const fs::path& dir, const RunSpec& r) {
                 s->fail(field, "= " + analytics::number_text(s->number(field)) + ", but the cell's run has " + analytics::number_text(want) +
                                    ": not this cell's run");
         out.finished = true;
+        out.pattern = s->text("flow_pattern/pattern");
+        // a still discharge in a vibrating cell (--vibration-start after its end) measures no vibration: not counted
+        out.never_vibrated = r.frequency > 0 && s->optional_number("vibration/vibrated_s").value_or(1) == 0;
+        if (out.never_vibrated) return out;
         // no rate where the run ended without a steady discharge
         out.rate = s->optional_number("rate/rate_kg_s").value_or(NAN) * 1e3;
-        out.pattern = s->text("flow_pattern/pattern");
         if (s->optional_number("outlet_flow/frames").value_or(0) > 0) {
             out.outlet_density = s->number("outlet_flow/solid_density_kg_m3");
             out.outlet_speed = s->number("outlet_flow/downward_speed_m_s");
@@ -238,7 +252,8 @@ void plot_rates(const VibrationCli& o, const fs::path& dir, const std::map<doubl
 
 json run_json(const RunSpec& r, const RunResult& res) {
     json entry = {{"theta_deg", r.theta}, {"frequency_hz", r.frequency}, {"seed", r.seed}};
-    if (res.finished) {
+    if (res.never_vibrated) entry["never_vibrated"] = true;
+    if (res.finished && !res.never_vibrated) {
         entry["rate_g_s"] = res.rate;
         entry["flow_pattern"] = res.pattern;
         if (std::isfinite(res.outlet_density)) {
@@ -273,6 +288,7 @@ struct CellSummary {
     double mean = NAN, sd = NAN, outlet_density = NAN, outlet_speed = NAN;
     std::size_t n = 0;  // runs with a rate
     int failed = 0;
+    int never_vibrated = 0;  // runs left out: their discharge ended before the vibration started
     std::string pattern = "-";
     PairedChange rate_change, density_change, speed_change;
 };
@@ -284,7 +300,8 @@ CellSummary summarize(const Cell& c, bool vibrated) {
     for (std::size_t i = 0; i < c.runs.size(); ++i) {
         const RunResult& r = c.runs[i];
         s.failed += r.failed;
-        if (r.finished) ++patterns[r.pattern];
+        s.never_vibrated += r.never_vibrated;
+        if (r.finished && !r.never_vibrated) ++patterns[r.pattern];
         rates.push_back(r.rate), densities.push_back(r.outlet_density), speeds.push_back(r.outlet_speed);
         still_rates.push_back(c.still[i].rate), still_densities.push_back(c.still[i].outlet_density);
         still_speeds.push_back(c.still[i].outlet_speed);
@@ -312,6 +329,7 @@ CellSummary summarize(const Cell& c, bool vibrated) {
 json cell_json(double theta, double f, double g, const CellSummary& s) {
     return {{"theta_deg", theta}, {"frequency_hz", f}, {"peak_acceleration_g", g},
             {"rate_mean_g_s", s.mean}, {"rate_sd_g_s", s.sd}, {"n", s.n}, {"failed", s.failed},
+            {"never_vibrated", s.never_vibrated},
             {"flow_pattern", s.pattern}, {"rate_change_paired", change_json(s.rate_change)},
             {"outlet_solid_density_mean_kg_m3", s.outlet_density},
             {"outlet_density_change_paired", change_json(s.density_change)},
@@ -347,9 +365,11 @@ int report(const VibrationCli& o, const json& settings, const fs::path& dir, con
           "[%] |\n"
        << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     std::map<double, std::string> data_by_theta;
+    int never_vibrated = 0;
     for (const auto& [key, c] : cells_of(runs, results)) {
         const auto [theta, f] = key;
         const CellSummary s = summarize(c, f > 0);
+        never_vibrated += s.never_vibrated;
         cells_with_rate += s.n > 0;
         const double g = o.amplitude * std::pow(2 * M_PI * f, 2) / 9.81;
         table.push_back(cell_json(theta, f, g, s));
@@ -362,6 +382,12 @@ int report(const VibrationCli& o, const json& settings, const fs::path& dir, con
     if (stopped)
         md << "\n**The sweep stopped before its end: " << finished << " of " << runs.size()
            << " runs finished; the same command continues it.**\n";
+    if (never_vibrated > 0) {
+        md << "\n**" << never_vibrated << " run(s) of vibrating cells discharged before their vibration started "
+           << "(--vibration-start after the discharge's end): still discharges, left out of their cells (n).**\n";
+        std::cerr << "demcal vibration: warning: " << never_vibrated << " run(s) of vibrating cells ended before "
+                  << "their vibration started (--vibration-start): left out of their cells\n";
+    }
     md << "\nChanges are paired seed by seed against the still run of the same angle and seed (the same filled bed); "
           "SE: the standard error of the pairs' mean. d ln(rate) = d ln(density) + d ln(speed) at the outlet splits a "
           "change of the rate.\n";

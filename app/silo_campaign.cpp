@@ -121,10 +121,17 @@ std::string silo_number(double value) {
 
 void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const std::vector<std::string>& owned,
                                const std::string& command) {
-    for (const std::string& a : silo_args)
+    auto is = [](const std::string& a, const std::string& o) { return a == o || a.rfind(o + "=", 0) == 0; };
+    for (const std::string& a : silo_args) {
         for (const std::string& o : owned)
-            if (a == o || a.rfind(o + "=", 0) == 0)
-                throw UserError("silo option " + a + " after --: " + command + " sets it for every run");
+            if (is(a, o)) throw UserError("silo option " + a + " after --: " + command + " sets it for every run");
+        // one path for every run: each run wrote the same bed file over the last one's, and the second run's
+        // snapshots were refused in the --vtk folder the first had filled (the campaign failed halfway)
+        for (const char* o : kOneRunOutputOptions)
+            if (is(a, o))
+                throw UserError("silo option " + a + " after --: " + command + " would give every run the same " +
+                                "output path (each run overwriting the last); run `demcal silo` with it for one run");
+    }
 }
 
 namespace {
@@ -336,6 +343,47 @@ bool silo_run_failed(const fs::path& dir, const std::string& name) { return fs::
 
 namespace {
 
+// A run folder's identity, DIR/runs/NAME/run.json, written before its first launch: the run's silo options and the
+// digests of the files they name. A run is found by its folder's name, so a folder copied from another campaign (of
+// another amplitude, particle count, ...) was read, or its checkpoint resumed, as this campaign's run: a vibration
+// cell reported another amplitude's rate, a still reference of 2000 grains paired with runs of 300.
+constexpr const char* kRunIdentityFile = "run.json";
+
+json silo_run_identity(const SiloRunPlan& plan) {
+    return {{"schema", "demcal.silo-run/1"},
+            {"silo_args", plan.silo_args},
+            {kInputFileDigestsKey, silo_input_file_digests(plan.silo_args)}};
+}
+
+// Refuses a run folder that holds a run of other settings (its run.json differs), naming the first option that
+// differs. A folder without run.json (not begun, or from a demcal before it) is taken as it is.
+void check_run_folder_identity(const fs::path& rd, const json& identity, const std::string& command) {
+    const fs::path file = rd / kRunIdentityFile;
+    if (!fs::exists(fs::symlink_status(file))) return;
+    json stored;
+    try {
+        stored = read_json_file(file.string(), "run identity");
+    } catch (const UserError& e) {
+        throw UserError(std::string(e.what()) + " (remove the run's folder " + rd.string() + " to run it again)");
+    }
+    if (stored == identity) return;
+    std::string what = "its settings";
+    if (stored.is_object() && stored.value(kInputFileDigestsKey, json()) != identity[kInputFileDigestsKey])
+        what = "the contents of its input files (--material, --geometry)";
+    if (stored.is_object() && stored.value("silo_args", json()) != identity["silo_args"])
+        what = "its silo options (" + analytics::shortened_text(stored.value("silo_args", json()).dump(), 300) +
+               ", this campaign's run: " + analytics::shortened_text(identity["silo_args"].dump(), 300) + ")";
+    throw UserError("demcal " + command + ": the run folder " + rd.string() + " holds a run of other settings than " +
+                    "this campaign's run of that name: " + what + " differ (a folder copied from another campaign?); "
+                    "remove it to run it here");
+}
+
+// Records the identity of a run about to start in its folder (made if need be).
+void record_run_identity(const fs::path& rd, const json& identity) {
+    fs::create_directories(rd);
+    if (!fs::exists(rd / kRunIdentityFile)) orchestrator::write_text_file_atomically(rd / kRunIdentityFile, identity.dump(1) + "\n");
+}
+
 // The run's end as the campaign records it: finished, stopped (resume later), or failed (a marker; left alone).
 void record_run_end(const fs::path& rd, const std::string& name, int rc, bool stop_requested,
                     const std::string& log, const std::string& command, SiloCampaignOutcome& outcome) {
@@ -373,7 +421,7 @@ void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& to
     for (const SiloRunPlan* plan : todo) {
         const fs::path rd = dir / "runs" / plan->name;
         const bool resume = fs::exists(rd / "checkpoint.bin");
-        fs::create_directories(rd);
+        record_run_identity(rd, silo_run_identity(*plan));
         std::vector<std::string> argv{program};
         const auto args = resume ? resume_command(*plan, rd) : fresh_command(*plan, rd, false);
         argv.insert(argv.end(), args.begin(), args.end());
@@ -416,6 +464,9 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
     std::vector<const SiloRunPlan*> todo;
     for (const SiloRunPlan& plan : plans) {
         const fs::path rd = dir / "runs" / plan.name;
+        const json identity = silo_run_identity(plan);
+        check_run_folder_identity(rd, identity, command);  // before its summary is read or its checkpoint resumed
+        if (fs::exists(rd)) record_run_identity(rd, identity);  // a run of a demcal before run.json: adopted
         if (fs::exists(rd / "summary.json"))
             ++outcome.finished;
         else if (fs::exists(rd / "failed"))
@@ -439,7 +490,7 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
             const SiloRunPlan& plan = *todo[next++];
             const fs::path rd = dir / "runs" / plan.name;
             const bool resume = fs::exists(rd / "checkpoint.bin");
-            fs::create_directories(rd);
+            record_run_identity(rd, silo_run_identity(plan));
             std::cout << "[" << outcome.finished + outcome.failed + running.size() + 1 << "/" << plans.size() << "] "
                       << plan.name << (resume ? " (resumed)" : "") << std::endl;
             running[spawn_demcal(resume ? resume_command(plan, rd) : fresh_command(plan, rd, false),

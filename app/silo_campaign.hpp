@@ -22,7 +22,12 @@ struct SiloRunPlan {
     std::vector<std::string> silo_args;  // e.g. {"--theta", "30", "--seed", "1", "--particles", "2000", ...}
 };
 
-// Refuses (UserError naming the option and `command`) a silo option after -- that the command sets for every run.
+// The silo options that name one run's output file or folder: a campaign cannot pass them on to all its runs.
+inline constexpr const char* kOneRunOutputOptions[] = {"--export-bed", "--export-final-bed", "--export-cloud", "--vtk",
+                                                       "--vtk-every"};
+
+// Refuses (UserError naming the option and `command`) a silo option after -- that the command sets for every run,
+// or one of kOneRunOutputOptions.
 void refuse_owned_silo_options(const std::vector<std::string>& silo_args, const std::vector<std::string>& owned,
                                const std::string& command);
 

@@ -44,6 +44,9 @@ struct BinVibration {
 // >= 0 s, each finite and not subnormal; a known direction and part. The checks that need the rest of the run (time
 // step, removal depth) are in validate(SiloCaseSettings).
 void validate(const BinVibration& v);
+// The shaking's strength: its peak acceleration at most kMaxVibrationPeakAcceleration (kernel/walls/wall_motion.hpp).
+// Apart from validate, so that a case checks it after the rules with more telling reasons (time steps per period).
+void validate_strength(const BinVibration& v);
 
 // The law every vibrating wall shares. The opening time is only known when the filling ends (at rest, or at its time
 // limit), after the walls were built: until open_at() is called the bin stays still; then the sinusoid starts

@@ -475,7 +475,8 @@ void validate(const SiloCaseSettings& s) {
     validate_contact_options(s);
     validate_vibration_in_run(s);
     validate_run_control(s);
-    validate_contact_softness(s);  // last: the checks above name a more specific cause first
+    validate_contact_softness(s);  // the checks above name a more specific cause first
+    validate_strength(s.vibration);  // last: the time step and the grains' softness are more telling reasons
 }
 
 namespace {

@@ -114,6 +114,20 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
   CHECK_THAT(demcal::test::read_file(dir / "foreign.log"),
              Catch::Matchers::Contains("vibration/frequency_hz = 0") &&
                  Catch::Matchers::Contains("not this cell's run"));
+  // a whole run folder of another campaign (another amplitude) copied into this one, summary and all (probe 59b):
+  // refused by its run.json, before anything is read or written
+  const fs::path other = dir / "other-amplitude";
+  REQUIRE(demcal_run("vibration --theta 45 --frequency 100 --amplitude 2.2e-4 --repeats 1 --campaign '" +
+                         other.string() + "' -- " + kTiny,
+                     dir / "other-amplitude.log") == 0);
+  fs::remove_all(campaign / "runs" / "theta45_f100_seed1");
+  fs::copy(other / "runs" / "theta45_f100_seed1", campaign / "runs" / "theta45_f100_seed1", fs::copy_options::recursive);
+  const std::string report_before = demcal::test::read_file(campaign / "vibration.json");
+  CHECK(demcal_run(grown, dir / "copied.log") == 2);
+  CHECK_THAT(demcal::test::read_file(dir / "copied.log"),
+             Catch::Matchers::Contains("theta45_f100_seed1 holds a run of other settings") &&
+                 Catch::Matchers::Contains("0.00022") && Catch::Matchers::Contains("remove it"));
+  CHECK(demcal::test::read_file(campaign / "vibration.json") == report_before);
   fs::remove_all(dir);
 }
 
@@ -131,7 +145,12 @@ TEST_CASE("demcal vibration: bad input exits 2 naming it before anything is writ
       {"--theta 45 --frequency 0,-5 --amplitude 1e-4" + campaign, "--frequency"},
       {"--theta 45 --frequency 100 --amplitude 1e-4 --direction y" + campaign, "--direction"},
       {"--theta 45 --frequency 100 --amplitude 1e-4 --part body" + campaign, "--part = 'body'"},
-      {"--theta 45 --frequency 100 --amplitude 1e-4 --repeats 0" + campaign, "--repeats"}};
+      {"--theta 45 --frequency 100 --amplitude 1e-4 --repeats 0" + campaign, "--repeats"},
+      // one run's output for every run: each overwrote the last's bed; the second run's snapshots were refused
+      {"--theta 45 --frequency 0,100 --amplitude 1e-4" + campaign + " -- " + kTiny + " --export-bed bed.json",
+       "--export-bed after --: demcal vibration would give every run the same output path"},
+      {"--theta 45 --frequency 0,100 --amplitude 1e-4" + campaign + " -- " + kTiny + " --vtk=snapshots",
+       "--vtk=snapshots after --"}};
   for (const auto& [args, expect] : cases) {
     INFO(args);
     CHECK(demcal_run("vibration " + args, dir / "log") == 2);
