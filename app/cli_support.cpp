@@ -326,6 +326,41 @@ void check_replaceable(const std::string& path, const std::string& named) {
 }
 }  // namespace
 
+namespace {
+// A campaign's own files are never a command's output: `calibrate -o CAMPAIGN/campaign.sqlite` replaced a store of
+// finished runs with a material's JSON, `scale -o DIR/runs/ID/result.json` a stored run's result. Refused: a file that
+// is an SQLite database (its header), a store's name or side file (campaign.sqlite, -wal, -shm, -journal), and any
+// (check_output_outside_run_folders: a run's folder, for the commands a campaign does not run itself).
+void refuse_campaign_files(const std::string& path, const std::string& named) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const std::string name = fs::path(path).filename().string();
+    for (const char* store : {"campaign.sqlite", "campaign.sqlite-wal", "campaign.sqlite-shm", "campaign.sqlite-journal"})
+        if (name == store)
+            throw UserError(named + " is a campaign store's file name: a command's output is never written over a "
+                            "store; give another name");
+    if (fs::is_regular_file(path, ec)) {
+        char header[16] = {};
+        std::ifstream in(path, std::ios::binary);
+        if (in.read(header, sizeof header) && std::string(header, sizeof header) == std::string("SQLite format 3\0", 16))
+            throw UserError(named + " is an SQLite database (a campaign store?): a command's output is never written "
+                            "over one; give another name");
+    }
+}
+}  // namespace
+
+void check_output_outside_run_folders(const std::string& path, const std::string& option) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path run_folder = fs::weakly_canonical(fs::absolute(path, ec), ec).parent_path();
+    const fs::path campaign = run_folder.parent_path().parent_path();
+    if (!ec && run_folder.parent_path().filename() == "runs" &&
+        (fs::exists(campaign / "campaign.sqlite", ec) || fs::exists(campaign / "campaign.json", ec)))
+        throw UserError(option + " = '" + analytics::shortened_text(path, 200) + "' lies in the run folder " +
+                        run_folder.string() + " of the campaign " + campaign.string() +
+                        ": a run's files are its own; give a path outside it");
+}
+
 void check_output_file(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
@@ -345,6 +380,7 @@ void check_output_file(const std::string& path, const std::string& option) {
         throw UserError(named + ": the folder " + folder.string() + " is not writable");
     if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) throw UserError(named + " is not writable");
     check_replaceable(path, named);
+    refuse_campaign_files(path, named);
 }
 
 namespace {

@@ -58,6 +58,10 @@ void check_argument_lengths(int argc, const char* const* argv);
 // Checks, before any work starts, that `path` can be written as an output file: not a folder, its folder exists and
 // is writable (and the file itself, when it exists). Throws UserError naming `option`, the path and the rule.
 void check_output_file(const std::string& path, const std::string& option);
+// Refuses (UserError naming `option`) an output in a run folder of a campaign (DIR/runs/NAME/ beside
+// DIR/campaign.sqlite or DIR/campaign.json): `scale -o DIR/runs/ID/result.json` replaced a stored run's result.
+// Not for the runs' own outputs (shear-run's result.json, a silo run's files), which live there.
+void check_output_outside_run_folders(const std::string& path, const std::string& option);
 
 // Checks, before any work starts, that `path` can be used as an output folder: not a file, and files can be created
 // in it (when it exists) or in the nearest existing folder above it (where it will be created). The check creates

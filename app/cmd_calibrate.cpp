@@ -397,8 +397,20 @@ void print_calibration_summary(const CalibrateCli& o, const CalibrationResult& r
 
 void run_calibrate(CalibrateCli& o) {
     const auto& camp = o.study.campaign;
-    if (!o.output.empty()) check_output_file(o.output, "--output");  // before hours of calibration, not after
-    check_paths_apart({{o.start_file, "--start"}, {o.sensitivity_file, "--sensitivity"}}, {{o.output, "--output"}});
+    if (!o.output.empty()) {  // before hours of calibration, not after
+        check_output_file(o.output, "--output");
+        check_output_outside_run_folders(o.output, "--output");
+    }
+    // nor on one of the reports this calibration writes into its campaign folder (its history was replaced)
+    const fs::path reports = camp.campaign_dir;
+    std::vector<NamedPath> outputs{
+        {o.output, "--output"},
+        {(reports / ("calibration_" + o.method + ".json")).string(), "the calibration's report"},
+        {(reports / ("calibration_log_" + o.method + ".jsonl")).string(), "the calibration's log"}};
+    if (o.sensitivity_file.empty())  // the study is run, and written, here
+        outputs.insert(outputs.end(), {{(reports / "sensitivity.json").string(), "the study's report"},
+                                       {(reports / "sensitivity_table.txt").string(), "the study's table"}});
+    check_paths_apart({{o.start_file, "--start"}, {o.sensitivity_file, "--sensitivity"}}, outputs);
     const auto start = orchestrator::validate_material(read_json_file(o.start_file, "start"), o.start_file);
     const auto targets = targets_of(o);
     const auto bounds = parse_ranges(o.bounds, "--bounds");
@@ -483,6 +495,7 @@ void check_enlarge_outputs(const EnlargeCli& o) {
     if (fs::path(o.output).extension() != ".json")  // the plot and its data take the same name
         throw UserError("--output = '" + o.output + "': must end in .json");
     check_output_file(o.output, "output");
+    check_output_outside_run_folders(o.output, "--output");
     std::vector<NamedPath> inputs;
     for (const auto& file : o.materials) inputs.push_back({file, "material"});
     std::vector<NamedPath> outputs = {{o.output, "output"}};

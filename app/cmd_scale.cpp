@@ -64,6 +64,7 @@ void check_scale(const nlohmann::json& base, const ScaleCli& o, const calibratio
         if (fs::path(o.output).extension() != ".json")  // the table and plots take the same stem
             throw UserError("--output = '" + o.output + "': must end in .json");
         check_output_file(o.output, "--output");
+        check_output_outside_run_folders(o.output, "--output");
     }
     check_paths_apart({{o.base_file, "base material"}}, {{output_of(o).string(), "--output"}});
     calibration::check_enlargement(base, options);

@@ -364,6 +364,9 @@ TEST_CASE("an output on an input's path or on another output's is refused before
     const std::string residuals = copy("examples/diagnose/oldal_clean.csv", "r_residuals.dat");
     const std::string m1_dat = copy("examples/materials/sand-tiny.json", "e.dat");
     std::ofstream(dir / "p.json") << tiny_run_params().dump();
+    fs::create_directories(dir / "store" / "runs" / "abc");  // a campaign: its store (a real SQLite file) and a run
+    std::ofstream(dir / "store" / "campaign.sqlite", std::ios::binary) << std::string("SQLite format 3\0", 16);
+    fs::copy_file(dir / "store" / "campaign.sqlite", dir / "store" / "renamed.db");
     const std::vector<std::string> silo{"silo", "--theta", "30", "--particles", "50", "--out", out, "--check"};
     const auto with = [&](std::vector<std::string> extra) {
         std::vector<std::string> a = silo;
@@ -378,6 +381,19 @@ TEST_CASE("an output on an input's path or on another output's is refused before
              {with({"--export-final-bed", out}), {"--export-final-bed", "is also --out"}},
              {with({"--export-bed", same, "--export-final-bed", same}), {"--export-final-bed", "is also --export-bed"}},
              {with({"--export-final-bed", out + "/summary.json"}), {"--export-final-bed", "summary.json in the --out folder is the run's own"}},
+             // a campaign's own files (probe 59: calibrate -o replaced a store with a material's JSON)
+             {{"calibrate", "--start", m1, "--target", "mu_b=0.6", "--engine", "kernel", "-c", (dir / "cal").string(),
+               "-o", (dir / "store" / "campaign.sqlite").string()},
+              {"--output = ", "is a campaign store's file name"}},
+             {{"calibrate", "--start", m1, "--target", "mu_b=0.6", "--engine", "kernel", "-c", (dir / "cal").string(),
+               "-o", (dir / "store" / "renamed.db").string()},
+              {"--output = ", "is an SQLite database"}},
+             {{"calibrate", "--start", m1, "--target", "mu_b=0.6", "--engine", "kernel", "-c", (dir / "store").string(),
+               "-o", (dir / "store" / "calibration_surrogate.json").string()},
+              {"the calibration's report = ", "is also --output"}},
+             {{"scale", m1, "--radii", "1e-3,2e-3,3e-3", "--engine", "kernel", "--dir", (dir / "scale").string(), "-o",
+               (dir / "store" / "runs" / "abc" / "result.json").string()},
+              {"--output = ", "lies in the run folder"}},
              // a temporary file or the lock of the run (probe 59b: the bed was removed by the run, exit 0)
              {with({"--export-bed", out + "/checkpoint.bin.tmp"}),
               {"--export-bed", "checkpoint.bin.tmp in the --out folder is the run's own"}},
