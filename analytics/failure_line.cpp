@@ -20,6 +20,14 @@ double t_quantile(double confidence, int dof) { return gsl_cdf_tdist_Pinv(0.5 + 
 
 void check_failure_line_design(std::span<const double> normal_stresses, int replicates) {
     const std::set<double> distinct(normal_stresses.begin(), normal_stresses.end());
+    // a stress given twice was one set of runs (a run is its stress and seed), announced as two
+    if (distinct.size() < normal_stresses.size())
+        for (std::size_t i = 0; i < normal_stresses.size(); ++i)
+            for (std::size_t k = 0; k < i; ++k)
+                if (normal_stresses[k] == normal_stresses[i])
+                    throw std::invalid_argument("normal-stress: " + number_text(normal_stresses[i]) +
+                                                " Pa is given twice: one stress runs once per replicate (for more "
+                                                "packings at a stress use --replicates)");
     if (distinct.size() < 2)
         throw std::invalid_argument("normal-stress: a failure line needs at least 2 distinct normal stresses, got " +
                                     std::to_string(distinct.size()));

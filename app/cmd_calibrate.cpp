@@ -429,7 +429,12 @@ void run_calibrate(CalibrateCli& o) {
         study = run_study(start, o.study, session.evaluate);
         write_study(dir, study, camp.plot_format);
         std::cout << "\n" << study.table() << std::endl;
-        controls = pick_controls(o, study, targets, bounds);
+        try {
+            controls = pick_controls(o, study, targets, bounds);
+        } catch (const std::invalid_argument& e) {  // the study's finding, after its runs: not bad input (exit 1)
+            throw std::runtime_error(std::string(e.what()) + "; the study is kept: " +
+                                     (dir / "sensitivity.json").string());
+        }
     }
     print_calibration_plan(o, targets, controls);
 

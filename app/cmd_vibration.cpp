@@ -97,6 +97,12 @@ json campaign_settings(const VibrationCli& o) {
 
 void check_options(const VibrationCli& o) {
     refuse_owned_silo_options(o.silo_args, kOwnedSiloOptions, "demcal vibration");
+    // it delays the vibrating cells' shaking (silo_plan): with none it does nothing
+    const bool any_vibrating = std::any_of(o.frequencies.begin(), o.frequencies.end(), [](double f) { return f > 0; });
+    for (const std::string& a : o.silo_args)
+        if (!any_vibrating && (a == "--vibration-start" || a.rfind("--vibration-start=", 0) == 0))
+            throw UserError("silo option --vibration-start after -- delays the vibrating cells' shaking, and every "
+                            "--frequency is 0");
     // before each cell's settings are checked (a subprocess each): a typo's millions of cells end here
     try {
         orchestrator::check_run_count(double(o.thetas.size()) * double(o.frequencies.size()) * o.repeats, o.max_runs,

@@ -253,6 +253,23 @@ void check_run_count(double runs, long max_runs, const std::string& breakdown) {
                                     " (raise it with --max-runs if that many are meant)");
 }
 
+namespace {
+// A --template is a YADE script that runs as the stock one: `yade -x SCRIPT params.json result.json` (its arguments,
+// or those names). Any file was taken: a JSON file given by mistake started every run, and each failed after YADE's
+// start-up. Refused here: a file with a NUL byte (not a script), and one that never names its arguments (sys.argv) nor
+// result.json (the file the orchestrator reads).
+void check_shear_template_text(const fs::path& file) {
+    const std::string text = read_text_file(file);
+    const std::string named = "template = '" + analytics::shortened_text(file.string(), 200) + "'";
+    if (text.find('\0') != std::string::npos)
+        throw std::invalid_argument(named + " holds a NUL byte: not a YADE (Python) script");
+    if (text.find("sys.argv") == std::string::npos && text.find("result.json") == std::string::npos)
+        throw std::invalid_argument(named + " names neither sys.argv nor result.json: a shear box script reads "
+                                    "params.json and writes result.json, its two arguments (see "
+                                    "yade_scripts/shear_box.py)");
+}
+}  // namespace
+
 void validate_shear_spec(const ShearCampaignSpec& spec) {
     if (spec.normal_stresses.empty()) throw std::invalid_argument("normal_stress: at least one normal stress is needed");
     for (double s : spec.normal_stresses)
@@ -274,6 +291,8 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
         yade_script("shear_box.py");
     else if (!fs::is_regular_file(spec.template_path))
         throw std::invalid_argument("template = '" + spec.template_path.string() + "' is not a file");
+    else
+        check_shear_template_text(spec.template_path);
     yade_script(kWrapperName);
 }
 
