@@ -479,7 +479,7 @@ std::string separation_advice(const DemRivalSeparation& sep, const SiloMeasureme
 // The statistics of the conditions, once the data are known to be diagnosable: 3 conditions at least (the
 // cross-validation leaves one out and refits one parameter), repeats (the noise scale is their scatter), and a
 // declared material that discharges wherever the data have a rate.
-ConditionStats diagnosable_stats(const SiloMeasurements& data, const std::vector<double>& rates_declared) {
+ConditionStats checked_condition_stats(const SiloMeasurements& data) {
     const std::size_t C = data.conditions.size();
     if (C < 3)
         throw std::invalid_argument(data.source + ": " + std::to_string(C) +
@@ -489,6 +489,12 @@ ConditionStats diagnosable_stats(const SiloMeasurements& data, const std::vector
     if (s.df_pure_error < 1 || !(s.s2 > 0))
         throw std::invalid_argument(data.source + ": no repeats (rows of one condition with different rates): the noise "
                                     "scale is the measured repeat scatter; give repeats of at least one condition");
+    return s;
+}
+
+ConditionStats diagnosable_stats(const SiloMeasurements& data, const std::vector<double>& rates_declared) {
+    const std::size_t C = data.conditions.size();
+    ConditionStats s = checked_condition_stats(data);
     if (rates_declared.size() != C) throw std::logic_error("diagnose_dem: one declared rate per condition");
     for (std::size_t k = 0; k < rates_declared.size(); ++k)
         if (!(rates_declared[k] > 0))
@@ -877,5 +883,7 @@ nlohmann::json DemDiagnosis::to_json(const SiloMeasurements& data) const {
             {"conditions", condition_rows},
             {"warnings", warnings}};
 }
+
+void check_diagnosable_data(const SiloMeasurements& data) { checked_condition_stats(data); }
 
 }  // namespace demcal::analytics

@@ -162,4 +162,9 @@ std::vector<double> candidate_grid(const DemEffectCandidate& c, int points);
 // A value as it is run: 4 significant digits, so that a cache key (the material) is stable across proposals.
 double run_value(double value);
 
+// The data's own conditions for a diagnosis, before any run: at least 3 conditions (the cross-validation leaves one
+// out) and repeats of one at least with different rates (the noise scale). Throws std::invalid_argument naming the
+// file.
+void check_diagnosable_data(const SiloMeasurements& data);
+
 }  // namespace demcal::analytics

@@ -71,6 +71,9 @@ struct SensitivityCli {
     CampaignCli campaign;
 };
 
+// The fewest levels AICc can rank the response shapes with (n > k + 1 for the parabola's k = 4).
+constexpr int kMinLevelsForAicc = 6;
+
 SensitivityOptions sensitivity_options(const SensitivityCli& o) {
     SensitivityOptions s;
     s.params = o.params;
@@ -87,6 +90,13 @@ SensitivityOptions sensitivity_options(const SensitivityCli& o) {
                 throw UserError("--range " + name + "=...: " + name + " is not among --params; add it there or drop "
                                 "the range");
     s.shape.criterion = analytics::shape_criterion_from_string(o.criterion);
+    // AICc needs more points than a model's parameters + 2 (the parabola: 3 coefficients and the scale): with fewer
+    // the line's and the parabola's AICc are undefined and every response came out "constant"
+    if (s.shape.criterion == analytics::ShapeCriterion::aicc && o.levels < kMinLevelsForAicc)
+        throw UserError("--criterion aicc with --levels " + std::to_string(o.levels) + ": AICc tells the parabola from " +
+                        std::to_string(kMinLevelsForAicc) + " levels on (with fewer every response is called "
+                        "constant); give --levels " + std::to_string(kMinLevelsForAicc) + " or more, or --criterion "
+                        "f-test");
     s.shape.alpha = o.alpha;
     s.line = line_kind_from_string(o.campaign.line);
     return s;

@@ -414,6 +414,13 @@ int run_diagnose(const DiagnoseArgs& a) {
 
 // The model decides the run: silo-dem (kernel runs), or an analytical model; the options of the other refused.
 void run_diagnose_command(const DiagnoseArgs& args, const CLI::App& diagnose) {
+    const auto& analytical = analytics::diagnose_models();
+    if (args.model != "silo-dem" && std::find(analytical.begin(), analytical.end(), args.model) == analytical.end()) {
+        std::string known;
+        for (const auto& m : analytical) known += m + ", ";
+        throw UserError("--model = '" + analytics::shortened_text(args.model, 60) + "' is unknown; expected one of " +
+                        known + "silo-dem");
+    }
     if (args.model == "silo-dem") {
         for (const char* option : kAnalyticalOnlyOptions)
             if (diagnose.count(option))
@@ -431,6 +438,12 @@ void run_diagnose_command(const DiagnoseArgs& args, const CLI::App& diagnose) {
     for (const char* option : kSiloDemOptions)
         if (diagnose.count(option))
             throw UserError(std::string(option) + ": only --model silo-dem takes it (model '" + args.model + "')");
+    // the flow mode (mass / funnel) is the silo models' regime: a shear test has none, and the angles did nothing
+    if (args.model == "failure-line")
+        for (const char* option : {"--effective-friction-deg", "--wall-friction-deg"})
+            if (diagnose.count(option))
+                throw UserError(std::string(option) + ": the silo models' flow mode takes it; --model failure-line "
+                                "(a shear test) has no flow mode");
     if (!args.silo_dem.silo_args.empty())
         throw UserError("options after -- ('" + args.silo_dem.silo_args.front() +
                         "'): only --model silo-dem runs demcal silo");

@@ -354,6 +354,11 @@ SiloDemInputs read_silo_dem_inputs(const SiloDemArgs& a) {
                         std::to_string(data.conditions.size()) +
                         " conditions: silo-dem needs at least 3 conditions (leave-one-out) and repeats of one at least "
                         "(the noise scale)");
+    try {  // before any run: the repeats' scatter was found missing after the kernel had run (a campaign written)
+        an::check_diagnosable_data(data);
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
     in.declared = read_json_file(a.material, "--material");
     const auto defects = an::candidate_table_defects(an::dem_effect_candidates());
     if (!defects.empty()) throw std::logic_error("the DEM candidate table: " + defects.front());

@@ -143,6 +143,7 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
     fs::create_directories(dir / "folder");  // (tests run as root: a folder's permissions would not stop a write)
     std::ofstream(dir / "m.csv") << "theta_deg,rate_g_s\n30,160\n30,162\n50,120\n70,100\n";
     std::ofstream(dir / "few.csv") << "theta_deg,rate_g_s\n30,160\n30,162\n50,120\n";
+    std::ofstream(dir / "same.csv") << "theta_deg,rate_g_s\n30,160\n30,160\n50,120\n70,100\n";
     const std::string data = " --data '" + (dir / "m.csv").string() + "'";
     const std::string campaign = " --campaign '" + (dir / "never").string() + "'";
     const std::string material = " --material '" + kDeclared + "'";
@@ -161,6 +162,14 @@ TEST_CASE("diagnose silo-dem: bad input and unwritable outputs exit 2 before any
         {"--model silo-dem" + data + campaign + material + " -- " + kTinySilo + " --stop-fraction 7", "--stop-fraction = 7"},
         {"--model silo-dem --data '" + (dir / "few.csv").string() + "'" + campaign + material + " -- " + kTinySilo,
          "at least 3 conditions"},
+        // repeats without scatter: found after the kernel had run, a campaign written (probe 59b)
+        {"--model silo-dem --data '" + (dir / "same.csv").string() + "'" + campaign + material + " -- " + kTinySilo,
+         "no repeats (rows of one condition with different rates)"},
+        // the flow mode's angles on a shear test did nothing (probe 59b)
+        {"--model failure-line --data '" + std::string(DEMCAL_SOURCE_DIR) +
+             "/examples/diagnose/shear_curved.csv' --effective-friction-deg 40",
+         "--effective-friction-deg: the silo models' flow mode takes it"},
+        {"--model BEVERLOO" + data, "expected one of beverloo, johanson, oldal, oldal-rect, failure-line, silo-dem"},
         {"--model silo-dem" + data + campaign + " --material '" + (dir / "m.csv").string() + "' -- " + kTinySilo,
          "--material"},
         {"--model silo-dem" + data + campaign + material + " --candidates wall_friction,moisture -- " + kTinySilo,

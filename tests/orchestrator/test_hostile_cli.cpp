@@ -283,6 +283,9 @@ TEST_CASE("levels and replicates have their own caps, named, below the total --m
              // a design whose line cannot be fitted ran its runs first (crosscheck shear with one stress)
              {{"crosscheck", "shear", tiny, "-s", "5e3,5e3", "-r", "3", "--campaign", camp},
               {"normal-stress: 5000 Pa is given twice"}},
+             // every response "constant" by construction: AICc undefined at 3 levels (probe 59)
+             {{"sensitivity", tiny, "--engine", "kernel", "--criterion", "aicc", "--levels", "3", "--campaign", camp},
+              {"--criterion aicc with --levels 3", "from 6 levels on"}},
              // a JSON file as the YADE script: every run started and failed (probe 59)
              {{"shear", tiny, "-s", "5e3,1e4,1.5e4", "--template", tiny, "--campaign", camp},
               {"--template = ", "names neither sys.argv nor result.json"}},
