@@ -252,7 +252,18 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
             throw UserError("measured point '" + analytics::shortened_text(item) + "' is not of the form SIGMA:TAU (Pa)");
         }
     }
-    return targets_from_measured_line(sigma, tau);
+    auto targets = targets_from_measured_line(sigma, tau);  // (its own checks first: the points' values and spread)
+    // the simulated lines are compared with the measured one over the stresses they share: a line measured at
+    // 100-300 kPa was "reproduced" by boxes at 4-8 kPa, an extrapolation of both
+    const auto& stresses = o.study.campaign.normal_stresses;
+    const auto [m_lo, m_hi] = std::minmax_element(sigma.begin(), sigma.end());
+    const auto [c_lo, c_hi] = std::minmax_element(stresses.begin(), stresses.end());
+    if (!stresses.empty() && (*c_hi < *m_lo || *c_lo > *m_hi))
+        throw UserError("--normal-stress " + analytics::number_text(*c_lo) + " to " + analytics::number_text(*c_hi) +
+                        " Pa lies outside the --measured line's stresses (" + analytics::number_text(*m_lo) + " to " +
+                        analytics::number_text(*m_hi) + " Pa): simulate the failure lines over the measured "
+                        "stresses");
+    return targets;
 }
 
 using RangeMap = std::map<std::string, std::pair<double, double>>;  // NAME -> [low, high], from NAME=LOW:HIGH
@@ -492,7 +503,18 @@ void add_calibrate(CLI::App& app) {
     cmd->add_option("--span", o->study.span, "study: base * (1 -+ span)")->capture_default_str();
     cmd->add_option("--range", o->study.ranges, "study: explicit range NAME=LOW:HIGH");
     add_campaign_options(cmd, o->study.campaign);
-    cmd->callback([o] { run_calibrate(*o); });
+    cmd->callback([o, cmd] {
+        // a stored study is read, not run: its own options were ignored (probe 59)
+        if (!o->sensitivity_file.empty())
+            for (const char* option : {"--params", "--levels", "--span", "--range"})
+                if (cmd->count(option))
+                    throw UserError(std::string(option) + " sets the sensitivity study, and --sensitivity reads a "
+                                    "stored one instead of running it: leave it out, or run the study here (no "
+                                    "--sensitivity)");
+        if (o->sequential && o->measured.empty() && o->target.find(',') == std::string::npos)
+            throw UserError("--sequential orders two targets (slope first, then cohesion); --target has one");
+        run_calibrate(*o);
+    });
 }
 
 // ---- enlarge ----

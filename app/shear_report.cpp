@@ -40,6 +40,13 @@ void print_line(const char* title, const analytics::FailureLine& fl) {
               << std::setprecision(1) << "  tau_c = " << fl.tau_c << " +/- " << fl.se_tau_c << " Pa  (95% CI "
               << fl.tau_c_low << " .. " << fl.tau_c_high << "),  R^2 = " << std::setprecision(4) << fl.r_squared
               << ", n = " << fl.n << "\n";
+    // a friction coefficient is > 0: a slope below 0, or one whose interval holds 0, is the boxes' scatter, not a
+    // bulk property (sand-scale-tiny at 4-8 kPa printed mu_b = -0.0225, phi_b = -1.29 deg, without a word)
+    if (!(fl.mu_b_low > 0))
+        std::cout << "  warning: the slope is not determined: its 95 % interval " << std::setprecision(4)
+                  << fl.mu_b_low << " .. " << fl.mu_b_high
+                  << " holds 0 or lies below it (too few runs for the scatter between them: more "
+                     "replicates, stresses further apart, or a larger box)\n";
     if (fl.lack_of_fit)
         std::cout << "  lack of fit: F = " << std::setprecision(3) << fl.lack_of_fit->f_statistic << " ("
                   << fl.lack_of_fit->df_lack_of_fit << ", " << fl.lack_of_fit->df_pure_error

@@ -1319,6 +1319,16 @@ TEST_CASE("probe 57: calibration targets no bulk material has, and radii a law c
              {calibrate("--target", "mu_b=1e9"), {"target mu_b = 1e9", "below 85 deg"}},
              {calibrate("--target", "mu_b=0.55,"), {"'mu_b=0.55,' has an empty item"}},
              {calibrate("--measured", "5000:3000,10000:6000,15000:9e8"), {"the measured failure line's mu_b"}},
+             // probe 59: a line measured at 100-300 kPa "reproduced" by boxes at 2-6 kPa; a study's options beside a
+             // stored study; one target put in order
+             {calibrate("--measured", "1e5:8e4,2e5:1.5e5,3e5:2.2e5"),
+              {"--normal-stress 2000 to 6000 Pa lies outside the --measured line's stresses (100000 to 300000 Pa)"}},
+             {{"calibrate", "--start", tiny, "--engine", "kernel", "--target", "mu_b=0.6", "--sensitivity",
+               (dir / "s.json").string(), "--levels", "9", "-c", (dir / "c").string()},
+              {"--levels sets the sensitivity study, and --sensitivity reads a stored one"}},
+             {{"calibrate", "--start", tiny, "--engine", "kernel", "--target", "mu_b=0.6", "--sequential", "-c",
+               (dir / "c").string()},
+              {"--sequential orders two targets"}},
              {{"scale", tiny, "--radii", "1e-3,1.0000001e-3,1.0000002e-3", "-c", (dir / "c").string()},
               {"radii: 0.001 and 0.0010000001 m differ by less than 1 %"}}},
             dir);
