@@ -236,10 +236,27 @@ void print_campaign_status(const ShearCampaignOutcome& o, bool folder_held) {
 // holds no campaign.sqlite"
 void check_campaign_folder_argument(const std::string& dir, const std::string& command) {
     std::error_code ec;
+    const std::string named = command + ": DIR = '" + analytics::shortened_text(dir, 200) + "'";
     if (fs::is_regular_file(dir, ec))
-        throw UserError(command + ": DIR = '" + analytics::shortened_text(dir, 200) +
-                        "' is a file, not a campaign folder: give the folder that holds it (" +
+        throw UserError(named + " is a file, not a campaign folder: give the folder that holds it (" +
                         analytics::shortened_text(fs::path(dir).parent_path().string(), 200) + ")");
+    if (!fs::exists(dir, ec)) throw UserError(named + " does not exist");
+    const fs::path d(dir);
+    if (fs::exists(d / "campaign.sqlite", ec) || fs::exists(d / "campaign.json", ec)) return;
+    if (fs::exists(d / "checkpoint.bin", ec) || fs::exists(d / "summary.json", ec))
+        throw UserError(named + " is a demcal silo run's folder, not a campaign: `demcal silo --resume " +
+                        analytics::shortened_text(dir, 200) + "` continues a suspended run");
+    // a folder of campaigns (campaigns/, where cutoff puts its silo searches): name them
+    std::vector<std::string> inside;
+    for (fs::directory_iterator it(d, ec), end; !ec && it != end && inside.size() < 6; it.increment(ec))
+        if (fs::exists(it->path() / "campaign.sqlite") || fs::exists(it->path() / "campaign.json"))
+            inside.push_back(it->path().filename().string());
+    if (!inside.empty()) {
+        std::sort(inside.begin(), inside.end());
+        std::string list;
+        for (const auto& n : inside) list += (list.empty() ? "" : ", ") + n;
+        throw UserError(named + " holds no campaign itself; its folders " + list + " do: give one of them");
+    }
 }
 
 void print_status(const std::string& dir) {
