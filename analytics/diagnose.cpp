@@ -402,6 +402,15 @@ void report_fits(Setting& s, const Model& base, const SearchWithoutOutliers& fou
     if (const std::string why = unidentified_parameters(base, before.fit); !why.empty())
         result.undetermined.push_back("some parameters of " + result.model + " are not identifiable from these data (" +
                                       why + ")");
+    for (std::size_t i = 0; i < base.plausible.size() && i < before.fit.params.size(); ++i) {
+        const auto [low, high] = base.plausible[i];
+        const double v = before.fit.params[i];
+        if (!(v >= low && v <= high))
+            result.undetermined.push_back(result.model + "'s " + base.param_names[i] + " = " + short_number(v) +
+                                          " lies outside its physical range [" + short_number(low) + ", " +
+                                          short_number(high) + "]: the data are not of this model, or of another "
+                                          "unit (a rate in g/s under W_kg_s?)");
+    }
     result.params_before = estimates(base, before.fit);
     result.fitted_before = before.fitted;
     result.before = before.errors;

@@ -238,6 +238,8 @@ Model beverloo_model(const MeasuredData& d, Setting& s) {
     Model m;
     m.param_names = {"C", "k"};
     m.start = {0.58, 1.5};
+    // Nedderman's C 0.55-0.65 (0.5-0.7 over the literature) and k 1-3 (up to 2.9 for angular grains), widened
+    m.plausible = {{0.3, 1.0}, {0.5, 4.0}};
     m.base = [c](std::size_t r, const double* p) {  // an outlet the annulus fills: no rate to fit (beverloo_rate: 0)
         return c.outlet[r] - p[1] * c.dp[r] > 0 ? beverloo_rate(c.outlet[r], c.dp[r], c.rho[r], p[0], p[1]) : nan;
     };
@@ -286,6 +288,7 @@ Model johanson_model(const MeasuredData& d, Setting& s) {
     Model m;
     m.param_names = {"scale"};
     m.start = {1.0};
+    m.plausible = {{0.1, 10.0}};  // a factor on Johanson's own rate: beyond 10x the data are of another unit or model
     m.base = [&geometry, &outlet, &theta, &rho, depth](std::size_t r, const double* p) {
         return p[0] * (geometry[r] == "conical" ? johanson_conical_rate(outlet[r], theta[r], rho[r])
                                                 : johanson_wedge_rate(depth->values[r], outlet[r], theta[r], rho[r]));

@@ -42,6 +42,9 @@ struct Model {
     bool relative = true;  // residuals on log scale
     std::vector<std::string> param_names;
     std::vector<double> start;
+    // The base parameters' physical ranges [low, high], where the model has one (empty: none checked). A fitted value
+    // outside is no property of a bulk solid: a unit slip in the data (rates in g/s under W_kg_s gave C = 589).
+    std::vector<std::pair<double, double>> plausible;
     std::function<double(std::size_t row, const double* p)> base;
     std::vector<Term> terms;
 

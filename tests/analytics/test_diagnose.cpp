@@ -215,4 +215,23 @@ TEST_CASE("parameters the data cannot pin down are reported not determined, not 
     std::stringstream text;
     text << file.rdbuf();
     CHECK(diagnose(load(text.str()), "beverloo").to_json().at("determined") == true);
+    // the same rates in g/s under W_kg_s (probe 59b: C = 589 fitted, exit 0): C outside its physical range
+    std::string grams;
+    std::istringstream rows(text.str());
+    for (std::string line; std::getline(rows, line);) {
+        if (!line.empty() && line[0] != '#' && line.rfind("geometry", 0) != 0) {
+            std::vector<std::string> cells;
+            std::istringstream split(line);
+            for (std::string c; std::getline(split, c, ',');) cells.push_back(c);
+            cells[6] = std::to_string(1000 * std::stod(cells[6]));  // W_kg_s, the 7th column
+            line.clear();
+            for (const auto& c : cells) line += (line.empty() ? "" : ",") + c;
+        }
+        grams += line + "\n";
+    }
+    const auto r = diagnose(load(grams), "beverloo");
+    CHECK(r.to_json().at("determined") == false);
+    bool said = false;
+    for (const auto& w : r.undetermined) said = said || w.find("beverloo's C = ") != std::string::npos;
+    CHECK(said);
 }
