@@ -569,13 +569,31 @@ struct EnlargementPoints {
     std::vector<double> r, e, nu;
 };
 
-EnlargementPoints read_enlargement_points(const std::vector<std::string>& materials) {
+// The calibration status demcal calibrate wrote into a material's description ("calibrated by demcal calibrate
+// (not_converged): ..."); empty for a material it did not write.
+std::string calibration_status_of(const nlohmann::json& material) {
+    const std::string prefix = "calibrated by demcal calibrate (";
+    if (!material.contains("description") || !material["description"].is_string()) return "";
+    const std::string d = material["description"].get<std::string>();
+    if (d.rfind(prefix, 0) != 0) return "";
+    const auto end = d.find(')', prefix.size());
+    return end == std::string::npos ? "" : d.substr(prefix.size(), end - prefix.size());
+}
+
+EnlargementPoints read_enlargement_points(const std::vector<std::string>& materials, bool allow_unconverged) {
     EnlargementPoints p;
     std::map<double, std::string> file_of_radius;
     nlohmann::json first_rest;  // the first material without the fields the laws are about
     std::string first_file;
     for (const auto& file : materials) {
-        const auto m = orchestrator::validate_material(read_json_file(file, "material"), file);
+        const nlohmann::json given = read_json_file(file, "material");
+        const auto m = orchestrator::validate_material(given, file);  // (without its description)
+        // a calibration that did not reach its target gives no point of the law (laws were fitted to them, exit 0)
+        if (const std::string status = calibration_status_of(given);
+            !status.empty() && status != to_string(CalibrationStatus::converged) && !allow_unconverged)
+            throw UserError("materials: '" + analytics::shortened_text(file, 200) + "' was calibrated with status " +
+                            analytics::shortened_text(status, 40) + " (its description), not converged: its E and nu "
+                            "do not reproduce the reference line (--allow-unconverged takes it anyway)");
         nlohmann::json rest = m;
         for (const char* k : {"particle_radius", "young_modulus", "poisson_ratio", "name", "description"})
             rest.erase(k);
@@ -629,7 +647,7 @@ void print_enlargement(const analytics::ScalingLawFit& e_law, const analytics::S
 
 void run_enlarge(const EnlargeCli& o) {
     check_enlarge_outputs(o);
-    const EnlargementPoints p = read_enlargement_points(o.materials);
+    const EnlargementPoints p = read_enlargement_points(o.materials, o.allow_unconverged);
     const auto e_law = analytics::fit_linear_law(p.r, p.e);
     const auto nu_law = analytics::fit_power_law(p.r, p.nu);
     for (const auto* law : {&e_law, &nu_law})  // e.g. nu equal at every radius: D is not identifiable
@@ -658,7 +676,8 @@ void add_enlarge(CLI::App& app) {
     cmd->add_option("--plot", o->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
     cmd->add_flag("--no-plot", o->no_plot, "write no plot (no gnuplot needed)");
     cmd->add_flag("--allow-unconverged", o->allow_unconverged,
-                  "write the laws even when the power-law fit did not converge (exit 0)");
+                  "write the laws even when the power-law fit did not converge (exit 0), and take materials whose "
+                  "calibration did not converge");
     cmd->callback([o] { run_enlarge(*o); });
 }
 

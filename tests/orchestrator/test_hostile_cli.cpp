@@ -1379,3 +1379,26 @@ TEST_CASE("probe 57: another user's file in a sticky folder is refused as an out
     CHECK(test::read_file(sticky / "out.json") == "{}\n");
     fs::remove_all(root);
 }
+
+TEST_CASE("probe 59: enlarge refuses a material whose calibration did not converge, unless asked", "[cli]") {
+    // three calibrate outputs marked not_converged in their description gave E(r) and nu(r) laws with exit 0
+    const fs::path root = test::fresh_test_dir("hostile-enlarge-unconverged"), dir = root / "work";
+    fs::create_directories(dir);
+    auto material = nlohmann::json::parse(test::read_file(test::source_path("examples/materials/sand-tiny.json")));
+    std::vector<std::string> files;
+    for (int i = 0; i < 3; ++i) {
+        material["particle_radius"] = 1.0e-3 + 0.5e-3 * i;
+        material["young_modulus"] = 1e7 * (1 + i);
+        material["description"] = std::string("calibrated by demcal calibrate (") +
+                                  (i == 1 ? "not_converged" : "converged") + "): test";
+        files.push_back((root / ("m" + std::to_string(i) + ".json")).string());
+        std::ofstream(files.back()) << material.dump();
+    }
+    const std::string out = (dir / "e.json").string();
+    refused({{{"enlarge", files[0], files[1], files[2], "--no-plot", "-o", out},
+              {"m1.json' was calibrated with status not_converged", "--allow-unconverged"}}},
+            dir);
+    CHECK(test::run_demcal({"enlarge", files[0], files[1], files[2], "--no-plot", "-o", out, "--allow-unconverged"},
+                           root / "allowed.log") != 2);
+    fs::remove_all(root);
+}
