@@ -246,8 +246,9 @@ CLI::Validator number_in(double lo, double hi) {
 }
 
 CLI::Validator run_timeout() {
-    return number_check("a positive number of seconds up to " + analytics::number_text(kMaxRunTimeout),
-                        [](double v) { return v > 0 && v <= kMaxRunTimeout; });
+    return number_check("a number of seconds from " + analytics::number_text(kMinRunTimeout) + " to " +
+                            analytics::number_text(kMaxRunTimeout),
+                        [](double v) { return v >= kMinRunTimeout && v <= kMaxRunTimeout; });
 }
 
 CLI::Validator positive_number() {

@@ -24,7 +24,10 @@ CLI::Validator integer_in(long long lo, long long hi);  // a whole integer, lo <
 // SLURM's --time, the longest limit in minutes as a long, overflowed. (A short one is allowed: its runs end as
 // timeouts, which a resume with a longer --timeout runs again.)
 inline constexpr double kMaxRunTimeout = 1e7;
-CLI::Validator run_timeout();  // 0 < x <= kMaxRunTimeout
+// and at least 1 s: 0.001 s killed every run in its start-up (YADE's alone takes seconds), and SLURM's limit is whole
+// minutes (a 0.5 s timeout became --time=1 there: the two executors read it differently).
+inline constexpr double kMinRunTimeout = 1;
+CLI::Validator run_timeout();  // kMinRunTimeout <= x <= kMaxRunTimeout
 
 // Adds to every option of `app` and its subcommands that takes a value a check refusing an empty one (CLI11 read
 // `--replicates ""` as 0), to every number option the number rule (analytics::number_defect) and to every integer

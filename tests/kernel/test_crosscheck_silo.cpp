@@ -87,7 +87,7 @@ TEST_CASE("crosscheck silo runs the kernel and YADE on one bed and reports both"
     CHECK_THAT(read_file(dir / "same.log"), Catch::Contains("the same material as --material"));
     // YADE killed at its timeout: nothing compared, and the report says so (it said "rates agree" and exit 1)
     const std::string timed_out = "crosscheck silo --theta 45 --particles 200 --stiffness-scale 1e-3 --max-time 1 "
-                                  "--timeout 0.5 --jobs 1 -c '" + (dir / "t").string() + "'";
+                                  "--timeout 1 --jobs 1 -c '" + (dir / "t").string() + "'";
     CHECK(run_demcal(timed_out, dir / "timeout.log") == 1);
     CHECK_THAT(read_file(dir / "timeout.log"), Catch::Contains("retry later theta_45 yade"));
     const auto none = nlohmann::json::parse(read_file(dir / "t" / "crosscheck_silo.json"));

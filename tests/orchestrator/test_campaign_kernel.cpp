@@ -85,8 +85,10 @@ TEST_CASE("runs that timed out are tried again by resume (a longer --timeout), r
     // a timeout was stored as a final failure: `resume --timeout 100` ran nothing and ended "3 failed", exit 1
     const fs::path dir = test::fresh_test_dir("kernel-campaign-timeout");
     const std::string camp = (dir / "c").string();
-    CHECK(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "--jobs", "2", "--timeout",
-                            "0.001", "--retries", "0", "--campaign", camp},
+    // sand.json's runs take several seconds: the shortest --timeout (1 s) stops them all
+    const std::string sand = test::source_path("examples/materials/sand.json").string();
+    CHECK(test::run_demcal({"shear", sand, "-s", "3e3,5e3,7e3", "--engine", "kernel", "--jobs", "2", "--timeout",
+                            "1", "--retries", "0", "--campaign", camp},
                            dir / "first.log") == 1);
     for (const auto& r : test::stored_runs(camp)) {
         CHECK(r.state == RunState::failed);

@@ -38,8 +38,9 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", ""}, "--levels: an empty value"},
         {{"shear", tiny, "-s", "5e3", "--timeout", "1e-320"}, "--timeout: '1e-320' is subnormal"},
         // 1e99 s passed, and a SLURM campaign's --time in minutes overflowed a long
-        {{"shear", tiny, "-s", "5e3", "--timeout", "1e99"}, "--timeout: 1e99 is not a positive number of seconds up to 1e+07"},
-        {{"crosscheck", "silo", "--theta", "30", "--timeout", "2e7"}, "--timeout: 2e7 is not a positive number of seconds"},
+        {{"shear", tiny, "-s", "5e3", "--timeout", "1e99"}, "--timeout: 1e99 is not a number of seconds from 1 to 1e+07"},
+        {{"shear", tiny, "-s", "5e3", "--timeout", "0.001"}, "--timeout: 0.001 is not a number of seconds from 1 to"},
+        {{"crosscheck", "silo", "--theta", "30", "--timeout", "2e7"}, "--timeout: 2e7 is not a number of seconds from 1 to"},
         {{"shear", tiny, "-s", "5e3,1e-320"}, "--normal-stress: '1e-320' is subnormal"},
         {{"shear", tiny, "-s", "5e3", "--seed", "9223372036854775808"},
          "--seed: '9223372036854775808' is not an integer between 0 and 2147483647"},
