@@ -240,7 +240,9 @@ void check_campaign_folder_argument(const std::string& dir, const std::string& c
     if (fs::is_regular_file(dir, ec))
         throw UserError(named + " is a file, not a campaign folder: give the folder that holds it (" +
                         analytics::shortened_text(fs::path(dir).parent_path().string(), 200) + ")");
-    if (!fs::exists(dir, ec)) throw UserError(named + " does not exist");
+    const bool there = fs::exists(dir, ec);
+    if (ec) return;  // a path the file system will not take (a link loop): named with its reason further on
+    if (!there) throw UserError(named + " does not exist");
     const fs::path d(dir);
     if (fs::exists(d / "campaign.sqlite", ec) || fs::exists(d / "campaign.json", ec)) return;
     if (fs::exists(d / "checkpoint.bin", ec) || fs::exists(d / "summary.json", ec))
