@@ -410,7 +410,8 @@ void record_run_end(const fs::path& rd, const std::string& name, int rc, bool st
 }
 
 // The runs left as SLURM array tasks (orchestrator::SlurmExecutor: sbatch, squeue, the tasks' exit_status files).
-void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& todo, std::size_t total,
+void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& todo,
+                  const std::map<const SiloRunPlan*, json>& identities, std::size_t total,
                   int jobs, const std::string& command, const SiloCampaignExecutor& where,
                   SiloCampaignOutcome& outcome) {
     std::error_code ec;
@@ -421,7 +422,7 @@ void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& to
     for (const SiloRunPlan* plan : todo) {
         const fs::path rd = dir / "runs" / plan->name;
         const bool resume = fs::exists(rd / "checkpoint.bin");
-        record_run_identity(rd, silo_run_identity(*plan));
+        record_run_identity(rd, identities.at(plan));
         std::vector<std::string> argv{program};
         const auto args = resume ? resume_command(*plan, rd) : fresh_command(*plan, rd, false);
         argv.insert(argv.end(), args.begin(), args.end());
@@ -462,9 +463,10 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
     }
     SiloCampaignOutcome outcome;
     std::vector<const SiloRunPlan*> todo;
+    std::map<const SiloRunPlan*, json> identities;
     for (const SiloRunPlan& plan : plans) {
         const fs::path rd = dir / "runs" / plan.name;
-        const json identity = silo_run_identity(plan);
+        const json& identity = identities[&plan] = silo_run_identity(plan);  // (input files read once per plan)
         check_run_folder_identity(rd, identity, command);  // before its summary is read or its checkpoint resumed
         if (fs::exists(rd)) record_run_identity(rd, identity);  // a run of a demcal before run.json: adopted
         if (fs::exists(rd / "summary.json"))
@@ -475,7 +477,7 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
             todo.push_back(&plan);
     }
     if (where.executor == "slurm") {
-        run_on_slurm(dir, todo, plans.size(), jobs, command, where, outcome);
+        run_on_slurm(dir, todo, identities, plans.size(), jobs, command, where, outcome);
         return outcome;
     }
     if (where.executor != "local")
@@ -490,7 +492,7 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
             const SiloRunPlan& plan = *todo[next++];
             const fs::path rd = dir / "runs" / plan.name;
             const bool resume = fs::exists(rd / "checkpoint.bin");
-            record_run_identity(rd, silo_run_identity(plan));
+            record_run_identity(rd, identities.at(&plan));
             std::cout << "[" << outcome.finished + outcome.failed + running.size() + 1 << "/" << plans.size() << "] "
                       << plan.name << (resume ? " (resumed)" : "") << std::endl;
             running[spawn_demcal(resume ? resume_command(plan, rd) : fresh_command(plan, rd, false),
