@@ -558,6 +558,17 @@ void CampaignStore::set_campaign_status(std::int64_t campaign_id, CampaignStatus
     });
 }
 
+std::optional<std::string> CampaignStore::setting(const std::string& key) {
+    Statement q(db_, "SELECT value FROM meta WHERE key = ?");
+    q.bind(1, key);
+    if (!q.step()) return std::nullopt;
+    return q.text(0);
+}
+
+void CampaignStore::set_setting_once(const std::string& key, const std::string& value) {
+    in_transaction(db_, [&] { Statement(db_, "INSERT OR IGNORE INTO meta VALUES(?, ?)").bind(1, key).bind(2, value).step(); });
+}
+
 RunRecord CampaignStore::ensure_run(std::int64_t campaign_id, const std::string& hash, const nlohmann::json& params,
                                     const std::filesystem::path& run_dir, const nlohmann::json& label) {
     in_transaction(db_, [&] {

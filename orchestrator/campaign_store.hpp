@@ -83,6 +83,12 @@ public:
     std::vector<CampaignRecord> campaigns();
     void set_campaign_status(std::int64_t campaign_id, CampaignStatus status);
 
+    // A store-wide setting (table meta), e.g. the simulator build whose results the store holds; nullopt if unset.
+    std::optional<std::string> setting(const std::string& key);
+    // Sets it unless it is already set (the first writer wins: two processes record the same value, or the second
+    // learns the first one's on its next read).
+    void set_setting_once(const std::string& key, const std::string& value);
+
     // Registers a run (new identity: pending) and links it to the campaign with its label. Returns the stored record.
     RunRecord ensure_run(std::int64_t campaign_id, const std::string& hash, const nlohmann::json& params,
                          const std::filesystem::path& run_dir, const nlohmann::json& label);

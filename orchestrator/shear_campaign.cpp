@@ -13,6 +13,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <deque>
+#include <fstream>
+#include <regex>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -85,12 +87,38 @@ bool is_executable_file(const fs::path& p) {
     std::error_code ec;
     return fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0;
 }
+
+// The significant decimal digits of the real numbers of the YADE build `launcher` starts, as YADE's generated launcher
+// writes them ("mpmath.mp.dps=(int(18)+1)" in the long-double build's); 0 when the launcher does not say (a wrapper).
+int yade_launcher_digits(const fs::path& launcher) {
+    std::ifstream in(launcher);
+    std::string line;
+    const std::regex dps(R"(^\s*mpmath\.mp\.dps\s*=\s*\(\s*int\(\s*(\d{1,6})\s*\)\s*\+\s*1\s*\)\s*$)");
+    for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+        std::smatch m;
+        if (std::regex_match(line, m, dps)) return std::stoi(m[1].str());
+    }
+    return 0;
+}
+
+// demcal's YADE scripts write their results with Python's json, which takes the double build's floats only: a
+// higher-precision build ran every run to its end and then failed to write its result.
+fs::path checked_yade_build(const fs::path& launcher, const std::string& given) {
+    constexpr int kDoubleDigits = 15;
+    const int digits = yade_launcher_digits(launcher);
+    if (digits > kDoubleDigits)
+        throw std::invalid_argument("yade = '" + given + "' is a YADE build of " + std::to_string(digits) +
+                                    "-digit reals (long double, float128 or MPFR): demcal's YADE scripts need the "
+                                    "double build (15 digits; Debian's /usr/bin/yade-double)");
+    return launcher;
+}
+
 }  // namespace
 
 fs::path find_yade(const std::string& yade) {
     if (yade.empty()) throw std::invalid_argument("yade = '': empty; give the YADE launcher's name or path");
     if (yade.find('/') != std::string::npos) {
-        if (is_executable_file(yade)) return fs::absolute(yade);  // runs start in their own folders
+        if (is_executable_file(yade)) return checked_yade_build(fs::absolute(yade), yade);  // runs start in their own folders
         std::error_code ec;
         const std::string why = !fs::exists(yade, ec)        ? "does not exist"
                                 : fs::is_directory(yade, ec) ? "is a folder, not a program"
@@ -103,7 +131,7 @@ fs::path find_yade(const std::string& yade) {
             std::size_t b = p.find(':', a);
             if (b == std::string::npos) b = p.size();
             const fs::path cand = fs::path(p.substr(a, b - a)) / yade;
-            if (is_executable_file(cand)) return fs::absolute(cand);  // (an empty or "." entry of PATH)
+            if (is_executable_file(cand)) return checked_yade_build(fs::absolute(cand), yade);  // ("" or "." in PATH)
             a = b + 1;
         }
     }
@@ -161,7 +189,38 @@ struct EngineSetup {
     std::string wrapper_text;            // YADE: run_clean.py
     std::vector<std::string> command;    // to which the run's files are appended
     std::string started_marker;          // a file the run writes once the simulator has started (YADE), or none
+    std::string build;                   // YADE: the build its results come from (yade_build_of), recorded in the store
 };
+
+// The YADE build a store's results come from: the launcher's resolved path and the SHA-256 of its text, which names
+// the build's version, precision and features. Runs of two builds share identities (the script and the parameters),
+// so a second build would take the first one's results as its own: a store holds one build's results.
+constexpr const char* kYadeBuildSetting = "yade_build";
+
+std::string yade_build_of(const fs::path& launcher) {
+    std::error_code ec;
+    fs::path resolved = fs::weakly_canonical(launcher, ec);
+    if (ec) resolved = launcher;
+    return nlohmann::json{{"launcher", resolved.string()}, {"sha256", sha256_hex(read_text_file(launcher))}}.dump();
+}
+
+// Refuses `given` (the --yade value) when the store holds results of another build, before anything is written.
+void check_store_yade_build(CampaignStore& store, const std::string& build, const std::string& given) {
+    const auto recorded = store.setting(kYadeBuildSetting);
+    if (!recorded || *recorded == build) return;
+    std::string recorded_launcher = *recorded;
+    try {
+        recorded_launcher = nlohmann::json::parse(*recorded).at("launcher").get<std::string>();
+    } catch (const std::exception&) {
+    }
+    const std::string now_launcher = nlohmann::json::parse(build).at("launcher").get<std::string>();
+    throw std::invalid_argument(
+        "yade = '" + analytics::shortened_text(given) + "' (" + analytics::shortened_text(now_launcher) +
+        ") is another YADE build than the one this campaign folder's results came from (" +
+        analytics::shortened_text(recorded_launcher) +
+        (recorded_launcher == now_launcher ? ", since changed: another version or an edited launcher" : "") +
+        "): the two builds' results would be mixed. Pass --yade with that build, or use another campaign folder");
+}
 
 // The file yade_scripts/run_clean.py writes in the run's folder first thing, once YADE has started.
 constexpr const char* kYadeStartedMarker = "yade_started";
@@ -197,12 +256,14 @@ EngineSetup engine_setup(const ShearCampaignSpec& spec, const ExecutionOptions& 
     if (spec.engine == ShearEngine::kernel) {
         if (o.kernel_command.empty() || o.kernel_engine.empty())
             throw std::invalid_argument("engine = 'kernel': this program does not say how to run the kernel engine");
-        return {o.kernel_engine, "", o.kernel_command, ""};
+        return {o.kernel_engine, "", o.kernel_command, "", ""};
     }
+    const fs::path yade = find_yade(o.yade);
     return {read_text_file(spec.template_path),
             read_text_file(yade_script(kWrapperName)),
-            {find_yade(o.yade).string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py"},
-            kYadeStartedMarker};
+            {yade.string(), "-n", "-j1", "-x", kWrapperName, "shear_box.py"},
+            kYadeStartedMarker,
+            yade_build_of(yade)};
 }
 
 // The executors append to DIR/stdout.log and DIR/stderr.log and read the failure cause from stderr.log: an earlier
@@ -576,6 +637,7 @@ private:
         ++finished_here_;
         const AttemptVerdict v = judge_attempt(o, job.dir, by_hash_.at(job.id)->params, engine_.started_marker);
         if (v.cause.empty()) {
+            if (!engine_.build.empty()) store_.set_setting_once(kYadeBuildSetting, engine_.build);
             store_.mark_done(job.id, v.result, o.exit_code, o.wall_s, o.cpu_s);
             ++out_.executed;
             ++prog_.done;
@@ -641,6 +703,7 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     const ShearCampaignSpec spec = resolved(spec_in);
     EngineSetup engine = engine_setup(spec, options_);
     if (spec.engine == ShearEngine::kernel) engine.command[0] = pinned_program(engine.command[0], dir_ / ".kernel-engine");
+    if (!engine.build.empty()) check_store_yade_build(*store_, engine.build, options_.yade);
     const auto plan = plan_runs(spec, engine.identity_text, dir_);
 
     ShearCampaignOutcome out;

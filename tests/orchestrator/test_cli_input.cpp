@@ -207,10 +207,16 @@ TEST_CASE("a YADE path that is a folder, empty or not executable is refused befo
     const fs::path dir = test::fresh_test_dir("cli-bad-yade");
     const fs::path campaign = dir / "never";
     std::ofstream(dir / "not-executable") << "#!/bin/sh\n";
+    // YADE's generated launcher names its build's precision; a long-double build ran every run to its end and then
+    // failed to write the result
+    std::ofstream(dir / "yade-longdouble") << "#!/usr/bin/python3\nif(True==True):\n\timport mpmath\n"
+                                              "\tmpmath.mp.dps=(int(18)+1)\n";
+    fs::permissions(dir / "yade-longdouble", fs::perms::owner_all);
     const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
     const std::vector<std::pair<std::string, std::string>> cases{
         {dir.string(), "is a folder, not a program"}, {"", "--yade: an empty value"},
-        {(dir / "not-executable").string(), "is not executable"}, {(dir / "none").string(), "does not exist"}};
+        {(dir / "not-executable").string(), "is not executable"}, {(dir / "none").string(), "does not exist"},
+        {(dir / "yade-longdouble").string(), "is a YADE build of 18-digit reals"}};
     for (const auto& [yade, expect] : cases) {
         INFO(yade);
         CHECK(test::run_demcal({"shear", tiny, "-s", "5e3", "--yade", yade, "--campaign", campaign.string()},
@@ -218,6 +224,53 @@ TEST_CASE("a YADE path that is a folder, empty or not executable is refused befo
         CHECK_THAT(test::read_file(dir / "out.log"), Contains(expect));
         CHECK_FALSE(fs::exists(campaign));
     }
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a campaign folder holds one YADE build's results: another launcher is refused before anything is written",
+          "[cli][store]") {
+    const fs::path dir = test::fresh_test_dir("cli-yade-build");
+    const fs::path campaign = dir / "campaign";
+    const fs::path first = test::write_stand_in_yade(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "5e3,1e4,2e4", "--yade", first.string(), "--campaign",
+                              campaign.string(), "--jobs", "1"},
+                             dir / "first.log") == 0);
+    // the same runs (same script, same parameters) with another build: it would have reused the first one's results
+    fs::create_directories(dir / "other");
+    fs::copy_file(first, dir / "other" / "stand-in-yade");
+    std::ofstream(dir / "other" / "stand-in-yade", std::ios::app) << "# another build\n";
+    const auto stored = [&] {  // each run's identity and state, and the run folders
+        std::vector<std::string> seen;
+        for (const auto& r : test::stored_runs(campaign)) seen.push_back(r.hash + " " + orchestrator::to_string(r.state));
+        for (const auto& e : fs::directory_iterator(campaign / "runs")) seen.push_back(e.path().filename().string());
+        std::sort(seen.begin(), seen.end());
+        return seen;
+    };
+    const auto before = stored();
+    REQUIRE(before.size() == 6);
+    for (const auto& args : {std::vector<std::string>{"shear", tiny, "-s", "5e3,1e4,2e4,3e4", "--campaign",
+                                                      campaign.string(), "--jobs", "1"},
+                             std::vector<std::string>{"resume", campaign.string()}}) {
+        auto a = args;
+        a.insert(a.end(), {"--yade", (dir / "other" / "stand-in-yade").string()});
+        INFO(a[0]);
+        const int rc = test::run_demcal(a, dir / "other.log");
+        INFO(test::read_file(dir / "other.log"));
+        if (a[0] == "shear") {
+            CHECK(rc == 2);
+            CHECK_THAT(test::read_file(dir / "other.log"),
+                       Contains("is another YADE build than the one this campaign folder's results came from") &&
+                           Contains(first.string()) && Contains("--yade"));
+        } else {
+            CHECK(rc == 0);  // nothing to resume: the campaign is complete, so nothing of the other build runs
+        }
+        CHECK(stored() == before);
+    }
+    // the build the results came from extends the campaign
+    CHECK(test::run_demcal({"shear", tiny, "-s", "5e3,1e4,2e4,3e4", "--yade", first.string(), "--campaign",
+                            campaign.string(), "--jobs", "1"},
+                           dir / "again.log") == 0);
     fs::remove_all(dir);
 }
 
