@@ -161,7 +161,27 @@ constexpr OptionNeeds kOptionNeeds[] = {
     {"yade", "engine", "yade", "yade", "YADE's launcher"},
     {"grid-points", "method", "grid", "surrogate", "the grid's points per parameter"},
     {"sequential", "method", "surrogate", "surrogate", "the surrogate loop's order (slope, then cohesion)"},
+    {"alpha", "criterion", "f-test", "f-test", "the F tests' significance level"},
 };
+
+// An option that one value of another option makes void (the opposite of OptionNeeds).
+struct OptionVoidWith {
+    const char* option;
+    const char* other;
+    const char* value;
+    const char* what;  // what the option is
+    const char* why;   // why that value leaves it nothing to do
+};
+constexpr OptionVoidWith kOptionVoidWith[] = {
+    {"max-evaluations", "method", "grid", "the search's budget of failure lines",
+     "a grid evaluates all of its --grid-points per control"},
+};
+
+// `--option = 'value'`, or `--option` for a flag (which has no value to show).
+std::string given_text(const CLI::Option& opt, const char* name) {
+    if (opt.get_expected_max() == 0) return std::string("--") + name;
+    return std::string("--") + name + " = '" + analytics::shortened_text(opt.as<std::string>()) + "'";
+}
 
 // Two options of which the second makes the first void: given together, one was ignored (silo's --dt with
 // --dt-fraction recorded a fraction it did not run; --plot svg with --no-plot drew nothing).
@@ -203,12 +223,16 @@ void check_options_apply(const CLI::App& cmd) {
         if (!opt || !other || opt->count() == 0) continue;
         const std::string value = value_or_default(*other, rule.other_default);
         if (value == rule.value) continue;
-        const std::string given = opt->get_expected_max() == 0  // a flag has no value to show
-                                      ? std::string("--") + rule.option
-                                      : std::string("--") + rule.option + " = '" +
-                                            analytics::shortened_text(opt->as<std::string>()) + "'";
-        throw UserError(given + " is " + rule.what + ": it applies to --" + rule.other + " " + rule.value +
-                        " only (this command runs with --" + rule.other + " " + value + ")");
+        throw UserError(given_text(*opt, rule.option) + " is " + rule.what + ": it applies to --" + rule.other + " " +
+                        rule.value + " only (this command runs with --" + rule.other + " " + value + ")");
+    }
+    for (const OptionVoidWith& rule : kOptionVoidWith) {
+        const CLI::Option* opt = option_named(cmd, rule.option);
+        const CLI::Option* other = option_named(cmd, rule.other);
+        if (!opt || !other || opt->count() == 0 || other->count() == 0 || other->as<std::string>() != rule.value)
+            continue;
+        throw UserError(given_text(*opt, rule.option) + " is " + rule.what + ", void with --" + rule.other + " " +
+                        rule.value + ": " + rule.why + "; leave it out");
     }
     for (const ExclusiveOptions& pair : kExclusiveOptions) {
         const CLI::Option* opt = option_named(cmd, pair.option);

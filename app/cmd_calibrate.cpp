@@ -68,6 +68,7 @@ struct SensitivityCli {
     std::vector<std::string> ranges;
     std::string criterion = "f-test";
     double alpha = 0.05;
+    bool span_given = false;  // --span typed (it is void when every studied parameter has its --range)
     CampaignCli campaign;
 };
 
@@ -89,6 +90,12 @@ SensitivityOptions sensitivity_options(const SensitivityCli& o) {
             if (std::find(o.params.begin(), o.params.end(), name) == o.params.end())
                 throw UserError("--range " + name + "=...: " + name + " is not among --params; add it there or drop "
                                 "the range");
+    if (o.span_given) {
+        const auto studied = o.params.empty() ? orchestrator::micromechanical_param_names() : o.params;
+        if (std::all_of(studied.begin(), studied.end(), [&](const std::string& n) { return s.ranges.count(n) > 0; }))
+            throw UserError("--span = " + analytics::number_text(o.span) + " sets the range of a studied parameter "
+                            "without --range, and every one here has its --range; leave --span out");
+    }
     s.shape.criterion = analytics::shape_criterion_from_string(o.criterion);
     // AICc needs more points than a model's parameters + 2 (the parabola: 3 coefficients and the scale): with fewer
     // the line's and the parabola's AICc are undefined and every response came out "constant"
@@ -195,7 +202,8 @@ void add_sensitivity(CLI::App& app) {
     cmd->add_option("--criterion", o->criterion, "shape selection: f-test or aicc")->capture_default_str();
     cmd->add_option("--alpha", o->alpha, "significance level of the F tests")->capture_default_str();
     add_campaign_options(cmd, o->campaign);
-    cmd->callback([o] {
+    cmd->callback([o, cmd] {
+        o->span_given = cmd->count("--span") > 0;
         const auto base = orchestrator::validate_material(read_json_file(o->base_file, "base"), o->base_file);
         check_study(base, *o);  // option errors before any campaign
         CampaignSession session(o->campaign, "sensitivity");
@@ -286,10 +294,27 @@ void check_calibrate_options(CalibrateCli& o, const nlohmann::json& start, const
                              const RangeMap& bounds, const CalibrationOptions& options) {
     const auto& camp = o.study.campaign;
     check_calibration_options(options);
+    if (o.sequential && targets.size() < 2)
+        throw UserError("--sequential orders two targets (slope first, then cohesion); the calibration has one (" +
+                        targets.front().quantity + ")");
     if (!o.controls.empty() && o.controls.size() != targets.size())
         throw UserError("--controls: " + std::to_string(o.controls.size()) + " given for " +
                         std::to_string(targets.size()) + " targets");
-    for (const auto& [name, range] : bounds) check_control(start, {name, range.first, range.second});
+    for (const auto& [name, range] : bounds) {
+        // a bound acts on a searched parameter only: one on another parameter was ignored
+        // (a stored study's parameters are checked when it is read: pick_controls)
+        const auto searchable = !o.controls.empty()         ? o.controls
+                                : !o.study.params.empty()   ? o.study.params
+                                : o.sensitivity_file.empty() ? orchestrator::micromechanical_param_names()
+                                                             : std::vector<std::string>{};
+        if (!searchable.empty() && std::find(searchable.begin(), searchable.end(), name) == searchable.end())
+            throw UserError("--bounds " + name + "=...: " + name + " is not among " +
+                            (!o.controls.empty()         ? "--controls"
+                             : !o.study.params.empty()   ? "the studied --params"
+                                                         : "the micromechanical parameters the study varies") +
+                            ", and a bound acts on a searched parameter only; add it there or drop the bound");
+        check_control(start, {name, range.first, range.second});
+    }
     if (o.sensitivity_file.empty()) {
         if (o.study.params.empty() && !o.controls.empty()) {
             // the controls become the study's parameters: named as the option that gave them (a control given
@@ -313,7 +338,18 @@ void check_calibrate_options(CalibrateCli& o, const nlohmann::json& start, const
 // The controls given (their bounds from --bounds or the study's range), or those the study chooses.
 std::vector<ControlParameter> pick_controls(const CalibrateCli& o, const SensitivityStudy& study,
                                             const std::vector<MacroTarget>& targets, const RangeMap& bounds) {
-    if (o.controls.empty()) return choose_controls(study, targets, o.tol, {}, bounds);
+    if (o.controls.empty()) {
+        for (const auto& [name, range] : bounds)  // (with --params the names were checked before the study ran)
+            if (!study.find(name))
+                throw UserError("--bounds " + name + "=...: " + name + " is not a parameter of the sensitivity study, "
+                                "which chooses the controls among its own; drop the bound, or name --controls");
+        auto chosen = choose_controls(study, targets, o.tol, {}, bounds);
+        for (const auto& [name, range] : bounds)
+            if (std::none_of(chosen.begin(), chosen.end(), [&](const ControlParameter& c) { return c.name == name; }))
+                std::cerr << "demcal: warning: --bounds " << name << "=...: the study did not choose " << name
+                          << " as a control, so its bound is not used" << std::endl;
+        return chosen;
+    }
     std::vector<ControlParameter> picked;
     for (const auto& name : o.controls) {
         const auto* p = study.find(name);
@@ -511,8 +547,7 @@ void add_calibrate(CLI::App& app) {
                     throw UserError(std::string(option) + " sets the sensitivity study, and --sensitivity reads a "
                                     "stored one instead of running it: leave it out, or run the study here (no "
                                     "--sensitivity)");
-        if (o->sequential && o->measured.empty() && o->target.find(',') == std::string::npos)
-            throw UserError("--sequential orders two targets (slope first, then cohesion); --target has one");
+        o->study.span_given = cmd->count("--span") > 0;
         run_calibrate(*o);
     });
 }

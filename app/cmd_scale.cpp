@@ -11,6 +11,7 @@
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_params.hpp"
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 
@@ -148,9 +149,14 @@ void add_scale_command(CLI::App& app) {
     cmd->add_flag("--no-plot", o->no_plot, "write no plot (no gnuplot needed)");
     cmd->add_option("--output,-o", o->output, "result JSON (default CAMPAIGN/scale.json; table and plots beside it)");
     add_campaign_options(cmd, o->campaign);
-    cmd->callback([o] {
+    cmd->callback([o, cmd] {
         const auto base = orchestrator::validate_material(read_json_file(o->base_file, "base"), o->base_file);
         const auto options = enlargement_options(*o);
+        const auto& controls = calibration::enlargement_controls();
+        if (cmd->count("--span") &&
+            std::all_of(controls.begin(), controls.end(), [&](const std::string& n) { return options.study.ranges.count(n); }))
+            throw UserError("--span = " + analytics::number_text(o->span) + " sets the range of a control without "
+                            "--range, and both (young_modulus, poisson_ratio) have their --range; leave --span out");
         check_scale(base, *o, options);
         CampaignSession session(o->campaign, "scale");
         const auto print = [](const std::string& line) { std::cout << line << std::endl; };
