@@ -181,6 +181,37 @@ std::vector<MacroTarget> reference_targets(const analytics::FailureLine& referen
     return targets;
 }
 
+// Why the reference line cannot serve as the calibrations' target ("" when it can): a slope that is no bulk friction,
+// or (when its interval widens the acceptance) an interval on mu_b that holds 0, which every line falls inside: each
+// radius was then "converged" at its start, and E(r) fitted through calibrations that never moved (probe 59).
+std::string reference_cannot_be_a_target(const analytics::FailureLine& reference, const EnlargementOptions& o) {
+    const double mu = macro_value(reference, "mu_b"), half = macro_half_width(reference, "mu_b");
+    if (!(mu > 0)) return "mu_b = " + num(mu) + " is no bulk friction (noise at this box and these stresses)";
+    if (!o.point_targets && !(half < mu))
+        return "mu_b = " + num(mu) + " +/- " + num(half) + " (95 %): an interval that holds 0 accepts every line, so "
+               "no calibration to it means anything; add --replicates or normal stresses (or a larger box), or pass "
+               "--point-targets to aim at its values within --tol";
+    return "";
+}
+
+// A calibration accepted by an interval (the reference's or its own simulated one) rather than within the tolerance
+// of the reference's values: says how far off it is ("" when within the tolerance, or not converged).
+std::string accepted_off_tolerance(const RadiusCalibration& c, const std::vector<MacroTarget>& targets, double tol) {
+    if (!c.converged() || c.result.best < 0) return "";
+    const auto& it = c.result.iterations[static_cast<std::size_t>(c.result.best)];
+    if (it.accepted_by == "tolerance") return "";
+    std::ostringstream o;
+    o.precision(3);
+    o << "accepted within the " << it.accepted_by << ", not the tolerance:";
+    for (const auto& t : targets) {
+        const double v = t.quantity == "mu_b" ? it.mu_b : it.tau_c;
+        o << " " << t.quantity << " " << v << " against " << t.value;
+        if (t.value != 0) o << " (" << 100 * (v - t.value) / std::fabs(t.value) << " %)";
+    }
+    o << "; add --replicates or normal stresses, or pass --strict --point-targets";
+    return o.str();
+}
+
 // Whether the base material at this radius already restores the reference line: the loop's own acceptance rule on a
 // budget of one evaluation (the start, already run in step 1).
 CalibrationResult start_if_accepted(const nlohmann::json& material, const std::vector<MacroTarget>& targets,
@@ -426,12 +457,19 @@ EnlargementStudy run_enlargement_study(const nlohmann::json& base_in, const Fail
     fit_trends(s);
     fit_costs(s);
 
+    if (const std::string why = reference_cannot_be_a_target(s.bases.front().line, options); !why.empty()) {
+        s.problems.push_back("r = " + num(options.radii.front()) + " m (the reference): " + why +
+                             "; the study stops before the calibrations (step 2)");
+        return s;
+    }
     const auto targets = reference_targets(s.bases.front().line, options.point_targets);
     say(progress, "2. calibration of young_modulus and poisson_ratio to the reference line (" +
                       line_text(s.bases.front().line) + ")");
     for (std::size_t i = 1; i < options.radii.size(); ++i) {
         say(progress, "  r = " + num(options.radii[i]) + " m:");
         s.calibrations.push_back(calibrate_radius(base, options.radii[i], targets, evaluate, options, progress));
+        if (const std::string w = accepted_off_tolerance(s.calibrations.back(), targets, options.tolerance); !w.empty())
+            s.warnings.push_back("r = " + num(options.radii[i]) + " m: " + w);
     }
     fit_laws(s);
     if (!s.young_law || !s.poisson_law) return s;

@@ -155,6 +155,56 @@ TEST_CASE("a study whose calibrations cannot move the line reports the laws as u
     CHECK(names_calibration);
 }
 
+TEST_CASE("a reference line whose interval on mu_b holds 0 stops the study before any calibration",
+          "[calibration][enlargement]") {
+    // probe 59: a 3-point reference of mu_b 0.79 +/- 1.66 accepted every radius's line at its start ("converged"),
+    // and E(r) was fitted through calibrations that never moved
+    int evaluations = 0;
+    const FailureLineEvaluator noisy = [&](const nlohmann::json& m) {
+        ++evaluations;
+        FailureLineEvaluation ev = synthetic_line(m);
+        std::vector<double> sigma, tau;
+        const double scatter[] = {2000, -2000, -1000, 1500};  // Pa: a box far too small for its stresses
+        int k = 0;
+        for (double s : {2e3, 4e3, 6e3, 8e3}) {
+            sigma.push_back(s);
+            tau.push_back(0.6 * s + 1000 + scatter[k++]);
+        }
+        ev.peak = analytics::fit_failure_line(sigma, tau);
+        ev.residual = ev.peak;
+        return ev;
+    };
+    auto options = seed_radii_options();
+    const auto study = run_enlargement_study(base_material(), noisy, options);
+    INFO(study.markdown());
+    const auto& ref = study.bases.front().line;
+    REQUIRE(ref.mu_b > 0);  // the premise: a positive slope whose interval holds 0
+    REQUIRE(ref.mu_b_low < 0);
+    CHECK(evaluations == static_cast<int>(options.radii.size()));  // step 1 only
+    CHECK(study.calibrations.empty());
+    CHECK_FALSE(study.young_law);
+    REQUIRE(study.problems.size() == 1);
+    CHECK_THAT(study.problems.front(), Catch::Contains("an interval that holds 0 accepts every line") &&
+                                           Catch::Contains("the study stops before the calibrations"));
+}
+
+TEST_CASE("a calibration accepted by an interval rather than the tolerance is warned with its distance",
+          "[calibration][enlargement]") {
+    // with a tolerance of 1e-6, below the lines' own intervals (noise 3 Pa), a calibration is accepted by an interval
+    // (the reference's or its own), which the study then reports
+    auto options = seed_radii_options();
+    options.tolerance = 1e-6;
+    options.calibration.accept_simulated_interval = true;
+    const auto study = run_enlargement_study(base_material(), synthetic_line, options);
+    INFO(study.markdown());
+    int by_interval = 0, warned = 0;
+    for (const auto& c : study.calibrations)
+        by_interval += c.converged() && c.result.iterations.at(c.result.best).accepted_by != "tolerance";
+    for (const auto& w : study.warnings) warned += w.find(", not the tolerance:") != std::string::npos;
+    CHECK(by_interval > 0);
+    CHECK(warned == by_interval);
+}
+
 TEST_CASE("bad radii are refused before any evaluation, naming the field and the value", "[calibration][enlargement]") {
     int evaluations = 0;
     const FailureLineEvaluator counting = [&](const nlohmann::json& m) {
