@@ -165,9 +165,11 @@ void add_scale_command(CLI::App& app) {
         keep_results();  // the study is written: an undetermined law below is its verdict, not a lost result
         print_summary(study, *o);
         if (!study.problems.empty() && !o->allow_unconverged) {
-            std::string list;
-            for (const auto& p : study.problems) list += "\n  - " + p;
-            throw std::runtime_error("scale: not every fit is determined (results written all the same):" + list);
+            // one line per problem, then the verdict on one line (a message is kept to one line)
+            for (const auto& p : study.problems) std::cerr << "demcal: scale: " << p << "\n";
+            throw std::runtime_error("scale: not every fit is determined (" + std::to_string(study.problems.size()) +
+                                     (study.problems.size() == 1 ? " problem" : " problems") +
+                                     " above; results written all the same)");
         }
     });
 }

@@ -1,4 +1,5 @@
 #include "orchestrator/slurm_executor.hpp"
+#include "orchestrator/campaign_suspended.hpp"
 
 #include "analytics/number_text.hpp"
 #include "orchestrator/run_identity.hpp"
@@ -39,7 +40,9 @@ std::string capture(const std::string& cmd, int* exit_code = nullptr) {
     if (exit_code) {
         *exit_code = code;
     } else if (code != 0) {
-        throw std::runtime_error("'" + cmd + "' failed (exit " + std::to_string(code) + "): " + out);
+        std::string said = out;  // (its final newline would end the one-line message early)
+        while (!said.empty() && std::isspace(static_cast<unsigned char>(said.back()))) said.pop_back();
+        throw std::runtime_error("'" + cmd + "' failed (exit " + std::to_string(code) + "): " + said);
     }
     return out;
 }
@@ -193,6 +196,12 @@ std::string array_script_text(const fs::path& list, std::size_t tasks, int slots
     return s.str();
 }
 
+// sbatch did not take a batch (the controller unreachable, a limit, a partition it does not know): a stop to resume
+// once SLURM answers, not a failure of the runs.
+struct SubmissionRefused : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
 // Submits `batch` as one array (its task list and script named by `stem` in work_dir); returns its tasks.
 std::vector<Task> submit_array(const std::vector<Job>& batch, const fs::path& work_dir, const std::string& stem,
                                int slots, const std::string& partition) {
@@ -206,9 +215,18 @@ std::vector<Task> submit_array(const std::vector<Job>& batch, const fs::path& wo
     }
     write_text_file_atomically(list, l.str());
     write_text_file_atomically(script, array_script_text(list, batch.size(), slots, longest, partition));
-    const std::string out = capture("sbatch --parsable " + shell_quote(script.string()));
-    const std::optional<long> array_id = parse_sbatch_job_id(out);
-    if (!array_id) throw std::runtime_error("sbatch printed no job id: " + analytics::shortened_text(out, 300));
+    int code = 0;
+    const std::string out = capture("sbatch --parsable " + shell_quote(script.string()), &code);
+    const std::optional<long> array_id = code == 0 ? parse_sbatch_job_id(out) : std::nullopt;
+    if (!array_id) {  // nothing was submitted: the batch's files would only mislead
+        std::error_code ec;
+        fs::remove(list, ec);
+        fs::remove(script, ec);
+        std::string said = out;
+        while (!said.empty() && std::isspace(static_cast<unsigned char>(said.back()))) said.pop_back();
+        throw SubmissionRefused("sbatch " + (code == 0 ? std::string("printed no job id") : "exit " + std::to_string(code)) +
+                                ": " + analytics::shortened_text(said, 300));
+    }
     const auto now = std::chrono::steady_clock::now();
     std::vector<Task> tasks;
     for (std::size_t i = 0; i < batch.size(); ++i) tasks.push_back({batch[i], *array_id, static_cast<int>(i), now, now});
@@ -269,16 +287,26 @@ bool poll_task(Task& t, ArrayStates& states, JobOutcome& o) {
 void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events) {
     fs::create_directories(work_dir_);
     std::vector<Task> tasks;
+    std::string refused;  // why sbatch did not take a batch: no further batch is submitted, the submitted ones end
     auto submit_batch = [&](const std::vector<Job>& batch) {
         const std::string stem = "batch-" + std::to_string(::getpid()) + "-" + std::to_string(batches_++);
-        for (const Task& t : submit_array(batch, work_dir_, stem, slots_, partition_)) {
+        std::vector<Task> submitted;
+        try {
+            submitted = submit_array(batch, work_dir_, stem, slots_, partition_);
+        } catch (const SubmissionRefused& e) {
+            refused = e.what();
+            return;
+        }
+        for (const Task& t : submitted) {
             tasks.push_back(t);
             if (events.started) events.started(t.job, t.array_id * kTaskBase + static_cast<long>(t.index));
         }
     };
     auto submit_ready_jobs = [&] {
         std::vector<Job> batch;
-        while (auto j = next_job()) {
+        while (refused.empty()) {
+            auto j = next_job();
+            if (!j) break;
             batch.push_back(*j);
             if (static_cast<long>(batch.size()) == std::min<long>(max_array_size_, kTaskBase)) {
                 submit_batch(batch);
@@ -312,6 +340,10 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
         }
         if (!stop) submit_ready_jobs();  // retries queued by the finished callbacks
     }
+    // the jobs of a refused batch were never started: their runs are as they were (pending), for a resume
+    if (!refused.empty())
+        throw CampaignSuspended("SLURM did not take the runs (" + refused + "); the runs not submitted stay as they "
+                                "were: resume once sbatch works, or run them with --executor local");
 }
 
 std::unique_ptr<Executor> make_executor(const std::string& kind, int slots, const fs::path& work_dir,
