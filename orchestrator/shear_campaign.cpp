@@ -340,6 +340,16 @@ void validate_shear_spec(const ShearCampaignSpec& spec) {
         throw std::invalid_argument("replicates = " + std::to_string(spec.replicates) + " must be between 1 and " +
                                     std::to_string(kMaxReplicates));
     if (spec.base_seed < 0) throw std::invalid_argument("seed = " + std::to_string(spec.base_seed) + " must be >= 0");
+    // the replicates take the seeds base_seed, base_seed + 1, ...: the last one named by the options that gave it,
+    // not as a run's field the user never typed
+    const auto largest_seed = static_cast<long>(find_shear_param("seed")->max);
+    if (spec.base_seed > largest_seed - (spec.replicates - 1))
+        throw std::invalid_argument("seed = " + std::to_string(spec.base_seed) + " with replicates = " +
+                                    std::to_string(spec.replicates) + ": the replicates' packings take the seeds " +
+                                    std::to_string(spec.base_seed) + " to " +
+                                    std::to_string(spec.base_seed + spec.replicates - 1) + ", and a seed is at most " +
+                                    std::to_string(largest_seed) + "; give --seed at most " +
+                                    std::to_string(largest_seed - (spec.replicates - 1)));
     // every run's own fields in their ranges (each stress, the last replicate's seed), before anything is written
     const nlohmann::json material = validate_material(spec.material);
     // (named by the option that gave the stress: every campaign command takes its stresses from --normal-stress)

@@ -29,7 +29,7 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
     const std::vector<Case> cases{
         // a run's own fields, checked for every stress and for the last replicate's seed
         {{"shear", tiny, "-s", "2e10"}, "'normal_stress' = 20000000000.0"},
-        {{"shear", tiny, "-s", "5e3", "--seed", "2147483647", "-r", "2"}, "'seed' = 2147483648"},
+        {{"shear", tiny, "-s", "5e3", "--seed", "2147483647", "-r", "2"}, "--seed = 2147483647 with replicates = 2"},
         // NaN passed CLI11's own range checks
         {{"shear", tiny, "-s", "5e3", "--timeout", "nan"}, "--timeout: 'nan' is not a number"},
         {{"sensitivity", tiny, "-s", "5e3,inf", "--params", "friction_coefficient"}, "--normal-stress: 'inf' is not finite"},
