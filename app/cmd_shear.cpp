@@ -8,6 +8,7 @@
 #include "app/shear_report.hpp"
 #include "app/silo_campaign.hpp"
 #include "analytics/failure_line.hpp"
+#include "analytics/user_input.hpp"
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/folder_lock.hpp"
 #include "orchestrator/run_identity.hpp"
@@ -203,8 +204,52 @@ void run_shear(const ShearCliOptions& opt) {
     if (code != 0) throw CLI::RuntimeError(code);
 }
 
+// A material field's value as text that compares numbers by value (2650 and 2650.0 are one density).
+std::string field_value_key(const nlohmann::json& v) {
+    return v.is_number() ? analytics::number_text(v.get<double>(), 15) : v.dump();
+}
+
+// Each material field's most common value among a store's shear campaigns: what a campaign's own values are told
+// against in `demcal status`, where campaign names are digests (a study's levels, a calibration's steps).
+std::map<std::string, std::string> common_material_values(const std::vector<ShearCampaignOutcome>& outs) {
+    std::map<std::string, std::map<std::string, int>> counts;
+    for (const auto& o : outs) {
+        if (o.campaign.kind != CampaignKind::shear) continue;
+        const nlohmann::json material = o.campaign.spec.value("material", nlohmann::json::object());
+        for (const auto& [k, v] : material.items()) ++counts[k][field_value_key(v)];
+    }
+    std::map<std::string, std::string> common;
+    for (const auto& [k, by_value] : counts)
+        common[k] = std::max_element(by_value.begin(), by_value.end(), [](const auto& a, const auto& b) {
+                        return a.second < b.second;
+                    })->first;
+    return common;
+}
+
+// What a shear campaign ran: the engine, its material (its name, and the fields whose values differ from the store's
+// most common ones), the stresses and packings, and its label.
+std::string campaign_description(const ShearCampaignOutcome& o, const std::map<std::string, std::string>& common) {
+    const auto spec = ShearCampaignSpec::from_json(o.campaign.spec);
+    std::ostringstream d;
+    d << "  " << to_string(spec.engine) << " engine";
+    if (spec.material.contains("name") && spec.material["name"].is_string())
+        d << ", material '" << analytics::shortened_text(spec.material["name"].get<std::string>(), 60) << "'";
+    for (const auto& [k, v] : spec.material.items()) {
+        if (k == "name" || k == "description") continue;
+        const auto c = common.find(k);
+        if (c == common.end() || c->second != field_value_key(v))
+            d << ", " << k << " " << analytics::json_value_text(v);
+    }
+    const auto [lo, hi] = std::minmax_element(spec.normal_stresses.begin(), spec.normal_stresses.end());
+    d << "; " << spec.normal_stresses.size() << " normal stresses " << analytics::number_text(*lo) << " to "
+      << analytics::number_text(*hi) << " Pa x " << spec.replicates << " packings from seed " << spec.base_seed;
+    if (!spec.label.empty()) d << "; " << analytics::shortened_text(spec.label, 80);
+    return d.str();
+}
+
 // One campaign's line of `demcal status`: its runs by state, their time, its failures and its failure line.
-void print_campaign_status(const ShearCampaignOutcome& o, bool folder_held) {
+void print_campaign_status(const ShearCampaignOutcome& o, bool folder_held,
+                           const std::map<std::string, std::string>& common_material) {
     std::map<std::string, int> by_state;
     double wall = 0;
     for (const auto& r : o.runs) {
@@ -221,6 +266,7 @@ void print_campaign_status(const ShearCampaignOutcome& o, bool folder_held) {
                                                      : s);
     std::cout << "; run time " << duration_text(wall) << ", CPU " << duration_text(o.cpu_s) << "\n";
     const bool shear = o.campaign.kind == CampaignKind::shear;
+    if (shear) std::cout << campaign_description(o, common_material) << "\n";
     for (const auto& r : o.runs)
         if (r.state == RunState::failed)
             std::cout << "  failed: "
@@ -266,7 +312,8 @@ void print_status(const std::string& dir) {
     if (!fs::exists(fs::path(dir) / "campaign.sqlite") && fs::exists(fs::path(dir) / "campaign.json"))
         return print_silo_sweep_status(dir);  // a vibration, cutoff or diagnose silo-dem sweep
     const std::vector<ShearCampaignOutcome> outs = inspect_campaigns(dir);
-    for (const auto& o : outs) print_campaign_status(o, orchestrator::FolderLock::held(dir));
+    const auto common = common_material_values(outs);
+    for (const auto& o : outs) print_campaign_status(o, orchestrator::FolderLock::held(dir), common);
     if (outs.empty()) std::cout << "no campaigns in " << dir << "\n";
 }
 

@@ -747,7 +747,8 @@ std::vector<ShearCampaignOutcome> inspect_campaigns(const fs::path& dir) {
         o.runs = store.campaign_runs(c.id);
         for (const auto& r : o.runs) {
             if (r.state == RunState::failed) ++o.failed;
-            if (r.state == RunState::done) o.cpu_s += r.cpu_s;
+            // the CPU the campaign spent: failed runs' too (a campaign of failed runs showed "CPU 0s")
+            if (r.state == RunState::done || r.state == RunState::failed) o.cpu_s += r.cpu_s;
         }
         outs.push_back(std::move(o));
     }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <set>
@@ -190,4 +191,30 @@ TEST_CASE("a result of schema 3 is its run's only when it records the run's para
     result["schema"] = 5;
     result.erase("params");
     CHECK_NOTHROW(orchestrator::check_shear_result_values(result, "r", &params));
+}
+
+TEST_CASE("status tells a folder's campaigns apart by what they ran",
+          "[kernel_engine]") {
+    // probe 59: a calibration's folder listed 42 campaigns as digests only ("shear-0f5a811c912e [complete] ...")
+    const fs::path dir = test::fresh_test_dir("kernel-status");
+    nlohmann::json material = nlohmann::json::parse(test::read_file(tiny));
+    material["friction_coefficient"] = 0.3;
+    const fs::path other = dir / "other.json";
+    std::ofstream(other) << material.dump();
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
+                             dir / "a.log") == 0);
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "--seed", "5", "-c",
+                              dir.string()},
+                             dir / "b.log") == 0);
+    REQUIRE(test::run_demcal({"shear", other.string(), "-s", "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
+                             dir / "c.log") == 0);
+    REQUIRE(test::run_demcal({"status", dir.string()}, dir / "status.log") == 0);
+    const std::string status = test::read_file(dir / "status.log");
+    INFO(status);
+    using Catch::Matchers::Contains;
+    // the two campaigns of the common material say only their engine and design; the other names its friction
+    CHECK_THAT(status, Contains("  kernel engine; 3 normal stresses 3000 to 7000 Pa x 1 packings from seed 1\n") &&
+                           Contains("  kernel engine; 3 normal stresses 3000 to 7000 Pa x 1 packings from seed 5\n") &&
+                           Contains("  kernel engine, friction_coefficient 0.3; 3 normal stresses"));
+    fs::remove_all(dir);
 }
