@@ -195,10 +195,16 @@ void validate(const SiloGeometry& g) {
     plausible("delta", g.arch_delta, 0, 10, "", "Oldal's arch height over the outlet is about 0.5");
     // Beverloo's empty annulus k d_p must leave an opening, or its rate is 0 for any silo (k is 1-3 in the literature)
     const double opening = narrowest_opening(g);
-    if (g.beverloo_k * g.particle_size >= opening)
-        throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + ": k d_p = " +
-                                    number_text(g.beverloo_k * g.particle_size) + " m is not smaller than the outlet (" +
-                                    number_text(opening) + " m): Beverloo's effective outlet would be empty");
+    if (g.beverloo_k * g.particle_size >= opening) {
+        // the field that gives the narrowest side: a rectangular outlet is outlet_m by b_m (the silo's depth)
+        const std::string side = g.shape == SiloShape::rectangular && g.depth < g.outlet
+                                     ? "the outlet's narrower side, the silo depth b_m=" + number_text(g.depth)
+                                     : "the outlet, outlet_m=" + number_text(g.outlet);
+        throw std::invalid_argument("beverloo_k=" + number_text(g.beverloo_k) + " with d_p_m=" +
+                                    number_text(g.particle_size) + ": k d_p = " +
+                                    number_text(g.beverloo_k * g.particle_size) + " m is not smaller than " + side +
+                                    " m: Beverloo's effective outlet would be empty");
+    }
     if (!(g.stagnant_angle_deg > 0 && g.stagnant_angle_deg < 90))
         throw std::invalid_argument("phi_d_deg=" + number_text(g.stagnant_angle_deg) + " not in (0, 90)");
     if (g.effective_friction_deg.has_value() != g.wall_friction_deg.has_value())
@@ -407,8 +413,8 @@ SiloGeometry geometry_from_json(const nlohmann::json& j) {
     static const std::vector<std::string> known{"geometry", "D_m",        "b_m",        "c_m",        "outlet_m",
                                                 "theta_deg", "d_p_m",     "rho_b_kg_m3", "beverloo_C", "beverloo_k",
                                                 "slot_C",    "delta",     "phi_d_deg",   "delta_e_deg", "phi_w_deg"};
-    for (const auto& [key, value] : j.items())
-        if (std::find(known.begin(), known.end(), key) == known.end())
+    for (const auto& [key, value] : j.items())  // (a key starting with '_' is a comment, as in the silo's files)
+        if (std::find(known.begin(), known.end(), key) == known.end() && key.rfind('_', 0) != 0)
             throw std::invalid_argument("geometry: unknown key " + shortened_text(key) + "=" + json_value_text(value));
     if (!j.contains("geometry") || !j.at("geometry").is_string())
         throw std::invalid_argument("geometry: key geometry must be \"conical\" or \"rectangular\"" +
@@ -417,7 +423,7 @@ SiloGeometry geometry_from_json(const nlohmann::json& j) {
     if (shape == "conical") {
         g.shape = SiloShape::conical;
         g.silo_diameter = required("D_m");
-        for (const char* k : {"b_m", "c_m"})
+        for (const char* k : {"b_m", "c_m", "slot_C"})  // (slot_C: Myers and Sellers' slot, rectangular outlets only)
             if (j.contains(k)) throw std::invalid_argument(std::string("geometry: ") + k + " is for rectangular silos");
     } else if (shape == "rectangular") {
         g.shape = SiloShape::rectangular;

@@ -318,6 +318,14 @@ void validate_measured(const MeasuredData& data, MeasuredKind kind) {
                                             geometry->text[r] + " silo)");
             check(r, *col, col->values[r] > 0, "is not a positive silo size");
         }
+        // a size of the other shape on this row is read by no model: refused, not ignored (b_m on a conical row)
+        for (const char* other : conical ? std::vector<const char*>{"b_m", "c_m"} : std::vector<const char*>{"D_m"})
+            if (const DataColumn* col = data.find(other); col && !col->text[r].empty())
+                throw std::invalid_argument(data.where(r, other) + ": '" + shortened_text(col->text[r]) + "' on a " +
+                                            geometry->text[r] + " silo's row, where no model reads it (" +
+                                            (conical ? "b_m and c_m are a rectangular silo's sizes" :
+                                                       "D_m is a conical silo's diameter") +
+                                            "): leave the cell empty");
         for (const auto* col : {&outlet, &dp, &rho, &rate})
             check_plausible_silo_quantity(col->name, col->values[r], data.where(r, col->name));
         for (const auto* col : sizes) check_plausible_silo_quantity(col->name, col->values[r], data.where(r, col->name));

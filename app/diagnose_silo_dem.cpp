@@ -54,6 +54,14 @@ std::vector<std::string> condition_options(const an::SiloCondition& c) {
     return a;
 }
 
+// A condition as its data columns give it: "theta_deg = 20, outlet_m = 30".
+std::string condition_text(const an::SiloCondition& c) {
+    std::string t = "theta_deg = " + silo_number(c.theta_deg);
+    for (const auto& g : kGeometryColumns)
+        if (std::isfinite(c.*g.value)) t += std::string(", ") + g.column + " = " + silo_number(c.*g.value);
+    return t;
+}
+
 // The material file's JSON object at "object.key", or null when absent.
 const json* field_at(const json& material, const std::string& path) {
     const auto dot = path.find('.');
@@ -171,11 +179,24 @@ public:
     }
 
     // `demcal silo --check` of every condition with the declared material file: nothing written.
+    // A refusal is named by the data's lines of that condition, whose values made the run (outlet_m = 30, in mm by
+    // mistake, was reported as the geometry file's D_m at fault, by a run's name).
     void check_settings() const {
-        std::vector<SiloRunPlan> plans;
-        for (std::size_t c = 0; c < data_.conditions.size(); ++c)
-            plans.push_back(plan("check", args_.material, c, args_.first_seed));
-        check_silo_runs(plans);
+        for (std::size_t c = 0; c < data_.conditions.size(); ++c) {
+            try {
+                check_silo_runs({plan("check", args_.material, c, args_.first_seed)});
+            } catch (const UserError& e) {
+                std::string lines;
+                for (std::size_t r = 0; r < data_.rows(); ++r)
+                    if (data_.condition_of_row[r] == c) lines += (lines.empty() ? "" : ", ") + ("line " + std::to_string(data_.lines[r]));
+                std::string why = e.what();
+                if (const auto colon = why.find(": "); why.rfind("run ", 0) == 0 && colon != std::string::npos)
+                    why.erase(0, colon + 2);  // (the run's name: the condition is named here by its data)
+                throw UserError("--data = '" + an::shortened_text(data_.source, 200) + "', " + lines + " (" +
+                                condition_text(data_.conditions[c]) + "): the silo run of this condition is refused: " +
+                                why);
+            }
+        }
     }
 
     double wall_seconds() const { return wall_seconds_; }

@@ -187,6 +187,13 @@ TEST_CASE("geometry JSON errors name the key and the value", "[discharge]") {
         return k;
     };
     CHECK_THROWS_WITH(geometry_from_json(with("outlet_mm", 35)), Catch::Contains("unknown key outlet_mm"));
+    CHECK_NOTHROW(geometry_from_json(with("_comment", "measured 2026-11-30")));  // a comment, as in the silo's files
+    // the narrowest side of a rectangular outlet is named by its field: b_m, which was called "the outlet"
+    const nlohmann::json slot{{"geometry", "rectangular"}, {"b_m", 0.005}, {"c_m", 0.1},  {"outlet_m", 0.03},
+                              {"theta_deg", 60},           {"d_p_m", 0.004}, {"rho_b_kg_m3", 800}};
+    CHECK_THROWS_WITH(geometry_from_json(slot), Catch::Contains("the outlet's narrower side, the silo depth b_m=0.005"));
+    // Myers and Sellers' slot constant on a conical outlet was ignored (probe 59b)
+    CHECK_THROWS_WITH(geometry_from_json(with("slot_C", 2)), Catch::Contains("slot_C is for rectangular silos"));
     CHECK_THROWS_WITH(geometry_from_json(with("d_p_m", -0.001)), Catch::Contains("d_p_m=-0.001"));
     CHECK_THROWS_WITH(geometry_from_json(with("d_p_m", 0.04)), Catch::Contains("not larger than the particles"));
     CHECK_THROWS_WITH(geometry_from_json(with("outlet_m", 0.2)), Catch::Contains("D_m=0.105"));

@@ -108,6 +108,11 @@ TEST_CASE("bad discharge files name the line and the column", "[measured]") {
     fails_with("conical,0.105,,,0.035,30,0.0055,780,0.171,,12.5\n", "line 3, column operator: missing value");
     fails_with("conical,0.105,,,0.035,30,0.0055,780,0.171,anna,1 2\n", "line 3, column moisture_pct: '1 2'");
     fails_with("hexagonal,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n", "line 3, column geometry: 'hexagonal'");
+    // a size of the other shape was read by no model, silently (probe 59b: b_m and c_m on conical rows)
+    fails_with("conical,0.105,0.05,,0.035,30,0.0055,780,0.171,anna,12.5\n",
+               "line 3, column b_m: '0.05' on a conical silo's row, where no model reads it");
+    fails_with("rectangular,0.105,0.05,0.1,0.03,60,0.0055,780,0.35,anna,12.5\n",
+               "line 3, column D_m: '0.105' on a rectangular silo's row");
     fails_with("conical,0.105,,,0.035,30,0.0055,780\n", "line 3: 8 fields, the header has 11");
     fails_with("conical,0,105,,,0.035,30,0.0055,780,0.171,anna,12.5\n",
                "line 3: 12 fields, the header has 11 (a decimal comma, 0,105,");
