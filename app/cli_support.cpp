@@ -242,6 +242,12 @@ void check_options_apply(const CLI::App& cmd) {
                             " makes --" + pair.option + " void; give one of the two");
     }
     check_local_jobs(cmd);
+    // SLURM asked for where it is not installed: refused before a campaign is written (it was after, exit 2 all the
+    // same, with a store, run folders and a program copy left)
+    if (const CLI::Option* executor = option_named(cmd, "executor");
+        executor && executor->count() > 0 && executor->as<std::string>() == "slurm" && !orchestrator::sbatch_on_path())
+        throw UserError("--executor slurm: sbatch is not on PATH (install slurm-client and reach a SLURM controller, "
+                        "or run on --executor local)");
     for (const CLI::App* sub : cmd.get_subcommands()) check_options_apply(*sub);
 }
 }  // namespace

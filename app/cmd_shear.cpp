@@ -314,7 +314,9 @@ void print_status(const std::string& dir) {
     const std::vector<ShearCampaignOutcome> outs = inspect_campaigns(dir);
     const auto common = common_material_values(outs);
     for (const auto& o : outs) print_campaign_status(o, orchestrator::FolderLock::held(dir), common);
-    if (outs.empty()) std::cout << "no campaigns in " << dir << "\n";
+    if (outs.empty())
+        std::cout << "no campaigns in " << dir << " (the command that made its store stopped before it recorded one: "
+                  << "run that command again)\n";
 }
 
 void run_resume(const ShearCliOptions& opt) {
@@ -352,6 +354,9 @@ void run_resume(const ShearCliOptions& opt) {
                             opt.campaign_dir + " have " + std::to_string(left) +
                             " runs not done; resume them with a --max-runs of at least that, or without it");
     }
+    if (inspect_campaigns(opt.campaign_dir).empty())  // (a command killed between making the store and its campaign)
+        throw UserError("resume: DIR = '" + analytics::shortened_text(opt.campaign_dir, 200) + "' holds a store with no "
+                        "campaign recorded in it (the command that made it stopped first): run that command again");
     find_yade(opt.exec.yade);  // before the store is opened: a bad --yade costs nothing
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
     const auto outs = runner.resume(print_progress);

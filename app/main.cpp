@@ -2,10 +2,15 @@
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "app/result_files.hpp"
+#include "app/silo_campaign.hpp"
 
 #include <gsl/gsl_errno.h>
 
 #include <cerrno>
+#include <csignal>
+#include <cstdlib>
+#include <sys/prctl.h>
+#include <unistd.h>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -101,7 +106,20 @@ int with_standard_output_checked(int status) {
 
 }  // namespace
 
+// A demcal started by a sweep (app/silo_campaign.cpp spawn_demcal) gets SIGTERM when the sweep dies, even by kill -9:
+// it checkpoints and stops, where it ran on as an orphan in the run folder the sweep, run again, needed. The variable
+// names the parent; a parent already gone before the link was made is caught by comparing it.
+void end_with_parent_if_asked() {
+    const char* parent = std::getenv(demcal::kDieWithParentVariable);
+    if (!parent) return;
+    const long expected = std::strtol(parent, nullptr, 10);
+    ::unsetenv(demcal::kDieWithParentVariable);  // (not passed on to anything this process starts)
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != expected) ::raise(SIGTERM);
+}
+
 int main(int argc, char** argv) {
+    end_with_parent_if_asked();
     // GSL's default error handler aborts the process (its F quantile did, on valid input: analytics/dem_diagnosis.cpp
     // f1_quantile). A command checks what the numerics return (a fit not converged, a value not finite) and says so;
     // an abort says nothing and leaves a core.

@@ -64,8 +64,17 @@ pid_t spawn_demcal(const std::vector<std::string>& args, const fs::path& log) {
     // while it wrote its checkpoint.
     posix_spawnattr_setpgroup(&attr, 0);
     posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
+    // the run ends with this process (app/main.cpp, kDieWithParentVariable): a sweep killed with -9 left its run
+    // going, which the sweep run again then found busy and marked failed (probe 60)
+    std::vector<std::string> env_text;
+    for (char** e = environ; *e; ++e)
+        if (std::string_view(*e).rfind(std::string(kDieWithParentVariable) + "=", 0) != 0) env_text.emplace_back(*e);
+    env_text.push_back(std::string(kDieWithParentVariable) + "=" + std::to_string(::getpid()));
+    std::vector<char*> envp;
+    for (auto& e : env_text) envp.push_back(e.data());
+    envp.push_back(nullptr);
     pid_t pid = 0;
-    const int err = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), environ);
+    const int err = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), envp.data());
     posix_spawn_file_actions_destroy(&fa);
     posix_spawnattr_destroy(&attr);
     if (err != 0) throw std::runtime_error("cannot start " + self + ": " + std::strerror(err));
@@ -409,6 +418,16 @@ void record_run_end(const fs::path& rd, const std::string& name, int rc, bool st
     ++outcome.failed;
 }
 
+// A run folder another demcal holds (a run of a sweep killed before its runs ended): said, and the campaign stops
+// for a later resume (exit 75), where the run started here was refused as busy and marked failed for good.
+bool run_folder_busy(const fs::path& rd, const std::string& name, const std::string& command) {
+    if (!orchestrator::FolderLock::held(rd)) return false;
+    std::cout << "run " << name << " is in use by another demcal process (" << rd.string()
+              << "); the campaign stops here: when that run has ended, the same command continues the " << command
+              << " campaign\n";
+    return true;
+}
+
 // The runs left as SLURM array tasks (orchestrator::SlurmExecutor: sbatch, squeue, the tasks' exit_status files).
 void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& todo,
                   const std::map<const SiloRunPlan*, json>& identities, std::size_t total,
@@ -421,6 +440,10 @@ void run_on_slurm(const fs::path& dir, const std::vector<const SiloRunPlan*>& to
     std::vector<orchestrator::Job> queue;
     for (const SiloRunPlan* plan : todo) {
         const fs::path rd = dir / "runs" / plan->name;
+        if (run_folder_busy(rd, plan->name, command)) {
+            outcome.stopped = true;
+            return;
+        }
         const bool resume = fs::exists(rd / "checkpoint.bin");
         record_run_identity(rd, identities.at(plan));
         std::vector<std::string> argv{program};
@@ -491,6 +514,10 @@ SiloCampaignOutcome run_silo_campaign(const fs::path& dir, const std::vector<Sil
         while (!stopping && next < todo.size() && int(running.size()) < std::max(1, jobs)) {
             const SiloRunPlan& plan = *todo[next++];
             const fs::path rd = dir / "runs" / plan.name;
+            if (run_folder_busy(rd, plan.name, command)) {
+                outcome.stopped = true;
+                break;
+            }
             const bool resume = fs::exists(rd / "checkpoint.bin");
             record_run_identity(rd, identities.at(&plan));
             std::cout << "[" << outcome.finished + outcome.failed + running.size() + 1 << "/" << plans.size() << "] "

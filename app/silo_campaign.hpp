@@ -16,6 +16,10 @@
 
 namespace demcal {
 
+// The environment variable by which a campaign tells the demcal it starts for a run to end with it (its pid);
+// app/main.cpp reads it.
+inline constexpr const char* kDieWithParentVariable = "DEMCAL_END_WITH_PARENT";
+
 // One run: its folder name under DIR/runs/ and its `demcal silo` options except --out (which the campaign sets).
 struct SiloRunPlan {
     std::string name;

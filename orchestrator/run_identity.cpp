@@ -3,6 +3,9 @@
 #include "analytics/user_input.hpp"
 
 #include <cerrno>
+#include <charconv>
+#include <csignal>
+#include <vector>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -154,6 +157,26 @@ void write_text_file_atomically(const std::filesystem::path& path, const std::st
         std::filesystem::remove(tmp, ignored);
         throw std::runtime_error("cannot write " + p.string() + " (" + ec.message() + ")");
     }
+}
+
+}  // namespace demcal::orchestrator
+
+namespace demcal::orchestrator {
+
+void remove_abandoned_temporaries(const std::filesystem::path& file) {
+    std::error_code ec;
+    const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+    const std::string prefix = file.filename().string() + ".tmp";
+    std::vector<std::filesystem::path> abandoned;
+    for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.compare(0, prefix.size(), prefix) != 0) continue;
+        long pid = 0;
+        const auto [last, bad] = std::from_chars(name.data() + prefix.size(), name.data() + name.size(), pid);
+        if (bad != std::errc() || last != name.data() + name.size() || pid <= 0 || pid == ::getpid()) continue;
+        if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) abandoned.push_back(it->path());
+    }
+    for (const auto& f : abandoned) std::filesystem::remove(f, ec);
 }
 
 }  // namespace demcal::orchestrator

@@ -69,6 +69,8 @@ std::string read_text_file(const std::filesystem::path& p);
 // followed (its target is written, the link kept); a path that is a folder, a device, a FIFO or a socket is refused
 // (throws, nothing written): a rename would replace the node.
 void write_text_file_atomically(const std::filesystem::path& p, const std::string& text);
+// Removes what a killed writer left of `file`: FILE.tmpPID whose process is gone (a 6 MB program copy stayed).
+void remove_abandoned_temporaries(const std::filesystem::path& file);
 // Where write_text_file_atomically writes `p` (the link's target for a link); throws as it does.
 std::filesystem::path atomic_write_target(const std::filesystem::path& p);
 

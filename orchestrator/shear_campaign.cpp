@@ -299,6 +299,7 @@ std::unique_ptr<Executor> make_executor(const ExecutionOptions& o, const fs::pat
 std::string pinned_program(const std::string& program, const fs::path& dir) {
     fs::create_directories(dir);
     const fs::path copy = dir / fs::path(program).filename();
+    remove_abandoned_temporaries(copy);
     const std::string bytes = read_text_file(program);
     if (fs::exists(copy) && fs::file_size(copy) == bytes.size() && read_text_file(copy) == bytes) return copy.string();
     write_text_file_atomically(copy, bytes);

@@ -4,11 +4,14 @@
 #include "analytics/number_text.hpp"
 #include "orchestrator/run_identity.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -54,7 +57,28 @@ struct Task {
     std::chrono::steady_clock::time_point submitted;
     std::chrono::steady_clock::time_point last_listed;  // when squeue last listed it (or its submission)
     bool cancel_sent = false;
+    std::chrono::steady_clock::time_point cancelled_at;  // when scancel was sent
 };
+
+// How long a stopped campaign waits for SLURM to confirm that a cancelled task ended (a silo task writes its
+// checkpoint first) before it leaves the task to SLURM and stops: with the controller gone, squeue never confirms and
+// Ctrl-C or SIGTERM went unheeded (probe 60: 11 minutes, until kill -9).
+constexpr double kCancelGraceS = 30;
+// How long squeue may fail without a break before the campaign stops for a resume (exit 75) instead of waiting on.
+constexpr double kControllerLostAfterS = 600;
+
+// A cancelled task SLURM did not confirm ending within kCancelGraceS: its run goes back to pending, for a resume.
+JobOutcome outcome_of_unconfirmed_cancel(const Task& t, std::chrono::steady_clock::time_point now) {
+    JobOutcome o;
+    o.exit_code = -1;
+    o.interrupted = true;
+    o.failure_cause = "interrupted";
+    o.message = "SLURM did not confirm within " + std::to_string(static_cast<int>(kCancelGraceS)) +
+                " s that cancelled array task " + std::to_string(t.array_id) + "_" + std::to_string(t.index) +
+                " ended; it is left to SLURM";
+    o.wall_s = std::chrono::duration<double>(now - t.submitted).count();
+    return o;
+}
 
 // run.sh: the job's command with its logs, then one line: exit code, start and end (epoch s), CPU seconds.
 void write_task_script(const Job& job) {
@@ -167,16 +191,30 @@ bool task_vanished(bool listed_now, double seconds_since_listed) {
     return !listed_now && seconds_since_listed > kTaskVanishedAfterS;
 }
 
+bool sbatch_on_path() {
+    const char* path = std::getenv("PATH");
+    if (!path) return false;
+    const std::string p = path;
+    for (std::size_t a = 0; a <= p.size();) {
+        std::size_t b = p.find(':', a);
+        if (b == std::string::npos) b = p.size();
+        const fs::path candidate = fs::path(p.substr(a, b - a).empty() ? "." : p.substr(a, b - a)) / "sbatch";
+        std::error_code ec;
+        if (fs::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0) return true;
+        a = b + 1;
+    }
+    return false;
+}
+
 SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition)
     : slots_(slots), work_dir_(std::move(work_dir)), partition_(std::move(partition)) {
     if (slots < 1) throw std::invalid_argument("jobs = " + std::to_string(slots) + " must be at least 1");
     if (const std::string defect = slurm_partition_defect(partition_); !defect.empty())
         throw std::invalid_argument("partition = '" + analytics::shortened_text(partition_, 300) + "': " + defect);
-    int code = 0;
-    capture("command -v sbatch", &code);
-    if (code != 0)
+    if (!sbatch_on_path())
         throw std::invalid_argument("executor = 'slurm' but sbatch is not on PATH (install slurm-client and reach a "
                                     "SLURM controller)");
+    int code = 0;
     // an array of more tasks than the cluster's MaxArraySize is refused by sbatch: larger batches are split
     const std::string config = capture("scontrol show config", &code);
     max_array_size_ = code == 0 ? parse_max_array_size(config) : kSlurmDefaultMaxArraySize;
@@ -317,17 +355,25 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
     };
 
     submit_ready_jobs();
+    auto controller_answered = std::chrono::steady_clock::now();
+    bool controller_lost = false;
     while (!tasks.empty()) {
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
-        const bool stop = interrupted();
+        const auto now = std::chrono::steady_clock::now();
+        const bool stop = interrupted() || controller_lost;
         ArrayStates states;
         for (std::size_t i = 0; i < tasks.size();) {
             Task& t = tasks[i];
             JobOutcome o;
-            const bool ended = poll_task(t, states, o);
+            bool ended = poll_task(t, states, o);
             if (!ended && stop && !t.cancel_sent) {
                 capture("scancel " + std::to_string(t.array_id) + "_" + std::to_string(t.index), &o.exit_code);
                 t.cancel_sent = true;
+                t.cancelled_at = now;
+            }
+            if (!ended && t.cancel_sent && std::chrono::duration<double>(now - t.cancelled_at).count() > kCancelGraceS) {
+                o = outcome_of_unconfirmed_cancel(t, now);
+                ended = true;
             }
             if (ended) {
                 if (t.cancel_sent) o.interrupted = true;
@@ -339,7 +385,17 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
             ++i;
         }
         if (!stop) submit_ready_jobs();  // retries queued by the finished callbacks
+        // squeue answered for some array this round (no array polled: no news either way)
+        if (states.empty() || std::any_of(states.begin(), states.end(), [](const auto& a) { return a.second.has_value(); }))
+            controller_answered = now;
+        else if (std::chrono::duration<double>(now - controller_answered).count() > kControllerLostAfterS)
+            controller_lost = true;
     }
+    if (controller_lost)
+        throw CampaignSuspended("SLURM's controller did not answer squeue for " +
+                                std::to_string(static_cast<int>(kControllerLostAfterS)) +
+                                " s; the runs it held go back to pending: resume once SLURM answers, or run them "
+                                "with --executor local");
     // the jobs of a refused batch were never started: their runs are as they were (pending), for a resume
     if (!refused.empty())
         throw CampaignSuspended("SLURM did not take the runs (" + refused + "); the runs not submitted stay as they "

@@ -30,6 +30,9 @@ private:
     int batches_ = 0;
 };
 
+// Whether SLURM's sbatch is a program on PATH: checked where `--executor slurm` is read, before anything is written.
+bool sbatch_on_path();
+
 // What the executor reads from SLURM's output (pure functions, tested without a cluster):
 // the job id `sbatch --parsable` printed among any warnings, or nothing;
 std::optional<long> parse_sbatch_job_id(const std::string& output);

@@ -5,6 +5,7 @@
 
 #include "campaign_test_support.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <sys/wait.h>
@@ -51,5 +52,55 @@ TEST_CASE("a shear campaign stopped by SIGTERM or SIGHUP stops its runs, and res
                                                      Catch::Matchers::Contains("runs not done"));
     REQUIRE(test::run_demcal({"resume", camp.string()}, dir / "resume.log") == 0);
     CHECK_FALSE(test::find_file(camp, "failure_line_", ".json").empty());
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a silo sweep killed with -9 takes its runs with it, and the same command then resumes them",
+          "[kernel_engine][signals]") {
+    // probe 60: the run went on as an orphan; the sweep run again found its folder busy and marked it failed for good
+    const fs::path dir = test::fresh_test_dir("sweep-kill9");
+    const fs::path camp = dir / "sweep";
+    const std::vector<std::string> sweep{
+        "vibration", "--theta", "70", "--frequency", "0", "--repeats", "1", "--jobs", "1", "--campaign", camp.string(),
+        "--", "--geometry", test::source_path("examples/silo/reduced_conical_70deg.json").string(), "--outlet",
+        "0.018", "--particles", "2000", "--stiffness-scale", "0.001", "--fill-time", "0.3", "--max-time", "0.4",
+        "--threads", "1", "--no-plots"};
+    // the sweep's runs: processes whose command line names the campaign (they run from the sweep's folder)
+    const auto runs_of_sweep = [&] {
+        std::vector<int> pids;
+        for (const auto& e : fs::directory_iterator("/proc")) {
+            const std::string name = e.path().filename().string();
+            if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+            std::string cmdline = test::read_file(e.path() / "cmdline");
+            std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+            if (cmdline.find(" silo ") != std::string::npos && cmdline.find(camp.string()) != std::string::npos)
+                pids.push_back(std::stoi(name));
+        }
+        return pids;
+    };
+    const int pid = test::spawn_demcal(sweep, dir / "killed.log");
+    REQUIRE(pid > 0);
+    int status = 0;
+    bool ended = false;
+    for (int i = 0; i < 6000 && !ended; ++i) {  // once its run is under way
+        if (!runs_of_sweep().empty()) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        ended = ::waitpid(pid, &status, WNOHANG) == pid;
+    }
+    REQUIRE_FALSE(ended);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    // the run got SIGTERM with its parent's death: it checkpoints and ends within seconds
+    bool gone = false;
+    for (int i = 0; i < 300 && !gone; ++i) {
+        gone = runs_of_sweep().empty();
+        if (!gone) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    CHECK(gone);
+    REQUIRE(test::run_demcal(sweep, dir / "again.log") == 0);
+    INFO(test::read_file(dir / "again.log"));
+    CHECK(fs::exists(camp / "runs" / "theta70_f0_seed1" / "summary.json"));
+    CHECK_FALSE(fs::exists(camp / "runs" / "theta70_f0_seed1" / "failed"));
     fs::remove_all(dir);
 }

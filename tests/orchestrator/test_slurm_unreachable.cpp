@@ -48,3 +48,21 @@ TEST_CASE("an unreachable SLURM controller stops a campaign for a resume, its ru
     for (const auto& r : test::stored_runs(campaign)) CHECK(r.state == orchestrator::RunState::done);
     fs::remove_all(dir);
 }
+
+TEST_CASE("--executor slurm without sbatch on PATH is refused before a campaign is written", "[cli]") {
+    // probe 60: the refusal came after the store, the run folders and a 6.5 MB program copy had been written
+    const fs::path dir = test::fresh_test_dir("slurm-absent");
+    fs::create_directories(dir / "empty-path");
+    const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+    ::setenv("PATH", (dir / "empty-path").c_str(), 1);
+    const int rc = test::run_demcal({"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s",
+                                     "5e3,1e4,2e4", "--engine", "kernel", "--executor", "slurm", "--campaign",
+                                     (dir / "campaign").string()},
+                                    dir / "out.log");
+    ::setenv("PATH", path.c_str(), 1);
+    INFO(test::read_file(dir / "out.log"));
+    CHECK(rc == 2);
+    CHECK_THAT(test::read_file(dir / "out.log"), Contains("--executor slurm: sbatch is not on PATH"));
+    CHECK_FALSE(fs::exists(dir / "campaign"));
+    fs::remove_all(dir);
+}

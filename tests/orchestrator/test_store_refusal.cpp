@@ -180,3 +180,16 @@ TEST_CASE("status and resume on a folder without a store refuse it as holding no
     }
     fs::remove_all(dir);
 }
+
+TEST_CASE("a store with no campaign recorded (its command killed first) is not called complete", "[cli][store]") {
+    // probe 60: kill -9 about 30 ms into `shear` left a store without its campaign; resume said "nothing to resume:
+    // every campaign is complete" with exit 0
+    const fs::path dir = test::fresh_test_dir("store-no-campaign");
+    { orchestrator::CampaignStore store(dir / "campaign.sqlite"); }
+    CHECK(test::run_demcal({"resume", dir.string()}, dir / "resume.log") == 2);
+    CHECK_THAT(test::read_file(dir / "resume.log"),
+               Contains("holds a store with no campaign recorded in it") && Contains("run that command again"));
+    CHECK(test::run_demcal({"status", dir.string()}, dir / "status.log") == 0);
+    CHECK_THAT(test::read_file(dir / "status.log"), Contains("no campaigns in") && Contains("run that command again"));
+    fs::remove_all(dir);
+}
