@@ -57,7 +57,6 @@ struct Task {
     std::chrono::steady_clock::time_point submitted;
     std::chrono::steady_clock::time_point last_listed;  // when squeue last listed it (or its submission)
     bool cancel_sent = false;
-    std::chrono::steady_clock::time_point cancelled_at;  // when scancel was sent
 };
 
 // How long a stopped campaign waits for SLURM to confirm that a cancelled task ended (a silo task writes its
@@ -357,26 +356,36 @@ void SlurmExecutor::run(const JobSource& next_job, const ExecutorEvents& events)
     submit_ready_jobs();
     auto controller_answered = std::chrono::steady_clock::now();
     bool controller_lost = false;
+    std::optional<std::chrono::steady_clock::time_point> stopped_at;
     while (!tasks.empty()) {
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
-        const auto now = std::chrono::steady_clock::now();
         const bool stop = interrupted() || controller_lost;
+        if (stop && !stopped_at) stopped_at = std::chrono::steady_clock::now();
+        if (stop) {  // one scancel for all: each call waits on the controller (10 s apiece with it gone)
+            std::string ids;
+            for (Task& t : tasks)
+                if (!t.cancel_sent) {
+                    ids += " " + std::to_string(t.array_id) + "_" + std::to_string(t.index);
+                    t.cancel_sent = true;
+                }
+            int code = 0;
+            if (!ids.empty()) capture("scancel" + ids, &code);
+        }
+        const auto now = std::chrono::steady_clock::now();
+        const bool grace_over = stopped_at && std::chrono::duration<double>(now - *stopped_at).count() > kCancelGraceS;
         ArrayStates states;
         for (std::size_t i = 0; i < tasks.size();) {
             Task& t = tasks[i];
             JobOutcome o;
-            bool ended = poll_task(t, states, o);
-            if (!ended && stop && !t.cancel_sent) {
-                capture("scancel " + std::to_string(t.array_id) + "_" + std::to_string(t.index), &o.exit_code);
-                t.cancel_sent = true;
-                t.cancelled_at = now;
-            }
-            if (!ended && t.cancel_sent && std::chrono::duration<double>(now - t.cancelled_at).count() > kCancelGraceS) {
-                o = outcome_of_unconfirmed_cancel(t, now);
+            bool ended = false;
+            if (grace_over) {  // what the task recorded, else given up: SLURM is not asked again
+                if (!read_exit_status(t.job, o)) o = outcome_of_unconfirmed_cancel(t, now);
                 ended = true;
+            } else {
+                ended = poll_task(t, states, o);
             }
             if (ended) {
-                if (t.cancel_sent) o.interrupted = true;
+                if (t.cancel_sent && !o.succeeded()) o.interrupted = true;  // (one that finished first is done)
                 Job j = t.job;
                 tasks.erase(tasks.begin() + static_cast<long>(i));
                 if (events.finished) events.finished(j, o);
