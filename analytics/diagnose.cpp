@@ -432,6 +432,28 @@ void report_fits(Setting& s, const Model& base, const SearchWithoutOutliers& fou
 
 }  // namespace
 
+// Rows identical in every cell (the response too) are most often one measurement pasted twice: each counts as its
+// own, narrowing every interval. Said, not refused: two runs can read the same to the digits recorded.
+void warn_identical_rows(const MeasuredData& data, DiagnoseResult& result) {
+    std::map<std::vector<std::string>, int> first_line;
+    std::vector<std::string> pairs;
+    std::size_t repeated = 0;
+    for (std::size_t r = 0; r < data.rows(); ++r) {
+        std::vector<std::string> cells;
+        for (const auto& c : data.columns) cells.push_back(c.text[r]);
+        const auto [it, fresh] = first_line.emplace(cells, data.lines[r]);
+        if (fresh) continue;
+        ++repeated;
+        if (pairs.size() < 3) pairs.push_back(std::to_string(it->second) + " and " + std::to_string(data.lines[r]));
+    }
+    if (repeated == 0) return;
+    std::string listed;
+    for (const auto& p : pairs) listed += (listed.empty() ? "" : "; ") + p;
+    result.warnings.push_back(std::to_string(repeated) + " row" + (repeated == 1 ? " repeats" : "s repeat") +
+                              " an earlier row in every cell (lines " + listed + (repeated > pairs.size() ? "; ..." : "") +
+                              "): a measurement pasted twice counts twice and narrows every interval");
+}
+
 DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name, const DiagnoseOptions& options) {
     const MeasuredKind kind = data_kind_of(model_name);
     validate_measured(data, kind);
@@ -457,6 +479,7 @@ DiagnoseResult diagnose(const MeasuredData& data, const std::string& model_name,
         throw std::invalid_argument(data.source + ": " + std::to_string(n) + " rows are too few to fit model " +
                                     model_name + " and test its residuals");
     if (model_name == "oldal-rect") warn_outside_oldal_rect_limits(data, result);
+    warn_identical_rows(data, result);
 
     const SearchWithoutOutliers found = search_without_outliers(s, base, options, result);
     result.effects = found.search.effects;

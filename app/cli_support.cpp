@@ -482,10 +482,15 @@ void check_paths_apart(const std::vector<NamedPath>& inputs, const std::vector<N
     }
 }
 
+std::string with_data_option(const std::string& message) {
+    return message.rfind("data file ", 0) == 0 ? "--data: " + message : message;
+}
+
 std::string with_option_name(const CLI::App& app, const std::string& message) {
     std::size_t n = 0;
     while (n < message.size() && (std::islower(static_cast<unsigned char>(message[n])) ||
-                                  std::isdigit(static_cast<unsigned char>(message[n])) || message[n] == '_'))
+                                  std::isdigit(static_cast<unsigned char>(message[n])) || message[n] == '_' ||
+                                  message[n] == '-'))
         ++n;
     if (n == 0 || (message.compare(n, 3, " = ") != 0 && message.compare(n, 2, ": ") != 0)) return message;
     const CLI::App* command = &app;
@@ -570,6 +575,24 @@ bool passes_arguments_on(const CLI::App& command) {
 
 // Refuses an option the command does not have, before `--`. CLI11 took it for a positional value of commands that
 // pass arguments on (vibration, cutoff: `-j 2` became a silo option) and named other words than the one mistyped.
+// Options that may be given more than once, each time with another value: NAME=LOW:HIGH ranges and bounds, the
+// columns that may change an effect. Any other option given twice kept its last value (a number) or joined the two
+// lists (--radii A,B,C --radii D,E,F was read as six radii), silently.
+const std::set<std::string> kRepeatableOptions{"range", "bounds", "regime-column"};
+
+void refuse_repeated_option(const CLI::Option& opt, const std::string& value, std::vector<std::string>& earlier) {
+    const std::string name = "--" + (opt.get_lnames().empty() ? opt.get_snames().front() : opt.get_lnames().front());
+    const bool repeatable = std::any_of(opt.get_lnames().begin(), opt.get_lnames().end(),
+                                        [](const std::string& n) { return kRepeatableOptions.count(n) > 0; });
+    if (!earlier.empty() && !repeatable)
+        throw UserError(name + " is given twice ('" + analytics::shortened_text(earlier.front(), 100) + "' and '" +
+                        analytics::shortened_text(value, 100) + "'): give it once" +
+                        (opt.get_items_expected_max() > 1 ? ", with all its values in one list" : ""));
+    if (std::find(earlier.begin(), earlier.end(), value) != earlier.end())
+        throw UserError(name + " = '" + analytics::shortened_text(value, 100) + "' is given twice");
+    earlier.push_back(value);
+}
+
 void check_options_known(const CLI::App& app, int argc, const char* const* argv) {
     std::vector<const CLI::App*> chain{&app};
     int i = 1;
@@ -587,6 +610,7 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
                 if (opt->check_name(name)) return opt;
         return nullptr;
     };
+    std::map<const CLI::Option*, std::vector<std::string>> given;  // each option's values as typed, in order
     for (; i < argc; ++i) {
         const std::string_view arg(argv[i]);
         if (arg == "--") break;  // a run's own options, checked by that run's command line
@@ -596,7 +620,9 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
         if (arg[1] != '-') name = std::string(arg.substr(0, 2));  // -j2: the short option -j with its value
         if (const CLI::Option* opt = option_named(name)) {
             // its value, whatever it looks like, is the option's to check ("--partition -x")
-            if (opt->get_items_expected_min() > 0 && name.size() == arg.size()) ++i;
+            std::string value = name.size() < arg.size() ? std::string(arg.substr(name.size() + (arg[1] == '-'))) : "";
+            if (opt->get_items_expected_min() > 0 && name.size() == arg.size() && i + 1 < argc) value = argv[++i];
+            if (opt->get_type_size_max() > 0) refuse_repeated_option(*opt, value, given[opt]);
             continue;
         }
         std::string command;

@@ -93,6 +93,8 @@ void check_side_files_free(const std::string& output, const std::vector<std::str
 // the file system resolves them: relative or absolute, "..", symbolic links. Throws UserError naming both options.
 void check_paths_apart(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
 
+// A reader's message about the measured-data file ("data file X is a folder") with the option that gave it, --data.
+std::string with_data_option(const std::string& message);
 // A library's refusal names its own field ("tol = 400 Hz: ...", "max_window = 2 s: ..."); where the command being run
 // has an option of that name (tol -> --tol, max_window -> --max-window), the message names the option as typed
 // instead. Only a message that starts with "FIELD = " or "FIELD: " changes; `app` is the parsed command line (its deepest

@@ -455,7 +455,7 @@ void print_calibration_summary(const CalibrateCli& o, const CalibrationResult& r
 void run_calibrate(CalibrateCli& o) {
     const auto& camp = o.study.campaign;
     if (!o.output.empty()) {  // before hours of calibration, not after
-        check_output_file(o.output, "--output");
+        check_output_file_in_new_folders(o.output, "--output");  // (made as it is written)
         check_output_outside_run_folders(o.output, "--output");
     }
     // nor on one of the reports this calibration writes into its campaign folder (its history was replaced)

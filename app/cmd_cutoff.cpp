@@ -2,6 +2,7 @@
 // small hopper of JKR spheres (kernel/cases/cohesive_hopper.hpp) or, with silo options after --, in the silo case
 // with a cohesive material (kernel/silo/silo_case.hpp); measured cases in examples/cohesive_arch/README.md.
 #include "app/cli_support.hpp"
+#include "kernel/walls/wall_motion.hpp"
 #include "app/commands.hpp"
 #include "app/result_files.hpp"
 #include "app/silo_campaign.hpp"
@@ -103,6 +104,19 @@ void check_search_size(const kc::CutoffSearch& s, double first_window, long max_
                                       (windows > 1 ? " x up to " + std::to_string(windows) + " windows" : ""));
 }
 
+// The lowest frequency the search can run (its low end, or from 0 its finest bisection) must still shake the bed:
+// a run below kMinVibrationPeakAcceleration is refused, which would end the search midway.
+void check_weakest_shaking(const kc::CutoffSearch& s, double amplitude) {
+    const double width = s.hi - s.lo;
+    if (!(width > 0) || !(s.tol > 0) || s.tol >= width) return;  // kc::validate names these
+    const double lowest = s.lo > 0 ? s.lo : std::ldexp(width, -static_cast<int>(std::ceil(std::log2(width / s.tol))));
+    if (const std::string defect = kernel::vibration_strength_defect(amplitude, lowest); !defect.empty())
+        throw UserError("--amplitude = " + analytics::number_text(amplitude) + " m with --bracket " +
+                        analytics::number_text(s.lo) + "," + analytics::number_text(s.hi) + " and --tol " +
+                        analytics::number_text(s.tol) + ": the lowest frequency the search may run, " + defect +
+                        "; give a larger amplitude, a coarser --tol or a higher low end");
+}
+
 kc::CutoffSearch search_from(const CutoffCli& o) {
     kc::CutoffSearch search;
     std::tie(search.lo, search.hi) = parse_bracket(o.bracket);
@@ -127,6 +141,7 @@ kc::CutoffSearch search_from(const CutoffCli& o) {
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
+    check_weakest_shaking(search, o.base.amplitude);
     return search;
 }
 

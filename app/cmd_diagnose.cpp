@@ -329,7 +329,7 @@ const char* const kAnalyticalOnlyOptions[] = {"--max-effects", "--regime-column"
 
 // The diagnosis on the console: the fit before, each effect added with its parameters and test, after, outliers,
 // warnings and what the data do not determine.
-void print_diagnosis(const analytics::DiagnoseResult& r) {
+void print_diagnosis(const analytics::DiagnoseResult& r, int max_effects) {
     std::cout << "model " << r.model << ": " << r.n << " rows, " << r.conditions << " conditions, " << r.folds
               << " CV folds\n"
               << "before: RMSE " << sci(r.before.rmse) << "  CV RMSE " << sci(r.before.cv_rmse) << "  MAPE "
@@ -341,7 +341,9 @@ void print_diagnosis(const analytics::DiagnoseResult& r) {
         std::cout << "p = " << sci(e.p_value) << " (Holm " << sci(e.p_holm) << ", " << e.candidates_tried
                   << " candidates), CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after) << "\n";
     }
-    if (r.effects.empty()) std::cout << "  no effect added: nothing significant and better out of sample\n";
+    if (r.effects.empty())
+        std::cout << (max_effects == 0 ? "  no effect searched for (--max-effects 0): the base model only\n"
+                                       : "  no effect added: nothing significant and better out of sample\n");
     std::cout << "after:  RMSE " << sci(r.after.rmse) << "  CV RMSE " << sci(r.after.cv_rmse) << "  MAPE "
               << sci(r.after.mape) << " %\n";
     for (const auto& o : r.outliers.rows)
@@ -398,14 +400,19 @@ void check_diagnosis_outputs(const DiagnoseArgs& a) {
 // 0, or 1 when the diagnosis is not determined by the data (and not --allow-undetermined): results are written.
 int run_diagnose(const DiagnoseArgs& a) {
     check_diagnosis_outputs(a);
-    const analytics::MeasuredData data =
-        analytics::read_measured_csv(a.data, analytics::data_kind_of(a.model), std::size_t(a.max_rows));
+    const analytics::MeasuredData data = [&] {
+        try {
+            return analytics::read_measured_csv(a.data, analytics::data_kind_of(a.model), std::size_t(a.max_rows));
+        } catch (const std::invalid_argument& e) {
+            throw UserError(with_data_option(e.what()));
+        }
+    }();
     auto options = a.options;
     options.names = {"--regime-column", "--effective-friction-deg", "--wall-friction-deg"};
     if (!std::isnan(a.effective_friction_deg)) options.effective_friction_deg = a.effective_friction_deg;
     if (!std::isnan(a.wall_friction_deg)) options.wall_friction_deg = a.wall_friction_deg;
     const analytics::DiagnoseResult r = analytics::diagnose(data, a.model, options);
-    print_diagnosis(r);
+    print_diagnosis(r, options.max_effects);
     write_diagnosis_files(a, r, data);
     if (r.undetermined.empty() || a.allow_undetermined) return 0;
     std::cout << "the diagnosis is not determined by these data (exit 1; --allow-undetermined: exit 0)\n";

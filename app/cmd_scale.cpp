@@ -64,7 +64,7 @@ void check_scale(const nlohmann::json& base, const ScaleCli& o, const calibratio
     if (!o.output.empty()) {
         if (fs::path(o.output).extension() != ".json")  // the table and plots take the same stem
             throw UserError("--output = '" + o.output + "': must end in .json");
-        check_output_file(o.output, "--output");
+        check_output_file_in_new_folders(o.output, "--output");  // (made as it is written)
         check_output_outside_run_folders(o.output, "--output");
     }
     check_paths_apart({{o.base_file, "base material"}}, {{output_of(o).string(), "--output"}});
@@ -108,8 +108,9 @@ void print_summary(const calibration::EnlargementStudy& study, const ScaleCli& o
     if (study.simulations_failed > 0)
         std::cout << study.simulations_failed << " runs failed (left out of their lines); "
                   << study.replacement_rounds << " rounds of fresh packings replaced them where a line could not be fitted\n";
-    std::cout << "results: "
-              << output_of(o).string() << " (Markdown: .md; plots: _macro, _cost, _laws)" << std::endl;
+    std::cout << "results: " << output_of(o).string()
+              << (o.no_plot ? " (Markdown: .md; no plot drawn, --no-plot)" : " (Markdown: .md; plots: _macro, _cost, _laws)")
+              << std::endl;
     for (const auto& w : study.warnings) std::cerr << "demcal: warning: " << w << "\n";
 }
 

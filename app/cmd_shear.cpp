@@ -285,7 +285,9 @@ void check_campaign_folder_argument(const std::string& dir, const std::string& c
     const std::string named = command + ": DIR = '" + analytics::shortened_text(dir, 200) + "'";
     if (fs::is_regular_file(dir, ec))
         throw UserError(named + " is a file, not a campaign folder: give the folder that holds it (" +
-                        analytics::shortened_text(fs::path(dir).parent_path().string(), 200) + ")");
+                        analytics::shortened_text(
+                            fs::path(dir).has_parent_path() ? fs::path(dir).parent_path().string() : ".", 200) +
+                        ")");
     const bool there = fs::exists(dir, ec);
     if (ec) return;  // a path the file system will not take (a link loop): named with its reason further on
     if (!there) throw UserError(named + " does not exist");

@@ -573,6 +573,10 @@ std::unique_ptr<orchestrator::FolderLock> lock_output_folder(const fs::path& dir
 // Refuses an output folder that holds an unfinished run's checkpoint, a finished run's results, or (in a folder no
 // silo run has held) a file of the user's that a run would replace.
 void check_out_folder_free(const fs::path& dir) {
+    // a run going on there first: its checkpoint is its own, not one to resume or remove (probe 60)
+    if (orchestrator::FolderLock::held(dir))
+        throw UserError("--out = '" + dir.string() + "' is in use by another demcal process (a silo run going on "
+                        "there): give another --out, or wait for that run to end");
     if (fs::exists(dir / kCheckpointName))
         throw UserError("--out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
@@ -671,20 +675,29 @@ void prepare_outputs(const SiloCli& o, const fs::path& dir, ks::SiloCaseSettings
     outputs.insert(outputs.end(), {{o.export_bed, "--export-bed"}, {o.export_final_bed, "--export-final-bed"},
                                    {o.export_cloud, "--export-cloud"}});
     check_paths_apart({{o.material_file, "--material"}, {o.geometry_file, "--geometry"}}, outputs);
+    // a bed exported into the --out folder, which the run makes before it writes anything, is not refused for that
+    // folder's absence (it was: "the folder s20 does not exist")
+    const auto check_export = [&dir](const std::string& file, const char* option) {
+        const fs::path parent = fs::absolute(fs::path(file)).lexically_normal().parent_path();
+        if (parent == fs::absolute(dir).lexically_normal() && !fs::exists(dir))
+            check_output_file_in_new_folders(file, option);
+        else
+            check_output_file(file, option);
+    };
     if (!o.export_bed.empty()) {
-        check_output_file(o.export_bed, "--export-bed");
+        check_export(o.export_bed, "--export-bed");
         s.at_opening = [file = o.export_bed, settings = s](const ks::BedSnapshot& bed) {
             write_silo_bed(file, bed, settings, BedMoment::opening, "export-bed");
         };
     }
     if (!o.export_final_bed.empty()) {
-        check_output_file(o.export_final_bed, "--export-final-bed");
+        check_export(o.export_final_bed, "--export-final-bed");
         s.at_end = [file = o.export_final_bed, settings = s](const ks::BedSnapshot& bed) {
             write_silo_bed(file, bed, settings, BedMoment::end, "export-final-bed");
         };
     }
     if (!o.export_cloud.empty()) {
-        check_output_file(o.export_cloud, "--export-cloud");
+        check_export(o.export_cloud, "--export-cloud");
         s.at_generation = [file = o.export_cloud, settings = s](const ks::BedSnapshot& bed) {
             write_silo_bed(file, bed, settings, BedMoment::generation, "export-cloud");
         };

@@ -364,7 +364,7 @@ SiloDemInputs read_silo_dem_inputs(const SiloDemArgs& a) {
     try {
         data = an::read_silo_measurements(a.data);
     } catch (const std::invalid_argument& e) {
-        throw UserError(e.what());
+        throw UserError(with_data_option(e.what()));
     }
     std::vector<std::string> owned = kOwnedSiloOptions;
     for (const auto& g : kGeometryColumns)

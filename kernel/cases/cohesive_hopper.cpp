@@ -75,11 +75,10 @@ void validate(const CohesiveHopperCase& c) {
     check(1.0 / c.frequency >= 20 * dt, "frequency", c.frequency, "leaves fewer than 20 time steps per period");
   }
   // last: the rules above name the grains' softness and the time step, the more telling reasons
-  const double peak = c.amplitude * std::pow(2 * M_PI * c.frequency, 2);
-  check(peak <= kMaxVibrationPeakAcceleration, "amplitude", c.amplitude,
-        "at " + silo::setting_text(c.frequency) + " Hz gives a peak acceleration of " + silo::setting_text(peak / 9.81) +
-            " g, above the " + silo::setting_text(kMaxVibrationPeakAcceleration / 9.81) +
-            " g a vibrated bed is checked for (the seed's largest: 9.3 g)");
+  if (c.frequency > 0 && c.amplitude > 0) {
+    const std::string defect = vibration_strength_defect(c.amplitude, c.frequency);
+    check(defect.empty(), "amplitude", c.amplitude, defect);
+  }
 }
 
 CohesiveHopperOutcome run_cohesive_hopper(const CohesiveHopperCase& c) {

@@ -58,12 +58,9 @@ void validate(const BinVibration& v) {
 }
 
 void validate_strength(const BinVibration& v) {
-    if (v.peak_acceleration() > kMaxVibrationPeakAcceleration)
-        reject_setting("vibration_amplitude", v.amplitude,
-                       "at " + setting_text(v.frequency) + " Hz gives a peak acceleration of " +
-                           setting_text(v.peak_acceleration() / 9.81) + " g, above the " +
-                           setting_text(kMaxVibrationPeakAcceleration / 9.81) +
-                           " g a vibrated bin is checked for (the seed's largest: 9.3 g)");
+    if (!(v.frequency > 0 && v.amplitude > 0)) return;  // a still bin (its settings are refused elsewhere)
+    if (const std::string defect = vibration_strength_defect(v.amplitude, v.frequency); !defect.empty())
+        reject_setting("vibration_amplitude", v.amplitude, defect);
 }
 
 BinVibrationMotion::BinVibrationMotion(const BinVibration& v) : v_(v) { validate(v_); }

@@ -3,6 +3,7 @@
 // driver sets (BasicSimulation::set_wall_velocity: a servo-held lid, a shear frame), zero unless set.
 #pragma once
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +28,31 @@ class WallMotion {
 /// (the frequency limit) is 443 g; far above, the walls throw the grains about rather than vibrate a bed (2 mm at
 /// 400 Hz, 1288 g, was searched for a cohesive arch and called one "arched"; 1 cm at 1000 Hz is 40,000 g).
 inline constexpr double kMaxVibrationPeakAcceleration = 500 * 9.81;
+
+/// The weakest shaking a case accepts: a peak acceleration of 1e-4 g. Below it the wall pushes a grain with less than
+/// a ten-thousandth of its weight, far under the force scatter of a packed bed: 0.01 Hz or 1e-12 m shook nothing and
+/// were reported as vibrated runs (probe 59b). The seed's amplitude, 0.11 mm, reaches it at 0.48 Hz.
+inline constexpr double kMinVibrationPeakAcceleration = 1e-4 * 9.81;
+
+/// Why shaking of amplitude A [m] and frequency f [Hz] (both > 0) is not a vibration a case simulates (its peak
+/// acceleration A (2 pi f)^2 outside [kMinVibrationPeakAcceleration, kMaxVibrationPeakAcceleration]), or "".
+inline std::string vibration_strength_defect(double amplitude, double frequency) {
+  const double peak = amplitude * std::pow(2 * M_PI * frequency, 2);
+  if (peak >= kMinVibrationPeakAcceleration && peak <= kMaxVibrationPeakAcceleration) return "";
+  const auto g = [](double a) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", a / 9.81);
+    return std::string(text);
+  };
+  char hz[32];
+  std::snprintf(hz, sizeof hz, "%g", frequency);
+  return std::string("at ") + hz + " Hz gives a peak acceleration of " + g(peak) + " g, " +
+         (peak > kMaxVibrationPeakAcceleration
+              ? "above the " + g(kMaxVibrationPeakAcceleration) +
+                    " g a vibrated bed is checked for (the seed's largest: 9.3 g): it throws the grains about"
+              : "below the " + g(kMinVibrationPeakAcceleration) +
+                    " g a vibrated bed is checked for: it shakes nothing (the seed: 0.11 mm at up to 145 Hz)");
+}
 
 /// d(t) = A sin(2 pi f (t - t0)) e for t >= t0, 0 before: a vibrator (the seed's eccentric vibrator on the bin).
 class SinusoidalMotion final : public WallMotion {

@@ -101,6 +101,22 @@ TEST_CASE("diagnose of degenerate data - identical rows get no effect and are no
     for (const auto& w : r.undetermined) said = said || w.find("no scatter to test an effect against") != std::string::npos;
     CHECK(said);
     CHECK(r.to_json().at("determined") == false);
+    bool repeats = false;
+    for (const auto& w : r.warnings) repeats = repeats || w.find("rows repeat an earlier row in every cell") != std::string::npos;
+    CHECK(repeats);
+    // one row pasted twice into a clean set: fitted, and said (held-back suite: no word of it)
+    auto pasted = make_synthetic_set(spec("oldal", "moisture", 0.2, 7));
+    for (auto& c : pasted.columns) {
+        if (c.numeric) c.values.push_back(c.values.front());
+        c.text.push_back(c.text.front());
+    }
+    pasted.lines.push_back(pasted.lines.back() + 1);
+    const auto twice = diagnose(pasted, "oldal");
+    bool said_twice = false;
+    for (const auto& w : twice.warnings)
+        said_twice = said_twice || w.find("1 row repeats an earlier row in every cell (lines " +
+                                          std::to_string(pasted.lines.front()) + " and ") != std::string::npos;
+    CHECK(said_twice);
     // a failure line with every stress equal has no slope to fit
     auto shear = make_synthetic_set(spec("failure-line", "none", 0, 3));
     auto& sigma = const_cast<demcal::analytics::DataColumn&>(shear.at("sigma_Pa"));
