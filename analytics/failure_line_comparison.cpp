@@ -46,7 +46,7 @@ nlohmann::json ParameterComparison::to_json() const {
 }
 
 nlohmann::json FailureLineComparison::to_json() const {
-    return {{"mu_b", mu_b.to_json()}, {"tau_c", tau_c.to_json()}, {"agree", agree()}};
+    return {{"mu_b", mu_b.to_json()}, {"tau_c", tau_c.to_json()}, {"agree", agree()}, {"conclusive", conclusive()}};
 }
 
 FailureLineComparison compare_failure_lines(const FailureLine& a, const FailureLine& b) {

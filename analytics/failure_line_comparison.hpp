@@ -23,6 +23,9 @@ struct ParameterComparison {
 struct FailureLineComparison {
     ParameterComparison mu_b, tau_c;
     bool agree() const { return mu_b.within_combined_intervals() && tau_c.within_combined_intervals(); }
+    // An agreement means something only when the intervals could have told the lines apart: a combined half-width on
+    // mu_b of at least half of mu_b agrees with anything (-r 1: 5.1 on mu_b 0.6). A difference is conclusive as is.
+    bool conclusive() const { return !agree() || mu_b.combined_half_width < 0.5 * std::abs(0.5 * (mu_b.a + mu_b.b)); }
     nlohmann::json to_json() const;
 };
 

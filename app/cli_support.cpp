@@ -452,6 +452,17 @@ void check_output_file_in_new_folders(const std::string& path, const std::string
     check_files_can_be_created_below(parent, named);
 }
 
+void check_output_in_campaign_or_existing_folder(const std::string& path, const std::string& option,
+                                                 const std::string& campaign_dir) {
+    namespace fs = std::filesystem;
+    const fs::path parent = fs::absolute(fs::path(path)).lexically_normal().parent_path();
+    const fs::path campaign = fs::absolute(fs::path(campaign_dir)).lexically_normal();
+    const auto [end, rest] = std::mismatch(campaign.begin(), campaign.end(), parent.begin(), parent.end());
+    if (!campaign_dir.empty() && end == campaign.end())  // the campaign folder or below: the command makes it
+        return check_output_file_in_new_folders(path, option);
+    check_output_file(path, option);
+}
+
 namespace {
 // The path as the file system resolves it (absolute, "." and ".." and links of its existing part resolved), so that
 // two spellings of one file compare equal.

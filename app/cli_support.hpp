@@ -75,6 +75,10 @@ void check_output_folder(const std::string& path, const std::string& option);
 // must allow files to be created (check_output_folder; the file, when it exists, as above). An empty path (output
 // not asked for) passes.
 void check_output_file_in_new_folders(const std::string& path, const std::string& option);
+// An output file that may lie in the campaign folder the command makes (or below it, made as it is written), or
+// else in a folder that exists (a typo elsewhere is refused, not made after hours of work).
+void check_output_in_campaign_or_existing_folder(const std::string& path, const std::string& option,
+                                                 const std::string& campaign_dir);
 
 // A path a command reads or writes, with the option (or field) that gave it, for the messages.
 struct NamedPath {

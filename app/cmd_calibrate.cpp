@@ -38,6 +38,21 @@ namespace {
 void check_study_matches_start(const SensitivityStudy& study, const nlohmann::json& start, const std::string& file) {
     nlohmann::json base = study.base_material, here = start;
     for (const auto& p : study.parameters) {
+        // a studied parameter may start elsewhere in its studied range (the search moves it there anyway), not
+        // outside it, where the study measured nothing (held-back suite: friction 0.3 against a study of 0.5)
+        if (here.contains(p.name) && here[p.name].is_number()) {
+            const double v = here[p.name].get<double>();
+            if (v < p.low() || v > p.high())
+                throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': the start material's " +
+                                p.name + " = " + analytics::number_text(v) + " lies outside the range the study " +
+                                "varied (" + analytics::number_text(p.low()) + " to " + analytics::number_text(p.high()) +
+                                " around " + analytics::number_text(p.base_value) + "): run the study around this " +
+                                "start, or start inside that range");
+            if (v != p.base_value)
+                std::cerr << "demcal: warning: --start's " << p.name << " = " << analytics::number_text(v)
+                          << " is not the study's base (" << analytics::number_text(p.base_value)
+                          << "): its responses, measured around the base, steer the search from there" << std::endl;
+        }
         base.erase(p.name);
         here.erase(p.name);
     }
@@ -455,7 +470,7 @@ void print_calibration_summary(const CalibrateCli& o, const CalibrationResult& r
 void run_calibrate(CalibrateCli& o) {
     const auto& camp = o.study.campaign;
     if (!o.output.empty()) {  // before hours of calibration, not after
-        check_output_file_in_new_folders(o.output, "--output");  // (made as it is written)
+        check_output_in_campaign_or_existing_folder(o.output, "--output", camp.campaign_dir);
         check_output_outside_run_folders(o.output, "--output");
     }
     // nor on one of the reports this calibration writes into its campaign folder (its history was replaced)

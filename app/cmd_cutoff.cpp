@@ -2,6 +2,8 @@
 // small hopper of JKR spheres (kernel/cases/cohesive_hopper.hpp) or, with silo options after --, in the silo case
 // with a cohesive material (kernel/silo/silo_case.hpp); measured cases in examples/cohesive_arch/README.md.
 #include "app/cli_support.hpp"
+#include "orchestrator/campaign_suspended.hpp"
+#include "orchestrator/executor.hpp"
 #include "kernel/walls/wall_motion.hpp"
 #include "app/commands.hpp"
 #include "app/result_files.hpp"
@@ -110,6 +112,7 @@ void check_weakest_shaking(const kc::CutoffSearch& s, double amplitude) {
     const double width = s.hi - s.lo;
     if (!(width > 0) || !(s.tol > 0) || s.tol >= width) return;  // kc::validate names these
     const double lowest = s.lo > 0 ? s.lo : std::ldexp(width, -static_cast<int>(std::ceil(std::log2(width / s.tol))));
+    if (amplitude * std::pow(2 * M_PI * lowest, 2) >= kernel::kMinVibrationPeakAcceleration) return;  // (the top: validate)
     if (const std::string defect = kernel::vibration_strength_defect(amplitude, lowest); !defect.empty())
         throw UserError("--amplitude = " + analytics::number_text(amplitude) + " m with --bracket " +
                         analytics::number_text(s.lo) + "," + analytics::number_text(s.hi) + " and --tol " +
@@ -407,6 +410,17 @@ int run(const CutoffCli& o, CLI::App& sub) {
                         {"window_s", c.window}, {"end", end}, {"flows", flows}, {"decided", decided},
                         {"wall_s", r.wall_s}});
     };
+    // SIGINT, SIGTERM, SIGHUP: the run under way ends, then the search stops (exit 75), where the signal killed it
+    // (exit 143, no word, nothing kept). The small hopper keeps no checkpoint: the same command starts over.
+    const orchestrator::InterruptGuard interrupts;
+    const auto report_then_stop_if_asked = [&](const kc::CohesiveHopperCase& c, const kc::CohesiveHopperOutcome& r) {
+        report(c, r);
+        if (orchestrator::interrupted())
+            throw orchestrator::CampaignSuspended(
+                "interrupted after " + std::to_string(runs.size()) + " run" + (runs.size() == 1 ? "" : "s") +
+                " of the small hopper's search (printed above); it keeps no checkpoint: run the same command again "
+                "to search afresh");
+    };
     kc::CutoffResult res;
     try {
         kc::validate(o.base, search);  // before the first run
@@ -416,7 +430,7 @@ int run(const CutoffCli& o, CLI::App& sub) {
                     search.seeds.size(), kc::flow_criterion_text(search.criterion).c_str(),
                     ladder_text(kc::window_ladder(o.base.window, search.longest_window)).c_str());
         std::fflush(stdout);  // before minutes of runs: a search stopped by a signal keeps what it printed
-        res = kc::find_cutoff(o.base, search, report);
+        res = kc::find_cutoff(o.base, search, report_then_stop_if_asked);
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }

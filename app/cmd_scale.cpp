@@ -64,7 +64,7 @@ void check_scale(const nlohmann::json& base, const ScaleCli& o, const calibratio
     if (!o.output.empty()) {
         if (fs::path(o.output).extension() != ".json")  // the table and plots take the same stem
             throw UserError("--output = '" + o.output + "': must end in .json");
-        check_output_file_in_new_folders(o.output, "--output");  // (made as it is written)
+        check_output_in_campaign_or_existing_folder(o.output, "--output", o.campaign.campaign_dir);
         check_output_outside_run_folders(o.output, "--output");
     }
     check_paths_apart({{o.base_file, "base material"}}, {{output_of(o).string(), "--output"}});

@@ -93,10 +93,15 @@ constexpr int kExitSuspended = 75;
 
 constexpr const char* kCheckpointName = "checkpoint.bin";
 // Every file a run writes into its --out folder (write_outputs, the checkpoint): an exported bed must not take one.
+// The session options a run was started with (--threads, --checkpoint-every, --no-plots), for its resumes: a run
+// started on one thread without plots resumed on every core and drew plots (needing gnuplot) unless they were given
+// again (probe 60). Options given to --resume override them.
+constexpr const char* kSessionFileName = "session.json";
+
 constexpr const char* kRunFiles[] = {kCheckpointName,       "summary.json",         "discharge.csv",
                                      "section.png",         "discharge.png",        "section.dat",
                                      "section_outline.dat", "section.png.gp",       "section.png.gp.log",
-                                     "discharge.png.gp",    "discharge.png.gp.log"};
+                                     "discharge.png.gp",    "discharge.png.gp.log", kSessionFileName};
 
 // A stop signal (orchestrator/stop_signals.hpp: SIGTERM from kill, scancel or a batch system's time limit, SIGINT from
 // Ctrl-C, SIGHUP from a closed terminal or ssh session) during a checkpointed run: the run ends the step it is in,
@@ -575,8 +580,8 @@ std::unique_ptr<orchestrator::FolderLock> lock_output_folder(const fs::path& dir
 void check_out_folder_free(const fs::path& dir) {
     // a run going on there first: its checkpoint is its own, not one to resume or remove (probe 60)
     if (orchestrator::FolderLock::held(dir))
-        throw UserError("--out = '" + dir.string() + "' is in use by another demcal process (a silo run going on "
-                        "there): give another --out, or wait for that run to end");
+        throw UserError("--out = '" + dir.string() + "': the silo output folder is in use by another demcal process "
+                        "(a silo run going on there): give another --out, or wait for that run to end");
     if (fs::exists(dir / kCheckpointName))
         throw UserError("--out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
@@ -760,6 +765,11 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
         s.checkpoint_interval = o.checkpoint_every;
     }
     s.wall_limit = o.wall_limit;
+    if (!o.no_checkpoint)
+        orchestrator::write_text_file_atomically(
+            dir / kSessionFileName, nlohmann::json{{"threads", o.threads},
+                                                   {"checkpoint_every", o.checkpoint_every},
+                                                   {"no_plots", o.no_plots}}.dump(1) + "\n");
     print_run_header(s, dir);
     std::optional<StopOnSignal> stop_on_signal;  // without a checkpoint there is nothing to stop to
     if (!s.checkpoint_file.empty()) {
@@ -769,8 +779,26 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
     write_outputs(dir, s, ks::run_silo_case(s, print_progress), o.no_plots);
 }
 
+// The session options of the run in `dir` (session.json) where --resume was not given them; the options as given
+// where the file is missing (a run of a demcal before it).
+SiloCli with_stored_session(const SiloCli& given, CLI::App& sub, const fs::path& dir) {
+    SiloCli o = given;
+    if (given.resume.empty() || !fs::is_regular_file(dir / kSessionFileName)) return o;
+    const nlohmann::json stored = read_json_file((dir / kSessionFileName).string(), "the run's session options");
+    try {
+        if (!sub.count("--threads")) o.threads = stored.at("threads").get<int>();
+        if (!sub.count("--checkpoint-every")) o.checkpoint_every = stored.at("checkpoint_every").get<double>();
+        if (!sub.count("--no-plots")) o.no_plots = stored.at("no_plots").get<bool>();
+    } catch (const nlohmann::json::exception& e) {
+        throw UserError("resume = '" + dir.string() + "': " + (dir / kSessionFileName).string() +
+                        " is not the run's session options (" + e.what() + "); remove it to resume with the defaults");
+    }
+    return o;
+}
+
 // Continues the run whose checkpoint lies in o.resume, with the settings stored in it.
-void resume_silo(const SiloCli& o, CLI::App& sub) {
+void resume_silo(const SiloCli& given, CLI::App& sub) {
+    const SiloCli o = with_stored_session(given, sub, fs::path(given.resume));
     for (const auto* opt : sub.get_options()) {
         const std::string name = opt->get_name();
         if (opt->count() > 0 && name != "--resume" && name != "--threads" && name != "--checkpoint-every" &&

@@ -368,6 +368,13 @@ json silo_run_identity(const SiloRunPlan& plan) {
 // differs. A folder without run.json (not begun, or from a demcal before it) is taken as it is.
 void check_run_folder_identity(const fs::path& rd, const json& identity, const std::string& command) {
     const fs::path file = rd / kRunIdentityFile;
+    // a checkpoint without the folder's run.json cannot be told from another run's (a folder copied in): resumed,
+    // a 1000-grain run was reported as a 300-grain sweep's cell (held-back suite). Finished runs of a demcal before
+    // run.json (summary.json alone) are still taken.
+    if (!fs::exists(fs::symlink_status(file)) && fs::exists(fs::symlink_status(rd / "checkpoint.bin")))
+        throw UserError("demcal " + command + ": the run folder " + rd.string() + " holds a checkpoint but no " +
+                        kRunIdentityFile + ", so nothing tells that it is this campaign's run (a folder copied in?): "
+                        "remove it to run it again");
     if (!fs::exists(fs::symlink_status(file))) return;
     json stored;
     try {

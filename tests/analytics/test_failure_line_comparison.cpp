@@ -72,3 +72,17 @@ TEST_CASE("lines with intervals at different levels are not combined", "[analyti
     CHECK(c.mu_b.confidence == 0.90);
     CHECK(c.to_json()["mu_b"].contains("combined_half_width_90"));  // the key names the level it holds
 }
+
+TEST_CASE("an agreement within intervals wider than the slope is inconclusive", "[analytics][failure_line_comparison]") {
+    // one packing per stress and a noise near the shear stresses themselves: intervals that hold any slope
+    const auto a = noisy_line(0.6, 1000, 4000, 11, 1), b = noisy_line(0.3, 1000, 4000, 12, 1);
+    const auto wide = compare_failure_lines(a, b);
+    REQUIRE(wide.agree());
+    CHECK_FALSE(wide.conclusive());
+    CHECK(wide.to_json().at("conclusive") == false);
+    // narrow intervals: an agreement, and a difference, are both conclusive
+    const auto same = compare_failure_lines(noisy_line(0.8, 1000, 300, 1), noisy_line(0.8, 1000, 300, 2));
+    CHECK((same.agree() && same.conclusive()));
+    const auto apart = compare_failure_lines(noisy_line(0.8, 1000, 30, 3), noisy_line(0.95, 1000, 30, 4));
+    CHECK((!apart.agree() && apart.conclusive()));
+}

@@ -366,6 +366,11 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM or SIGHUP res
     CHECK(fs::exists(ckpt));
     CHECK_FALSE(fs::exists(out / "summary.json"));
     CHECK_THAT(read_file(dir / "out.log"), Catch::Matchers::Contains("suspended: wall limit"));
+    // a resume without session options runs with the run's own (session.json): one thread, no plots, checkpoints
+    // every 0.1 s, where it ran on every core and drew plots (probe 60)
+    const Run own = run_silo("--resume '" + out.string() + "' --wall-limit 0.001", dir);
+    CHECK(own.rc == 75);
+    CHECK_THAT(read_file(dir / "out.log"), Catch::Matchers::Contains("\n  1 thread(s)"));
 
     // a session stopped by a signal once it steps: SIGTERM (a batch system's time limit, scancel) and SIGHUP (the
     // terminal or the ssh session closed) make the same clean stop as the wall limit
@@ -410,8 +415,9 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM or SIGHUP res
     REQUIRE(WEXITSTATUS(nohup_status) == 0);
     CHECK(read_file(out / "discharge.csv") == read_file(dir / "whole" / "discharge.csv"));
     const std::string summary = read_file(out / "summary.json");
-    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 5"));
-    CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 5"));
+    // the first, the wall-limited one, the one on its own session options, SIGTERM's, SIGHUP's and nohup's
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"sessions\": 6"));
+    CHECK_THAT(summary, Catch::Matchers::Contains("\"cpu_sessions\": 6"));
     // the CPU split at the opening survives the sessions: the filling's part from the checkpoint
     const auto j = nlohmann::json::parse(summary);
     const double fill_cpu = j["fill"]["cpu_s"].get<double>(), discharge_cpu = j["discharge"]["cpu_s"].get<double>();

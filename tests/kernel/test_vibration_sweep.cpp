@@ -128,6 +128,15 @@ TEST_CASE("demcal vibration: a tiny sweep, continued by the same command without
              Catch::Matchers::Contains("theta45_f100_seed1 holds a run of other settings") &&
                  Catch::Matchers::Contains("0.00022") && Catch::Matchers::Contains("remove it"));
   CHECK(demcal::test::read_file(campaign / "vibration.json") == report_before);
+  // a suspended run's folder without run.json (a direct `silo --out` run copied in): its checkpoint cannot be told
+  // from this campaign's run, and was resumed as it (held-back suite: a 1000-grain run in a 300-grain sweep)
+  fs::remove_all(campaign / "runs" / "theta45_f100_seed1");
+  fs::create_directories(campaign / "runs" / "theta45_f100_seed1");
+  std::ofstream(campaign / "runs" / "theta45_f100_seed1" / "checkpoint.bin") << "a checkpoint of some other run";
+  CHECK(demcal_run(grown, dir / "checkpoint.log") == 2);
+  CHECK_THAT(demcal::test::read_file(dir / "checkpoint.log"),
+             Catch::Matchers::Contains("holds a checkpoint but no run.json"));
+  CHECK(demcal::test::read_file(campaign / "vibration.json") == report_before);
   fs::remove_all(dir);
 }
 

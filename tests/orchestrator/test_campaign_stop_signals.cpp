@@ -104,3 +104,25 @@ TEST_CASE("a silo sweep killed with -9 takes its runs with it, and the same comm
     CHECK_FALSE(fs::exists(camp / "runs" / "theta70_f0_seed1" / "failed"));
     fs::remove_all(dir);
 }
+
+TEST_CASE("the small hopper's cut-off search stopped by SIGTERM ends its run and exits 75, saying so",
+          "[kernel_engine][signals]") {
+    // held-back suite: SIGTERM killed the search (exit 143), no word, nothing kept
+    const fs::path dir = test::fresh_test_dir("cutoff-sigterm");
+    const int pid = test::spawn_demcal({"cutoff", "--grains", "200", "--tol", "50", "--window", "1", "--json",
+                                        (dir / "hop.json").string()},
+                                       dir / "cutoff.log");
+    REQUIRE(pid > 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    int status = 0;
+    REQUIRE(::waitpid(pid, &status, WNOHANG) == 0);  // still searching
+    ::kill(pid, SIGTERM);
+    ::waitpid(pid, &status, 0);
+    INFO(test::read_file(dir / "cutoff.log"));
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 75);
+    CHECK_THAT(test::read_file(dir / "cutoff.log"),
+               Catch::Matchers::Contains("interrupted after") && Catch::Matchers::Contains("run the same command again"));
+    CHECK_FALSE(fs::exists(dir / "hop.json"));  // no result of a search not ended
+    fs::remove_all(dir);
+}

@@ -49,7 +49,7 @@ TEST_CASE("an unreachable SLURM controller stops a campaign for a resume, its ru
     fs::remove_all(dir);
 }
 
-TEST_CASE("--executor slurm without sbatch on PATH is refused before a campaign is written", "[cli]") {
+TEST_CASE("the SLURM executor asked for without sbatch on PATH is refused before a campaign is written", "[cli]") {
     // probe 60: the refusal came after the store, the run folders and a 6.5 MB program copy had been written
     const fs::path dir = test::fresh_test_dir("slurm-absent");
     fs::create_directories(dir / "empty-path");
