@@ -449,8 +449,9 @@ void warn_identical_rows(const MeasuredData& data, DiagnoseResult& result) {
     if (repeated == 0) return;
     std::string listed;
     for (const auto& p : pairs) listed += (listed.empty() ? "" : "; ") + p;
-    result.warnings.push_back(std::to_string(repeated) + " row" + (repeated == 1 ? " repeats" : "s repeat") +
-                              " an earlier row in every cell (lines " + listed + (repeated > pairs.size() ? "; ..." : "") +
+    result.warnings.push_back(std::to_string(repeated) + " duplicate row" + (repeated == 1 ? "" : "s") + ", equal to " +
+                              (repeated == 1 ? "an earlier row" : "earlier rows") + " in every cell (lines " + listed +
+                              (repeated > pairs.size() ? "; ..." : "") +
                               "): a measurement pasted twice counts twice and narrows every interval");
 }
 

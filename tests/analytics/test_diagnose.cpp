@@ -102,7 +102,7 @@ TEST_CASE("diagnose of degenerate data - identical rows get no effect and are no
     CHECK(said);
     CHECK(r.to_json().at("determined") == false);
     bool repeats = false;
-    for (const auto& w : r.warnings) repeats = repeats || w.find("rows repeat an earlier row in every cell") != std::string::npos;
+    for (const auto& w : r.warnings) repeats = repeats || w.find("duplicate rows, equal to earlier rows in every cell") != std::string::npos;
     CHECK(repeats);
     // one row pasted twice into a clean set: fitted, and said (held-back suite: no word of it)
     auto pasted = make_synthetic_set(spec("oldal", "moisture", 0.2, 7));
@@ -114,7 +114,7 @@ TEST_CASE("diagnose of degenerate data - identical rows get no effect and are no
     const auto twice = diagnose(pasted, "oldal");
     bool said_twice = false;
     for (const auto& w : twice.warnings)
-        said_twice = said_twice || w.find("1 row repeats an earlier row in every cell (lines " +
+        said_twice = said_twice || w.find("1 duplicate row, equal to an earlier row in every cell (lines " +
                                           std::to_string(pasted.lines.front()) + " and ") != std::string::npos;
     CHECK(said_twice);
     // a failure line with every stress equal has no slope to fit
