@@ -452,11 +452,16 @@ void check_output_file_in_new_folders(const std::string& path, const std::string
     check_files_can_be_created_below(parent, named);
 }
 
+std::filesystem::path without_trailing_separator(const std::filesystem::path& p) {
+    // "dir/" and "dir/." are the folder dir: lexically_normal keeps an empty last part that no comparison matches
+    return p.has_filename() || !p.has_parent_path() || p == p.root_path() ? p : p.parent_path();
+}
+
 void check_output_in_campaign_or_existing_folder(const std::string& path, const std::string& option,
                                                  const std::string& campaign_dir) {
     namespace fs = std::filesystem;
-    const fs::path parent = fs::absolute(fs::path(path)).lexically_normal().parent_path();
-    const fs::path campaign = fs::absolute(fs::path(campaign_dir)).lexically_normal();
+    const fs::path parent = without_trailing_separator(fs::absolute(fs::path(path)).lexically_normal().parent_path());
+    const fs::path campaign = without_trailing_separator(fs::absolute(fs::path(campaign_dir)).lexically_normal());
     const auto [end, rest] = std::mismatch(campaign.begin(), campaign.end(), parent.begin(), parent.end());
     if (!campaign_dir.empty() && end == campaign.end())  // the campaign folder or below: the command makes it
         return check_output_file_in_new_folders(path, option);
@@ -633,7 +638,9 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
             // its value, whatever it looks like, is the option's to check ("--partition -x")
             std::string value = name.size() < arg.size() ? std::string(arg.substr(name.size() + (arg[1] == '-'))) : "";
             if (opt->get_items_expected_min() > 0 && name.size() == arg.size() && i + 1 < argc) value = argv[++i];
-            if (opt->get_type_size_max() > 0) refuse_repeated_option(*opt, value, given[opt]);
+            // (a flag given twice says the same thing twice: harmless, and it has no value to name)
+            if (opt->get_expected_max() > 0 && opt->get_type_size_max() > 0)
+                refuse_repeated_option(*opt, value, given[opt]);
             continue;
         }
         std::string command;

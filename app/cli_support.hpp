@@ -77,6 +77,8 @@ void check_output_folder(const std::string& path, const std::string& option);
 void check_output_file_in_new_folders(const std::string& path, const std::string& option);
 // An output file that may lie in the campaign folder the command makes (or below it, made as it is written), or
 // else in a folder that exists (a typo elsewhere is refused, not made after hours of work).
+// The folder `p` names, written without a trailing separator ("out/" and "out/." are "out").
+std::filesystem::path without_trailing_separator(const std::filesystem::path& p);
 void check_output_in_campaign_or_existing_folder(const std::string& path, const std::string& option,
                                                  const std::string& campaign_dir);
 

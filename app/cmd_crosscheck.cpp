@@ -262,8 +262,9 @@ int run_crosscheck(const CrosscheckOptions& opt) {
                   << " within their combined 95 % intervals\n";
         if (!peak->conclusive())
             std::cout << "the comparison is INCONCLUSIVE: the combined 95 % half-width on mu_b is "
-                      << analytics::number_text(peak->mu_b.combined_half_width, 3) << ", at least half of mu_b ("
-                      << analytics::number_text(0.5 * (peak->mu_b.a + peak->mu_b.b), 3)
+                      << analytics::number_text(peak->mu_b.combined_half_width, 3) << ", at least half of mu_b (half of "
+                      << analytics::number_text(0.5 * (peak->mu_b.a + peak->mu_b.b), 3) << " is "
+                      << analytics::number_text(0.25 * (peak->mu_b.a + peak->mu_b.b), 3)
                       << "), so any two lines would agree; more --replicates or stresses narrow it\n";
     }
     write_result_file(report, crosscheck_json(opt, specs.at(ShearEngine::yade).material, r, peak, residual).dump(2) +

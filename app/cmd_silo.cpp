@@ -98,6 +98,9 @@ constexpr const char* kCheckpointName = "checkpoint.bin";
 // again (probe 60). Options given to --resume override them.
 constexpr const char* kSessionFileName = "session.json";
 
+// The most OpenMP threads a run takes (--threads; a stored session's value is held to it too).
+constexpr int kMaxThreads = 256;
+
 constexpr const char* kRunFiles[] = {kCheckpointName,       "summary.json",         "discharge.csv",
                                      "section.png",         "discharge.png",        "section.dat",
                                      "section_outline.dat", "section.png.gp",       "section.png.gp.log",
@@ -683,8 +686,8 @@ void prepare_outputs(const SiloCli& o, const fs::path& dir, ks::SiloCaseSettings
     // a bed exported into the --out folder, which the run makes before it writes anything, is not refused for that
     // folder's absence (it was: "the folder s20 does not exist")
     const auto check_export = [&dir](const std::string& file, const char* option) {
-        const fs::path parent = fs::absolute(fs::path(file)).lexically_normal().parent_path();
-        if (parent == fs::absolute(dir).lexically_normal() && !fs::exists(dir))
+        const fs::path parent = without_trailing_separator(fs::absolute(fs::path(file)).lexically_normal().parent_path());
+        if (parent == without_trailing_separator(fs::absolute(dir).lexically_normal()) && !fs::exists(dir))
             check_output_file_in_new_folders(file, option);
         else
             check_output_file(file, option);
@@ -780,18 +783,35 @@ void run_silo(const SiloCli& o, CLI::App& sub) {
 }
 
 // The session options of the run in `dir` (session.json) where --resume was not given them; the options as given
-// where the file is missing (a run of a demcal before it).
+// where the file is missing (a run of a demcal before it). The file is read only for an option not given, and a
+// value it holds that the option itself would refuse (threads 100000 crashed the resume), or a file that is not the
+// run's session options, is said and left aside for the default: a side file never stops a resumable run.
 SiloCli with_stored_session(const SiloCli& given, CLI::App& sub, const fs::path& dir) {
     SiloCli o = given;
-    if (given.resume.empty() || !fs::is_regular_file(dir / kSessionFileName)) return o;
-    const nlohmann::json stored = read_json_file((dir / kSessionFileName).string(), "the run's session options");
+    const bool all_given = sub.count("--threads") && sub.count("--checkpoint-every") && sub.count("--no-plots");
+    if (given.resume.empty() || all_given || !fs::is_regular_file(dir / kSessionFileName)) return o;
+    const fs::path file = dir / kSessionFileName;
     try {
-        if (!sub.count("--threads")) o.threads = stored.at("threads").get<int>();
-        if (!sub.count("--checkpoint-every")) o.checkpoint_every = stored.at("checkpoint_every").get<double>();
+        const nlohmann::json stored = read_json_file(file.string(), "the run's session options");
+        if (!sub.count("--threads")) {
+            const int threads = stored.at("threads").get<int>();
+            if (threads < 0 || threads > kMaxThreads)
+                throw std::out_of_range("threads = " + std::to_string(threads) + " is not 0 (every core) to " +
+                                        std::to_string(kMaxThreads));
+            o.threads = threads;
+        }
+        if (!sub.count("--checkpoint-every")) {
+            const double every = stored.at("checkpoint_every").get<double>();
+            if (!(every > 0) || !std::isfinite(every))
+                throw std::out_of_range("checkpoint_every = " + ks::setting_text(every) + " is not a positive time");
+            o.checkpoint_every = every;
+        }
         if (!sub.count("--no-plots")) o.no_plots = stored.at("no_plots").get<bool>();
-    } catch (const nlohmann::json::exception& e) {
-        throw UserError("resume = '" + dir.string() + "': " + (dir / kSessionFileName).string() +
-                        " is not the run's session options (" + e.what() + "); remove it to resume with the defaults");
+    } catch (const std::exception& e) {
+        std::cerr << "demcal: warning: " << file.string() << " is not the run's session options ("
+                  << analytics::shortened_text(e.what(), 300) << "); the resume uses --threads, --checkpoint-every "
+                  << "and --no-plots as given, or their defaults" << std::endl;
+        return given;
     }
     return o;
 }
@@ -1045,7 +1065,7 @@ void add_geometry_options(CLI::App* sub, SiloCli& o) {
 void add_run_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--particles", o.particles, "number of grains")->capture_default_str();
     sub->add_option("--fill-mass", o.fill_mass, "mass of grain [kg] (instead of --particles)");
-    sub->add_option("--threads", o.threads, "OpenMP threads (default: every core)")->check(integer_in(1, 256));
+    sub->add_option("--threads", o.threads, "OpenMP threads (default: every core)")->check(integer_in(1, kMaxThreads));
     sub->add_option("--seed", o.seed, "random seed of the generation")->capture_default_str();
     sub->add_option("--out", o.out, "output directory (default silo_theta<DEG>)");
     sub->add_option("--vtk", o.vtk, "write VTK snapshots of the spheres into this directory");

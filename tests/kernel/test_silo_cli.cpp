@@ -371,6 +371,18 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM or SIGHUP res
     const Run own = run_silo("--resume '" + out.string() + "' --wall-limit 0.001", dir);
     CHECK(own.rc == 75);
     CHECK_THAT(read_file(dir / "out.log"), Catch::Matchers::Contains("\n  1 thread(s)"));
+    // a session file holding what --threads refuses (100000 threads crashed the resume) or no JSON at all is said and
+    // left aside, in a copy of the run: a side file never stops a resumable run
+    for (const std::string text : {"{\"threads\": 100000, \"checkpoint_every\": 7, \"no_plots\": true}", "garbage"}) {
+        INFO(text);
+        fs::remove_all(dir / "copy");
+        fs::copy(out, dir / "copy", fs::copy_options::recursive);
+        std::ofstream(dir / "copy" / "session.json") << text;
+        const Run aside = run_silo("--resume '" + (dir / "copy").string() + "' --no-plots --wall-limit 0.001", dir);
+        CHECK(aside.rc == 75);
+        CHECK_THAT(aside.err, Catch::Matchers::Contains("is not the run's session options"));
+    }
+    fs::remove_all(dir / "copy");
 
     // a session stopped by a signal once it steps: SIGTERM (a batch system's time limit, scancel) and SIGHUP (the
     // terminal or the ssh session closed) make the same clean stop as the wall limit

@@ -896,6 +896,14 @@ TEST_CASE("probe 47: an option the rest of the command line makes void is refuse
     // the rules leave what applies alone
     CHECK(test::run_demcal({"silo", "--theta", "30", "--particles", "200", "--dt", "1e-6", "--check"},
                            root / "dt.log") == 0);
+    // a flag given twice says one thing (it was "--no-plots is given twice ('' and '')"); a bed exported into the new
+    // --out folder written with a trailing slash (it was "the folder does not exist")
+    CHECK(test::run_demcal({"silo", "--theta", "30", "--particles", "200", "--no-plots", "--no-plots", "--check"},
+                           root / "flag.log") == 0);
+    CHECK(test::run_demcal({"silo", "--theta", "30", "--particles", "200", "--out", (dir / "new-out/").string(),
+                            "--export-bed", (dir / "new-out" / "bed.json").string(), "--check"},
+                           root / "slash.log") == 0);
+    INFO(test::read_file(root / "slash.log"));
     fs::remove_all(root);
 }
 
