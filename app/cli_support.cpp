@@ -589,8 +589,6 @@ bool passes_arguments_on(const CLI::App& command) {
                 .empty();
 }
 
-// Refuses an option the command does not have, before `--`. CLI11 took it for a positional value of commands that
-// pass arguments on (vibration, cutoff: `-j 2` became a silo option) and named other words than the one mistyped.
 // Options that may be given more than once, each time with another value: NAME=LOW:HIGH ranges and bounds, the
 // columns that may change an effect. Any other option given twice kept its last value (a number) or joined the two
 // lists (--radii A,B,C --radii D,E,F was read as six radii), silently.
@@ -609,6 +607,9 @@ void refuse_repeated_option(const CLI::Option& opt, const std::string& value, st
     earlier.push_back(value);
 }
 
+// Refuses an option the command does not have, before `--`. CLI11 took it for a positional value of commands that
+// pass arguments on (vibration, cutoff: `-j 2` became a silo option) and named other words than the one mistyped.
+// Also refuses an option given twice (refuse_repeated_option).
 void check_options_known(const CLI::App& app, int argc, const char* const* argv) {
     std::vector<const CLI::App*> chain{&app};
     int i = 1;

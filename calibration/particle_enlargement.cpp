@@ -196,7 +196,7 @@ std::string reference_cannot_be_a_target(const analytics::FailureLine& reference
 
 // A calibration accepted by an interval (the reference's or its own simulated one) rather than within the tolerance
 // of the reference's values: says how far off it is ("" when within the tolerance, or not converged).
-std::string accepted_off_tolerance(const RadiusCalibration& c, const std::vector<MacroTarget>& targets, double tol) {
+std::string accepted_off_tolerance(const RadiusCalibration& c, const std::vector<MacroTarget>& targets) {
     if (!c.converged() || c.result.best < 0) return "";
     const auto& it = c.result.iterations[static_cast<std::size_t>(c.result.best)];
     if (it.accepted_by == "tolerance") return "";
@@ -468,7 +468,7 @@ EnlargementStudy run_enlargement_study(const nlohmann::json& base_in, const Fail
     for (std::size_t i = 1; i < options.radii.size(); ++i) {
         say(progress, "  r = " + num(options.radii[i]) + " m:");
         s.calibrations.push_back(calibrate_radius(base, options.radii[i], targets, evaluate, options, progress));
-        if (const std::string w = accepted_off_tolerance(s.calibrations.back(), targets, options.tolerance); !w.empty())
+        if (const std::string w = accepted_off_tolerance(s.calibrations.back(), targets); !w.empty())
             s.warnings.push_back("r = " + num(options.radii[i]) + " m: " + w);
     }
     fit_laws(s);

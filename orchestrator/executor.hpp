@@ -56,6 +56,10 @@ public:
     virtual void run(const JobSource& next_job, const ExecutorEvents& events) = 0;
 };
 
+// The program `name` (no '/') as a shell finds it on PATH: the first regular file with execute permission (an empty
+// or "." entry is the current folder), made absolute; nullopt when there is none.
+std::optional<std::filesystem::path> find_program_on_path(const std::string& name);
+
 // Set by SIGINT/SIGTERM while an InterruptGuard lives; executors poll it.
 bool interrupted();
 void request_interrupt();

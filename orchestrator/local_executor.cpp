@@ -14,6 +14,7 @@
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
+#include <cstdlib>
 
 namespace demcal::orchestrator {
 
@@ -25,6 +26,22 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 }  // namespace
+
+std::optional<std::filesystem::path> find_program_on_path(const std::string& name) {
+    const char* path = std::getenv("PATH");
+    if (!path) return std::nullopt;
+    const std::string p = path;
+    for (std::size_t a = 0; a <= p.size();) {
+        std::size_t b = p.find(':', a);
+        if (b == std::string::npos) b = p.size();
+        const std::filesystem::path candidate = std::filesystem::path(p.substr(a, b - a)) / name;
+        std::error_code ec;  // (a folder of that name is no program: access(X_OK) alone took one)
+        if (std::filesystem::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0)
+            return std::filesystem::absolute(candidate);
+        a = b + 1;
+    }
+    return std::nullopt;
+}
 
 bool interrupted() { return g_interrupted.load(); }
 void request_interrupt() { g_interrupted.store(true); }

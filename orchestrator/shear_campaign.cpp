@@ -125,15 +125,8 @@ fs::path find_yade(const std::string& yade) {
                                 : !fs::is_regular_file(yade, ec) ? "is not a regular file"
                                                                  : "is not executable";
         throw std::invalid_argument("yade = '" + yade + "' " + why + " (pass --yade with the YADE launcher)");
-    } else if (const char* path = std::getenv("PATH")) {
-        std::string p = path;
-        for (std::size_t a = 0; a <= p.size();) {
-            std::size_t b = p.find(':', a);
-            if (b == std::string::npos) b = p.size();
-            const fs::path cand = fs::path(p.substr(a, b - a)) / yade;
-            if (is_executable_file(cand)) return checked_yade_build(fs::absolute(cand), yade);  // ("" or "." in PATH)
-            a = b + 1;
-        }
+    } else if (const auto found = find_program_on_path(yade)) {
+        return checked_yade_build(*found, yade);
     }
     throw std::invalid_argument("yade = '" + yade +
                                 "' was not found on this machine (install the Debian package 'yade', e.g. with "

@@ -190,20 +190,7 @@ bool task_vanished(bool listed_now, double seconds_since_listed) {
     return !listed_now && seconds_since_listed > kTaskVanishedAfterS;
 }
 
-bool sbatch_on_path() {
-    const char* path = std::getenv("PATH");
-    if (!path) return false;
-    const std::string p = path;
-    for (std::size_t a = 0; a <= p.size();) {
-        std::size_t b = p.find(':', a);
-        if (b == std::string::npos) b = p.size();
-        const fs::path candidate = fs::path(p.substr(a, b - a).empty() ? "." : p.substr(a, b - a)) / "sbatch";
-        std::error_code ec;
-        if (fs::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0) return true;
-        a = b + 1;
-    }
-    return false;
-}
+bool sbatch_on_path() { return find_program_on_path("sbatch").has_value(); }
 
 SlurmExecutor::SlurmExecutor(int slots, fs::path work_dir, std::string partition)
     : slots_(slots), work_dir_(std::move(work_dir)), partition_(std::move(partition)) {
