@@ -886,4 +886,23 @@ nlohmann::json DemDiagnosis::to_json(const SiloMeasurements& data) const {
 
 void check_diagnosable_data(const SiloMeasurements& data) { checked_condition_stats(data); }
 
+std::string rate_scale_mismatch(const SiloMeasurements& data, const std::vector<double>& declared_g_s) {
+    if (declared_g_s.size() != data.conditions.size())
+        throw std::invalid_argument("rate_scale_mismatch: one declared rate per condition");
+    double log_sum = 0;
+    int n = 0;
+    for (std::size_t row = 0; row < data.rows(); ++row) {
+        const double declared = declared_g_s[data.condition_of_row[row]];
+        if (!(declared > 0) || !(data.rate_g_s[row] > 0)) continue;  // a clogged prediction: no ratio
+        log_sum += std::log(data.rate_g_s[row] / declared);
+        ++n;
+    }
+    if (n == 0) return "";
+    const double ratio = std::exp(log_sum / n);
+    if (ratio <= kRateScaleLimit && ratio >= 1 / kRateScaleLimit) return "";
+    return "the measured rates are " + number_text(ratio, 3) + " times the declared material's (geometric mean over " +
+           std::to_string(n) + " rows of " + data.source + "); no effect of the table moves a rate by a factor of " +
+           number_text(kRateScaleLimit, 3) + ": another unit (kg/s under rate_g_s?) or another silo";
+}
+
 }  // namespace demcal::analytics

@@ -167,4 +167,12 @@ double run_value(double value);
 // file.
 void check_diagnosable_data(const SiloMeasurements& data);
 
+// The largest factor between the measured rates and the declared material's predictions (geometric mean over the
+// rows) that a diagnosis takes on: the table's effects move a rate by tens of percent, a unit mistake by 60 (per
+// minute), 1000 (kg/s under rate_g_s) or 3600 (per hour).
+inline constexpr double kRateScaleLimit = 10;
+// Why the measured rates cannot be diagnosed against the declared material's predictions `declared_g_s` (one per
+// condition): their geometric-mean ratio beyond kRateScaleLimit either way; "" when within.
+std::string rate_scale_mismatch(const SiloMeasurements& data, const std::vector<double>& declared_g_s);
+
 }  // namespace demcal::analytics

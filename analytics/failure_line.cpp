@@ -46,7 +46,11 @@ void check_normal_stress_spread(double lowest, double highest, const std::string
         throw std::invalid_argument(field + ": " + number_text(lowest) + " to " + number_text(highest) +
                                     " Pa: a failure line needs normal stresses at least " +
                                     number_text(100 * kMinNormalStressSpread) +
-                                    " % apart (the largest - the smallest): closer ones give a line through their noise");
+                                    " % apart (the largest - the smallest, over the largest: here " +
+                                    number_text(100 * (highest - lowest) / std::fabs(highest), 3) +
+                                    " %; e.g. " + number_text(lowest) + " to " +
+                                    number_text(lowest / (1 - kMinNormalStressSpread), 4) +
+                                    " Pa or more): closer ones give a line through their noise");
 }
 
 void check_measured_stress(double value, const std::string& field) {

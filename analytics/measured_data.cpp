@@ -54,6 +54,7 @@ public:
                     ++i;
                 } else if (ch == '"') {
                     quoted_ = false;
+                    quoted_end_ = cur_.size();
                 } else {
                     append(ch);
                 }
@@ -79,6 +80,9 @@ private:
         cur_blank_ = cur_blank_ && (ch == ' ' || ch == '\t' || ch == '\r');
     }
     void end_field() {
+        // blanks after a closing quote are not the field's: a CRLF file's "last field"\r kept its \r (probe 61: the
+        // column "vibration_Hz\r" became another, categorical one; a quoted response column was "missing")
+        if (was_quoted_ && trim(std::string_view(cur_).substr(quoted_end_)).empty()) cur_.resize(quoted_end_);
         fields_.push_back(was_quoted_ ? cur_ : trim(cur_));
         cur_.clear();
         cur_blank_ = true;
@@ -86,6 +90,7 @@ private:
     }
     std::vector<std::string> fields_;
     std::string cur_;
+    std::size_t quoted_end_ = 0;  // where the closing quote left cur_
     bool cur_blank_ = true, quoted_ = false, was_quoted_ = false;
 };
 

@@ -693,4 +693,14 @@ void check_command_line_shape(const CLI::App& app, int argc, const char* const* 
     }
 }
 
+std::string shell_word(const std::string& word) {
+    const bool literal = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("_./-:@%+=,").find(c) != std::string_view::npos;
+    });
+    if (literal) return word;
+    std::string quoted = "'";
+    for (const char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
 }  // namespace demcal

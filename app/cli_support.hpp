@@ -110,4 +110,9 @@ std::string with_option_name(const CLI::App& app, const std::string& message);
 // "42s", "3m05s", "2h10m": short enough for a progress line; "?" for a negative (unknown) duration.
 std::string duration_text(double seconds);
 
+/// `word` as a shell reads it back, for the commands a message tells a user to type: as it is when it holds only
+/// characters the shell takes literally, else in single quotes (a path with a space printed bare failed when copied:
+/// probe 61).
+std::string shell_word(const std::string& word);
+
 }  // namespace demcal

@@ -65,6 +65,21 @@ std::string fixed(double v, int digits) {
     return o.str();
 }
 
+// What the comparison of one pair of lines ("peak", "residual") says: agree or DIFFER, and INCONCLUSIVE where the
+// intervals are so wide that any two lines would agree. One text for the console and crosscheck.md (probe 60b: the
+// report and the residual line had no verdict).
+std::string comparison_verdict(const std::string& which, const analytics::FailureLineComparison& c) {
+    std::string text = "the two engines' " + which + " failure lines " + (c.agree() ? "agree" : "DIFFER") +
+                       " within their combined 95 % intervals\n";
+    if (!c.conclusive())
+        text += "the " + which + " comparison is INCONCLUSIVE: the combined 95 % half-width on mu_b is " +
+                analytics::number_text(c.mu_b.combined_half_width, 3) + ", at least half of mu_b (half of " +
+                analytics::number_text(0.5 * (c.mu_b.a + c.mu_b.b), 3) + " is " +
+                analytics::number_text(0.25 * (c.mu_b.a + c.mu_b.b), 3) +
+                "), so any two lines would agree; more --replicates or stresses narrow it\n";
+    return text;
+}
+
 std::string markdown_table(const std::map<ShearEngine, calibration::FailureLineEvaluation>& ev,
                            const std::map<ShearEngine, RunCost>& cost,
                            const std::optional<analytics::FailureLineComparison>& peak,
@@ -102,6 +117,9 @@ std::string markdown_table(const std::map<ShearEngine, calibration::FailureLineE
         row("residual mu_b", residual->mu_b, 3);
         row("residual tau_c [Pa]", residual->tau_c, 0);
     }
+    if (peak || residual) md << "\n";
+    if (peak) md << comparison_verdict("peak", *peak);
+    if (residual) md << comparison_verdict("residual", *residual);
     const RunCost& y = cost.at(ShearEngine::yade);
     const RunCost& k = cost.at(ShearEngine::kernel);
     if (y.runs > 0 && k.runs > 0 && k.wall_s > 0 && k.cpu_s > 0)
@@ -257,16 +275,6 @@ int run_crosscheck(const CrosscheckOptions& opt) {
     }
     const std::string md = markdown_table(r.ev, r.cost, peak, residual);
     std::cout << "\n" << md;
-    if (peak) {
-        std::cout << "\nthe two engines' peak failure lines " << (peak->agree() ? "agree" : "DIFFER")
-                  << " within their combined 95 % intervals\n";
-        if (!peak->conclusive())
-            std::cout << "the comparison is INCONCLUSIVE: the combined 95 % half-width on mu_b is "
-                      << analytics::number_text(peak->mu_b.combined_half_width, 3) << ", at least half of mu_b (half of "
-                      << analytics::number_text(0.5 * (peak->mu_b.a + peak->mu_b.b), 3) << " is "
-                      << analytics::number_text(0.25 * (peak->mu_b.a + peak->mu_b.b), 3)
-                      << "), so any two lines would agree; more --replicates or stresses narrow it\n";
-    }
     write_result_file(report, crosscheck_json(opt, specs.at(ShearEngine::yade).material, r, peak, residual).dump(2) +
                                   "\n");
     write_result_file(dir / "crosscheck.md", md);

@@ -326,8 +326,10 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     // passed where a 20 s one would not end)
     if (ladder.size() > 1) check_silo_runs({silo_run_plan(o, search.hi, search.seeds.front(), ladder.back())});
     const nlohmann::json settings = silo_campaign_settings(o);
+    nlohmann::json named = settings;  // the folder named by the search, not by the spelling of its silo options
+    canonicalize_silo_args(named);
     const fs::path dir = o.campaign.empty()
-                             ? fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(settings.dump()).substr(0, 12))
+                             ? fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(named.dump()).substr(0, 12))
                              : fs::path(o.campaign);
     check_output_folder(dir.string(), "--campaign");
     check_paths_apart(silo_campaign_inputs(o.silo_args, dir), {{o.json, "--json"}});

@@ -167,7 +167,7 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
         std::cout << "the simulator could not be started (" << outcome.infrastructure_failure
                   << "); the runs it hit stay pending: fix what stops it (its message; --yade for another YADE; the "
                      "kernel engine: the demcal program), then `demcal resume "
-                  << dir.string() << "`\n";
+                  << shell_word(dir.string()) << "`\n";
         return kExitResumeLater;
     }
     // a campaign is run for its failure line: finished without one, it has not done its job
@@ -200,7 +200,7 @@ void run_shear(const ShearCliOptions& opt) {
               << opt.exec.executor << " executor\n";
     const auto outcome = runner.run(spec, print_progress);
     const int code = report_campaign(runner.dir(), outcome, opt.plot_format);
-    if (outcome.interrupted) std::cout << "interrupted: continue with `demcal resume " << runner.dir().string() << "`\n";
+    if (outcome.interrupted) std::cout << "interrupted: continue with `demcal resume " << shell_word(runner.dir().string()) << "`\n";
     if (code != 0) throw CLI::RuntimeError(code);
 }
 
@@ -232,8 +232,8 @@ std::string campaign_description(const ShearCampaignOutcome& o, const std::map<s
     const auto spec = ShearCampaignSpec::from_json(o.campaign.spec);
     std::ostringstream d;
     d << "  " << to_string(spec.engine) << " engine";
-    if (spec.material.contains("name") && spec.material["name"].is_string())
-        d << ", material '" << analytics::shortened_text(spec.material["name"].get<std::string>(), 60) << "'";
+    if (!spec.material_name.empty())
+        d << ", material '" << analytics::shortened_text(spec.material_name, 60) << "'";
     for (const auto& [k, v] : spec.material.items()) {
         if (k == "name" || k == "description") continue;
         const auto c = common.find(k);
@@ -295,7 +295,7 @@ void check_campaign_folder_argument(const std::string& dir, const std::string& c
     if (fs::exists(d / "campaign.sqlite", ec) || fs::exists(d / "campaign.json", ec)) return;
     if (fs::exists(d / "checkpoint.bin", ec) || fs::exists(d / "summary.json", ec))
         throw UserError(named + " is a demcal silo run's folder, not a campaign: `demcal silo --resume " +
-                        analytics::shortened_text(dir, 200) + "` continues a suspended run");
+                        shell_word(analytics::shortened_text(dir, 200)) + "` continues a suspended run");
     // a folder of campaigns (campaigns/, where cutoff puts its silo searches): name them
     std::vector<std::string> inside;
     for (fs::directory_iterator it(d, ec), end; !ec && it != end && inside.size() < 6; it.increment(ec))

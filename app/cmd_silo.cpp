@@ -7,6 +7,7 @@
 #include "app/gnuplot.hpp"
 #include "app/result_files.hpp"
 #include "app/silo_bed_export.hpp"
+#include "app/silo_campaign.hpp"  // silo_number
 #include "app/silo_flow_pattern.hpp"
 #include "app/silo_material.hpp"
 #include "app/silo_settings.hpp"
@@ -433,8 +434,10 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
     try {
         ks::validate(s);
     } catch (const ks::SettingRejected& e) {
-        const auto source = sources.find(e.field);
-        throw UserError(source == sources.end() ? std::string(e.what()) : source->second + e.after_field);
+        throw UserError(e.message([&](const std::string& field) {
+            const auto source = sources.find(field);
+            return source == sources.end() ? field : source->second;
+        }));
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
@@ -443,18 +446,25 @@ ks::SiloCaseSettings settings_from(const SiloCli& o, CLI::App& sub) {
 }
 
 // The settings as given (a still bin too: a sweep reads every run the same way) and the peak acceleration.
+// How long the walls shook while the bed discharged: 0 when the discharge ended before the start (a run "vibrating"
+// at 4 g gave the still run's rate bit for bit).
+double vibrated_time(const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
+    return s.vibration.vibrates() ? std::max(0.0, r.discharge_time - s.vibration.start_after_opening) : 0.0;
+}
+
 nlohmann::json vibration_json(const ks::SiloCaseSettings& s, const ks::SiloCaseResult& r) {
     const ks::BinVibration& v = s.vibration;
-    return {{"vibrates", v.vibrates()},
+    // "vibrates": the walls shook during the discharge; "vibration_requested": the settings ask for shaking (a
+    // --vibration-start after the discharge's end recorded "vibrates": true for a still run: held-back suite)
+    return {{"vibrates", vibrated_time(s, r) > 0},
+            {"vibration_requested", v.vibrates()},
             {"frequency_hz", v.frequency},
             {"amplitude_m", v.amplitude},
             {"direction", ks::to_string(v.direction)},
             {"part", ks::to_string(v.part)},
             {"start_after_opening_s", v.start_after_opening},
             {"start_time_s", r.fill_time + v.start_after_opening},
-            // how long the walls shook while the bed discharged: 0 when the discharge ended before the start (a
-            // run "vibrating" at 4 g gave the still run's rate bit for bit)
-            {"vibrated_s", v.vibrates() ? std::max(0.0, r.discharge_time - v.start_after_opening) : 0.0},
+            {"vibrated_s", vibrated_time(s, r)},
             {"peak_acceleration_m_s2", v.peak_acceleration()},
             {"peak_acceleration_g", v.peak_acceleration() / s.gravity},
             {"note", "displacement A sin(2 pi f (t - start_time_s)) of the walls of the part (bin: every wall, "
@@ -587,7 +597,7 @@ void check_out_folder_free(const fs::path& dir) {
                         "(a silo run going on there): give another --out, or wait for that run to end");
     if (fs::exists(dir / kCheckpointName))
         throw UserError("--out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
-                        "`demcal silo --resume " + dir.string() + "`, or remove " + (dir / kCheckpointName).string() +
+                        "`demcal silo --resume " + shell_word(dir.string()) + "`, or remove " + (dir / kCheckpointName).string() +
                         " to start over");
     if (fs::is_regular_file(dir / "summary.json"))  // a new run would leave the old results beside its own until its end
         throw UserError("--out = '" + dir.string() + "' holds the results of a finished run (summary.json): give "
@@ -738,7 +748,7 @@ void print_run_header(const ks::SiloCaseSettings& s, const fs::path& dir) {
                   << " facets around, as YADE's silo.py (the filling: exact walls)";
     if (!s.checkpoint_file.empty())
         std::cout << "\n  checkpoint every " << duration_text(s.checkpoint_interval) << " to " << s.checkpoint_file
-                  << " (continue an interrupted run with `demcal silo --resume " << dir.string() << "`)";
+                  << " (continue an interrupted run with `demcal silo --resume " << shell_word(dir.string()) << "`)";
     std::cout << std::endl;
 }
 
@@ -885,7 +895,7 @@ nlohmann::json seconds_or_null(double seconds) { return std::isfinite(seconds) ?
               << " (" << r.steps << " steps, " << r.grains_discharged << " grains discharged); checkpoint "
               << r.checkpoints << " written to " << s.checkpoint_file << "\nwall time so far "
               << duration_text(r.wall_s) << ", " << cpu_text(r) << "; continue with `demcal silo --resume "
-              << dir.string() << "`" << std::endl;
+              << shell_word(dir.string()) << "`" << std::endl;
     throw CLI::RuntimeError(kExitSuspended);
 }
 
@@ -994,7 +1004,7 @@ void write_results(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
                   << analytics::shortened_text(
                          std::string(e.what()) + "; the results are not written" +
                              (resumable ? "; the checkpoint is kept: make room, then `demcal silo --resume " +
-                                              dir.string() + "` finishes the run again"
+                                              shell_word(dir.string()) + "` finishes the run again"
                                         : "; no checkpoint was written (none was due: --checkpoint-every), so "
                                           "the run must be made again"),
                          4000)
@@ -1024,6 +1034,19 @@ void print_summary(const fs::path& dir, const ks::SiloCaseSettings& s, const ks:
     else
         std::cout << "rate: not determined (" << r.fit.message << ")\n";
     if (s.vibration.vibrates()) std::cout << "vibration: " << vibration_text(s) << "\n";
+    // a run that could not give what a silo run is for says so where a user looks, not only in its summary
+    if (!r.fill_at_rest)
+        std::cerr << "demcal silo: warning: the filling reached its time limit (" << ks::setting_text(s.fill_time_max)
+                  << " s) with the grains still moving (" << std::setprecision(3) << r.fill_kinetic_energy
+                  << " J per grain): the discharge started from a bed not at rest; a longer --fill-time settles it"
+                  << std::endl;
+    if (!r.fit.ok)
+        std::cerr << "demcal silo: warning: no discharge rate: " << r.fit.message << " (the discharge ended: "
+                  << r.stop_reason << ")" << std::endl;
+    if (s.vibration.vibrates() && !(vibrated_time(s, r) > 0))
+        std::cerr << "demcal silo: warning: the bin never vibrated: the discharge ended " << fixed(r.discharge_time, 3)
+                  << " s after the opening, before --vibration-start (" << ks::setting_text(s.vibration.start_after_opening)
+                  << " s); summary.json records \"vibrates\": false, a still discharge" << std::endl;
     std::cout << "flow pattern: " << ks::to_string(r.flow.pattern) << " (wall/axis velocity ratio "
               << fixed(r.flow.ratio, 3) << ")\n";
     std::cout << r.steps << " steps of " << std::setprecision(3) << r.time_step << " s, wall time "
@@ -1078,7 +1101,7 @@ void add_run_options(CLI::App* sub, SiloCli& o) {
     sub->add_option("--dt-fraction", o.dt_fraction, "time step as a fraction of the Rayleigh time step")
         ->capture_default_str();
     sub->add_option("--stiffness-scale", o.stiffness_scale,
-                    "scales the shear moduli of Table 2.1 (softer contacts allow a larger time step)")
+                    "scales the shear moduli of Table 2.1, in (0, 1] (softer contacts allow a larger time step)")
         ->capture_default_str();
     sub->add_option("--stop-fraction", o.stop_fraction,
                     "stop once this fraction of the filled mass has left (1: until empty)")
@@ -1185,6 +1208,23 @@ ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options,
     add_silo_options(&parser, o);
     refuse_empty_values(parser);  // the number rule, as on demcal silo's own command line
     read_values_strictly(parser);
+    // an option given twice after --: CLI11 said only "At Most 1 required but received 2" (probe 60b)
+    std::map<std::string, std::string> given;
+    for (std::size_t i = 0; i < options.size(); ++i) {
+        const std::string& arg = options[i];
+        if (arg.size() < 3 || arg.rfind("--", 0) != 0) continue;
+        const std::string name = arg.substr(0, arg.find('='));
+        const CLI::Option* opt = parser.get_option_no_throw(name);
+        if (!opt || opt->get_expected_max() == 0 || opt->get_type_size_max() == 0) continue;  // (a flag: harmless)
+        const std::string value = name.size() < arg.size() ? arg.substr(name.size() + 1)
+                                  : i + 1 < options.size() ? options[i + 1]
+                                                           : "";
+        if (const auto earlier = given.find(opt->get_name()); earlier != given.end())
+            throw UserError("silo options of " + owner + ": " + name + " is given twice ('" +
+                            analytics::shortened_text(earlier->second, 100) + "' and '" +
+                            analytics::shortened_text(value, 100) + "'): give it once");
+        given[opt->get_name()] = value;
+    }
     std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
     try {
         parser.parse(reversed);
@@ -1201,6 +1241,36 @@ ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options,
             throw UserError(std::string("silo option ") + own + " does not apply to " + owner +
                             " (it runs the silo case itself and writes its own outputs)");
     return settings_from(o, parser);
+}
+
+nlohmann::json canonical_silo_options(const std::vector<std::string>& options) {
+    CLI::App parser("silo options", "silo");
+    SiloCli o;
+    add_silo_options(&parser, o);
+    std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
+    try {
+        parser.parse(reversed);
+    } catch (const CLI::Error&) {
+        return options;  // (refused elsewhere with its message): the text as given
+    }
+    // one spelling per value: a number by its value (1e-3 and 0.001); a file not by its path (relative, absolute or
+    // through a link): the campaigns compare its contents' digest (silo_input_file_digests)
+    const auto value_key = [](const std::string& option, const std::string& value) -> std::string {
+        if (option == "--material" || option == "--geometry") return "(a file: its contents are compared by digest)";
+        char* end = nullptr;
+        const double number = std::strtod(value.c_str(), &end);
+        if (!value.empty() && end && *end == '\0') return silo_number(number);
+        return value;
+    };
+    nlohmann::json canonical = nlohmann::json::object();  // (sorted by option name)
+    for (const CLI::Option* opt : parser.get_options()) {
+        if (opt->count() == 0 || opt->get_name().empty()) continue;
+        const std::string name = opt->get_name(false, true);  // the long name, whichever spelling was typed
+        nlohmann::json values = nlohmann::json::array();
+        for (const std::string& v : opt->results()) values.push_back(value_key(name, v));
+        canonical[name] = values;
+    }
+    return canonical;
 }
 
 void add_silo_command(CLI::App& app) {

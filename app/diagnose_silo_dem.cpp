@@ -503,6 +503,12 @@ int run_silo_dem_diagnosis(const SiloDemArgs& input) {
         std::cout << "declared material (" << a.material << "): " << data.conditions.size() << " conditions x "
                   << a.seeds << " seed(s)" << std::endl;
         const auto declared_rates = campaign.rates({in.declared}).front();
+        // measured rates of another unit or silo: no candidate's runs could explain them (held-back suite)
+        if (const std::string mismatch = an::rate_scale_mismatch(data, declared_rates); !mismatch.empty()) {
+            std::cout << "not determined: " << mismatch << "\n"
+                      << "the diagnosis is not determined by these data (exit 1); no candidate was run\n";
+            return 1;
+        }
         r = an::diagnose_dem(data, declared_rates, setups, options);
     } catch (const CampaignStopped&) {
         std::cout << "stopped; the same command continues the campaign in " << a.campaign << " (finished runs kept)\n";

@@ -48,7 +48,12 @@ int run_command(int argc, char** argv) {
             sub = given.empty() ? nullptr : given.front();
             if (sub) command += " " + sub->get_name();
         }
-        return "demcal: error: " + one_line(e.what()) + " (the options: " + command + " --help)\n";
+        // words left over are mostly a list typed with spaces (-s 5e3 10e3 15e3: "not expected: 15e3 10e3")
+        const std::string list_hint = dynamic_cast<const CLI::ExtrasError*>(&e)
+                                          ? "; a list is one word, its values separated by commas without spaces "
+                                            "(-s 5e3,10e3,15e3)"
+                                          : "";
+        return "demcal: error: " + one_line(e.what()) + list_hint + " (the options: " + command + " --help)\n";
     });
     demcal::add_shear_commands(app);
     demcal::add_shear_run_command(app);

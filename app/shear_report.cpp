@@ -2,6 +2,7 @@
 
 #include "app/cli_support.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -32,8 +33,8 @@ void print_progress(const CampaignProgress& p) {
 void print_line(const char* title, const analytics::FailureLine& fl) {
     std::ios saved(nullptr);
     saved.copyfmt(std::cout);  // restored at the end: later output keeps cout's default format
-    std::cout << std::fixed << std::setprecision(4) << title << ": tau = " << fl.mu_b << " sigma + "
-              << std::setprecision(1) << fl.tau_c << " Pa\n"
+    std::cout << std::fixed << std::setprecision(4) << title << ": tau = " << fl.mu_b << " sigma "
+              << (fl.tau_c < 0 ? "- " : "+ ") << std::setprecision(1) << std::fabs(fl.tau_c) << " Pa\n"
               << std::setprecision(4) << "  mu_b  = " << fl.mu_b << " +/- " << fl.se_mu_b << "  (95% CI "
               << fl.mu_b_low << " .. " << fl.mu_b_high << "),  phi_b = " << std::setprecision(2) << fl.phi_b_deg
               << " +/- " << fl.se_phi_b_deg << " deg\n"

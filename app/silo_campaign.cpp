@@ -1,4 +1,5 @@
 #include "app/silo_campaign.hpp"
+#include "app/silo_settings.hpp"  // canonical_silo_options
 
 #include "app/cli_support.hpp"
 #include "analytics/number_text.hpp"
@@ -212,6 +213,18 @@ json silo_input_file_digests(const std::vector<std::string>& silo_args) {
     return digests;
 }
 
+void canonicalize_silo_args(json& settings) {
+    if (!settings.is_object()) return;
+    const auto args = settings.find("silo_args");
+    if (args == settings.end() || !args->is_array()) return;
+    std::vector<std::string> list;
+    for (const auto& a : *args) {
+        if (!a.is_string()) return;  // not demcal's: compared as it is
+        list.push_back(a.get<std::string>());
+    }
+    *args = canonical_silo_options(list);
+}
+
 namespace {
 // The top-level settings whose values differ between two campaign.json objects, e.g. "amplitude_m, input_files_sha256"
 std::string differing_settings(const json& stored, const json& now) {
@@ -223,6 +236,21 @@ std::string differing_settings(const json& stored, const json& now) {
         if (!now.contains(key)) keys.insert(key);
     std::string text;
     for (const auto& key : keys) text += (text.empty() ? "" : ", ") + key;
+    return text;
+}
+// The silo options that differ between two canonical "silo_args" objects, e.g. "--material given now, not before;
+// --particles 300 before, 1000 now".
+std::string differing_silo_options(const json& before, const json& now) {
+    if (!before.is_object() || !now.is_object()) return "";
+    std::string text;
+    const auto add = [&](const std::string& item) { text += (text.empty() ? "" : "; ") + item; };
+    for (const auto& [option, values] : now.items())
+        if (!before.contains(option)) add(option + " given now, not before");
+        else if (before[option] != values)
+            add(option + " " + analytics::shortened_text(before[option].dump(), 80) + " before, " +
+                analytics::shortened_text(values.dump(), 80) + " now");
+    for (const auto& [option, values] : before.items())
+        if (!now.contains(option)) add(option + " given before, not now");
     return text;
 }
 }  // namespace
@@ -255,11 +283,17 @@ void open_silo_campaign(const fs::path& dir, const json& settings, const std::st
         const bool without_digests = stored.is_object() && !stored.contains(kInputFileDigestsKey) &&
                                      now.contains(kInputFileDigestsKey);
         if (without_digests) now.erase(kInputFileDigestsKey);
+        canonicalize_silo_args(stored);
+        canonicalize_silo_args(now);
         if (stored != now) {
             const std::string differ = differing_settings(stored, now);
+            const std::string options = differing_silo_options(stored.value("silo_args", json()),
+                                                               now.value("silo_args", json()));
+            const bool files_differ = differ.find(kInputFileDigestsKey) != std::string::npos;
             throw UserError("campaign = '" + dir.string() + "' holds a " + command + " campaign with other settings (" +
-                            settings_file.string() + "; they differ in " + differ + ")" +
-                            (differ.find(kInputFileDigestsKey) != std::string::npos
+                            settings_file.string() + "; they differ in " + differ +
+                            (options.empty() ? "" : ": " + options) + ")" +
+                            (files_differ && options.empty()
                                  ? ": a --material or --geometry file was changed since the campaign began; its runs "
                                    "are of the file as it was"
                                  : "") +
@@ -382,11 +416,14 @@ void check_run_folder_identity(const fs::path& rd, const json& identity, const s
     } catch (const UserError& e) {
         throw UserError(std::string(e.what()) + " (remove the run's folder " + rd.string() + " to run it again)");
     }
-    if (stored == identity) return;
+    json stored_canonical = stored, identity_canonical = identity;
+    canonicalize_silo_args(stored_canonical);
+    canonicalize_silo_args(identity_canonical);
+    if (stored_canonical == identity_canonical) return;
     std::string what = "its settings";
     if (stored.is_object() && stored.value(kInputFileDigestsKey, json()) != identity[kInputFileDigestsKey])
         what = "the contents of its input files (--material, --geometry)";
-    if (stored.is_object() && stored.value("silo_args", json()) != identity["silo_args"])
+    if (stored_canonical.is_object() && stored_canonical.value("silo_args", json()) != identity_canonical["silo_args"])
         what = "its silo options (" + analytics::shortened_text(stored.value("silo_args", json()).dump(), 300) +
                ", this campaign's run: " + analytics::shortened_text(identity["silo_args"].dump(), 300) + ")";
     throw UserError("demcal " + command + ": the run folder " + rd.string() + " holds a run of other settings than " +

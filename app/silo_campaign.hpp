@@ -59,6 +59,11 @@ inline constexpr const char* kInputFileDigestsKey = "input_files_sha256";
 // throws.
 nlohmann::json silo_input_file_digests(const std::vector<std::string>& silo_args);
 
+// Replaces a campaign.json's (or a run identity's) "silo_args" list by its one spelling (canonical_silo_options), so
+// that two commands that run the same silo case compare equal: the options after -- in another order, as
+// --opt=value, 1e-3 for 0.001 or a file by another path were refused as other settings (probe 61).
+void canonicalize_silo_args(nlohmann::json& settings);
+
 // DIR/campaign.json: created with `settings` (and DIR/runs) when absent; when present it must hold the same settings,
 // else UserError naming the settings that differ (another campaign lives there, or its input files changed). A
 // campaign.json from before the input files' digests (no kInputFileDigestsKey) takes the files' present digests, with

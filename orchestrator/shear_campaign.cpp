@@ -40,6 +40,7 @@ nlohmann::json ShearCampaignSpec::to_json() const {
         j["engine"] = to_string(engine);
         j["template"] = "";
     }
+    if (!material_name.empty()) j["material_name"] = material_name;
     return j;
 }
 
@@ -52,6 +53,7 @@ ShearCampaignSpec ShearCampaignSpec::from_json(const nlohmann::json& j) {
     s.template_path = j.at("template").get<std::string>();
     s.label = j.value("label", "");
     s.engine = parse_shear_engine(j.value("engine", "yade"));
+    s.material_name = j.value("material_name", "");
     return s;
 }
 
@@ -134,7 +136,9 @@ fs::path find_yade(const std::string& yade) {
 }
 
 std::string campaign_name(const ShearCampaignSpec& spec) {
-    return "shear-" + sha256_hex(spec.to_json().dump()).substr(0, 12);
+    nlohmann::json identity = spec.to_json();
+    identity.erase("material_name");  // a label: campaigns of one material under two names are one campaign
+    return "shear-" + sha256_hex(identity.dump()).substr(0, 12);
 }
 
 namespace {
@@ -156,6 +160,9 @@ ShearCampaignSpec resolved(const ShearCampaignSpec& spec) {
         if (s.template_path.empty()) s.template_path = default_shear_template();
         s.template_path = fs::absolute(s.template_path).lexically_normal();
     }
+    if (s.material_name.empty() && spec.material.is_object())
+        if (const auto name = spec.material.find("name"); name != spec.material.end() && name->is_string())
+            s.material_name = name->get<std::string>();
     s.material = validate_material(spec.material);
     return s;
 }

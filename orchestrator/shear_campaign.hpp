@@ -35,6 +35,9 @@ struct ShearCampaignSpec {
     std::filesystem::path template_path;     // empty: the installed yade_scripts/shear_box.py
     std::string label;                       // optional human name, e.g. "sensitivity density level 2"
     ShearEngine engine = ShearEngine::yade;  // template_path applies to yade only
+    // The material file's "name" (resolved() takes it from `material`): what `demcal status` calls the campaign's
+    // material. Not part of the campaign's identity (campaign_name): a renamed file is the same campaign.
+    std::string material_name;
 
     nlohmann::json to_json() const;
     static ShearCampaignSpec from_json(const nlohmann::json& j);

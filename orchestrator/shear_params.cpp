@@ -321,7 +321,9 @@ nlohmann::json validate_material(const nlohmann::json& material, const std::stri
     if (!material.is_object()) throw std::invalid_argument(where + ": a material must be a JSON object");
     nlohmann::json out = nlohmann::json::object();
     for (const auto& [key, value] : material.items()) {
-        if (key == "name" || key == "description" || key.rfind("_comment", 0) == 0) {  // documentation, not physics
+        // documentation, not physics: any "_" key, as the silo's material and geometry files take (probe 61: "_note"
+        // was an unknown field). Not passed on: the YADE script, which takes "_comment..." keys, never sees them.
+        if (key == "name" || key == "description" || key.rfind('_', 0) == 0) {
             if (!value.is_string())
                 throw std::invalid_argument(where + ": field '" + key + "' must be a string, got " + format_value(value));
             continue;

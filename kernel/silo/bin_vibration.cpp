@@ -59,8 +59,10 @@ void validate(const BinVibration& v) {
 
 void validate_strength(const BinVibration& v) {
     if (!(v.frequency > 0 && v.amplitude > 0)) return;  // a still bin (its settings are refused elsewhere)
-    if (const std::string defect = vibration_strength_defect(v.amplitude, v.frequency); !defect.empty())
-        reject_setting("vibration_amplitude", v.amplitude, defect);
+    // both settings named: either may be the one mistyped (0.01 Hz, or 1e-12 m)
+    if (const std::string defect = vibration_peak_defect(v.amplitude, v.frequency); !defect.empty())
+        throw SettingRejected("vibration_amplitude", v.amplitude, "vibration_frequency", v.frequency,
+                              "gives " + defect);
 }
 
 BinVibrationMotion::BinVibrationMotion(const BinVibration& v) : v_(v) { validate(v_); }

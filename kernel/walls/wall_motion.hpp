@@ -35,8 +35,9 @@ inline constexpr double kMaxVibrationPeakAcceleration = 500 * 9.81;
 inline constexpr double kMinVibrationPeakAcceleration = 1e-4 * 9.81;
 
 /// Why shaking of amplitude A [m] and frequency f [Hz] (both > 0) is not a vibration a case simulates (its peak
-/// acceleration A (2 pi f)^2 outside [kMinVibrationPeakAcceleration, kMaxVibrationPeakAcceleration]), or "".
-inline std::string vibration_strength_defect(double amplitude, double frequency) {
+/// acceleration A (2 pi f)^2 outside [kMinVibrationPeakAcceleration, kMaxVibrationPeakAcceleration]), or "":
+/// "a peak acceleration of X g, below ...".
+inline std::string vibration_peak_defect(double amplitude, double frequency) {
   const double peak = amplitude * std::pow(2 * M_PI * frequency, 2);
   if (peak >= kMinVibrationPeakAcceleration && peak <= kMaxVibrationPeakAcceleration) return "";
   const auto g = [](double a) {
@@ -44,14 +45,21 @@ inline std::string vibration_strength_defect(double amplitude, double frequency)
     std::snprintf(text, sizeof text, "%g", a / 9.81);
     return std::string(text);
   };
-  char hz[32];
-  std::snprintf(hz, sizeof hz, "%g", frequency);
-  return std::string("at ") + hz + " Hz gives a peak acceleration of " + g(peak) + " g, " +
+  return "a peak acceleration of " + g(peak) + " g, " +
          (peak > kMaxVibrationPeakAcceleration
               ? "above the " + g(kMaxVibrationPeakAcceleration) +
                     " g a vibrated bed is checked for (the seed's largest: 9.3 g): it throws the grains about"
               : "below the " + g(kMinVibrationPeakAcceleration) +
                     " g a vibrated bed is checked for: it shakes nothing (the seed: 0.11 mm at up to 145 Hz)");
+}
+
+/// vibration_peak_defect with the frequency named: "at f Hz gives a peak acceleration of ...", or "".
+inline std::string vibration_strength_defect(double amplitude, double frequency) {
+  const std::string defect = vibration_peak_defect(amplitude, frequency);
+  if (defect.empty()) return "";
+  char hz[32];
+  std::snprintf(hz, sizeof hz, "%g", frequency);
+  return std::string("at ") + hz + " Hz gives " + defect;
 }
 
 /// d(t) = A sin(2 pi f (t - t0)) e for t >= t0, 0 before: a vibrator (the seed's eccentric vibrator on the bin).

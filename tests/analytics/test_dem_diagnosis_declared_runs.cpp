@@ -36,3 +36,22 @@ TEST_CASE("silo-dem: the same steep candidate is named where the data hold its e
     REQUIRE(r.effect == 0);
     CHECK(r.candidates[0].cv_rmse < 0.5 * r.rmse_before);
 }
+
+TEST_CASE("silo-dem: measured rates an order of magnitude off the declared runs' are named as another unit",
+          "[diagnose][silo-dem]") {
+    SyntheticSilo model;
+    const auto data = model.measured(0.0);
+    const auto declared = model.rates(data, 0.0);
+    CHECK(an::rate_scale_mismatch(data, declared).empty());  // the declared material's own rates
+    auto scaled = data;
+    for (double& rate : scaled.rate_g_s) rate *= 3;  // an effect's size of change, not a unit's
+    CHECK(an::rate_scale_mismatch(scaled, declared).empty());
+    for (const double factor : {1e-3, 1.0 / 60, 60.0, 3600.0}) {  // kg/s, per minute, per hour under rate_g_s
+        auto other_unit = data;
+        for (double& rate : other_unit.rate_g_s) rate *= factor;
+        INFO("factor " << factor);
+        CHECK_THAT(an::rate_scale_mismatch(other_unit, declared),
+                   Catch::Contains("times the declared material's") && Catch::Contains("another unit"));
+    }
+    CHECK_THROWS(an::rate_scale_mismatch(data, {1.0}));  // one rate per condition
+}

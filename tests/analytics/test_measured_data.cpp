@@ -72,6 +72,30 @@ TEST_CASE("a spreadsheet's UTF-8 byte-order mark and CRLF line ends are read, UT
     CHECK_THROWS_WITH(load(std::string("\xFF\xFEg\0e\0o\0", 8) + "\n"), Catch::Contains("UTF-16"));
 }
 
+TEST_CASE("a CRLF file with every field quoted reads its last column as the others, without the line end",
+          "[measured]") {
+    // Python's csv.QUOTE_ALL and spreadsheets' "quote all" exports: "moisture_pct"\r\n; the last column was
+    // "moisture_pct\r", another and categorical column (probe 61)
+    const auto quoted_all = [](const std::string& after_quote, const std::string& line_end) {
+        std::string text;
+        for (const std::string& line : {header, std::string("conical,0.105,,,0.035,30,0.0055,780,0.171,anna,12.5\n")}) {
+            std::string fields = "\"";
+            for (const char c : line.substr(0, line.size() - 1))
+                fields += c == ',' ? "\"" + after_quote + ",\"" : std::string(1, c);
+            text += fields + "\"" + after_quote + line_end;
+        }
+        return text;
+    };
+    for (const auto& [after_quote, line_end] : {std::pair{std::string(""), std::string("\r\n")},
+                                                std::pair{std::string("  "), std::string("\n")},
+                                                std::pair{std::string(" \t"), std::string("\r\n")}}) {
+        const auto data = load(quoted_all(after_quote, line_end));
+        REQUIRE(data.find("moisture_pct") != nullptr);
+        CHECK(data.at("moisture_pct").values[0] == Approx(12.5));
+        CHECK(data.at("W_kg_s").values[0] == Approx(0.171));
+    }
+}
+
 TEST_CASE("a file separated by semicolons or tabs is named as such, not by its rows' field counts", "[measured]") {
     // a spreadsheet set to decimal commas saves "CSV" as geometry;D_m;...: every row then had "7 fields, the header
     // has 1"

@@ -124,6 +124,21 @@ TEST_CASE("silo case: bad settings name the field and the value", "[silo]") {
     s.wall_limit = 3600;  // without a checkpoint to resume from, the session's work would be lost at the limit
     CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("wall_limit = 3600") &&
                                        Catch::Matchers::Contains("checkpoint"));
+    // held-back suite: a friction coefficient of 10, a stiffening by 100
+    s = reduced_case(30);
+    s.materials.wheat_steel.friction = 10;
+    CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("friction = 10") && Catch::Matchers::Contains("[0, 2]"));
+    s.materials.wheat_steel.friction = 2;  // the bound itself is taken
+    CHECK_NOTHROW(validate(s));
+    s.materials.stiffness_scale = 1.5;
+    CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("stiffness_scale = 1.5"));
+    // a stop fraction leaves at least 10 grains in the rate's window (20-80 % of the discharged mass)
+    s = reduced_case(30);
+    s.stop_fraction = 10.0 / (0.6 * double(s.particles)) * 0.99;
+    CHECK_THROWS_WITH(validate(s), Catch::Matchers::Contains("stop_fraction = ") &&
+                                       Catch::Matchers::Contains("at least 10 are needed"));
+    s.stop_fraction = 10.0 / (0.6 * double(s.particles)) * 1.01;
+    CHECK_NOTHROW(validate(s));
 }
 
 TEST_CASE("silo case: a bed that cannot fit the silo is refused, a full silo is not", "[silo]") {

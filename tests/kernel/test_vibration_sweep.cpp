@@ -209,5 +209,13 @@ TEST_CASE("demcal vibration: a sweep in which no run's rate is determined ends w
   CHECK(demcal_run(sweep, dir / "run.log") == 1);
   CHECK_THAT(demcal::test::read_file(dir / "run.log"), Catch::Matchers::Contains("no cell has a rate"));
   CHECK(fs::exists(dir / "v" / "vibration.json"));  // the table is still written
+  // the same silo options in another spelling continue the campaign (probe 61: order, --opt=value, 2e-2 for 0.02
+  // were "other settings", exit 2); another value is still refused, by its option
+  const std::string respelled = "vibration --theta 30 --frequency 0 --repeats 1 --campaign '" + (dir / "v").string() +
+                                "' -- --threads=1 --max-time 2e-2 --no-plots --fill-time 0.020 --particles 50";
+  CHECK(demcal_run(respelled, dir / "again.log") == 1);
+  CHECK_THAT(demcal::test::read_file(dir / "again.log"), Catch::Matchers::Contains("no cell has a rate"));
+  CHECK(demcal_run(respelled + " --skin 0.0005", dir / "other.log") == 2);
+  CHECK_THAT(demcal::test::read_file(dir / "other.log"), Catch::Matchers::Contains("--skin given now, not before"));
   fs::remove_all(dir);
 }

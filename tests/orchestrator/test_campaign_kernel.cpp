@@ -199,6 +199,7 @@ TEST_CASE("status tells a folder's campaigns apart by what they ran",
     const fs::path dir = test::fresh_test_dir("kernel-status");
     nlohmann::json material = nlohmann::json::parse(test::read_file(tiny));
     material["friction_coefficient"] = 0.3;
+    material["name"] = "sand-tiny, rougher";
     const fs::path other = dir / "other.json";
     std::ofstream(other) << material.dump();
     REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
@@ -212,9 +213,13 @@ TEST_CASE("status tells a folder's campaigns apart by what they ran",
     const std::string status = test::read_file(dir / "status.log");
     INFO(status);
     using Catch::Matchers::Contains;
-    // the two campaigns of the common material say only their engine and design; the other names its friction
-    CHECK_THAT(status, Contains("  kernel engine; 3 normal stresses 3000 to 7000 Pa x 1 packings from seed 1\n") &&
-                           Contains("  kernel engine; 3 normal stresses 3000 to 7000 Pa x 1 packings from seed 5\n") &&
-                           Contains("  kernel engine, friction_coefficient 0.3; 3 normal stresses"));
+    // the two campaigns of the common material say only their engine, material name and design; the other names
+    // its friction (the name: held-back suite, the stored spec had lost it)
+    CHECK_THAT(status, Contains("  kernel engine, material 'sand-tiny'; 3 normal stresses 3000 to 7000 Pa x 1 packings "
+                                "from seed 1\n") &&
+                           Contains("  kernel engine, material 'sand-tiny'; 3 normal stresses 3000 to 7000 Pa x 1 "
+                                    "packings from seed 5\n") &&
+                           Contains("  kernel engine, material 'sand-tiny, rougher', friction_coefficient 0.3; 3 normal "
+                                    "stresses"));
     fs::remove_all(dir);
 }

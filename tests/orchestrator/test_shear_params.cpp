@@ -21,6 +21,17 @@ TEST_CASE("a complete material validates and gets the set-up defaults", "[params
     CHECK_FALSE(m.contains("normal_stress"));
 }
 
+TEST_CASE("a material's name, description and any \"_\" key are documentation, not passed on", "[params]") {
+    auto documented = sand();
+    documented["name"] = "sand";
+    documented["_note"] = "measured 2026-11-30";  // probe 61: refused as an unknown field, as silo files take it
+    documented["_comment_source"] = "Table 2.1";
+    const auto m = validate_material(documented);
+    CHECK(m == validate_material(sand()));
+    documented["_note"] = 5;  // documentation is text
+    CHECK_THROWS_WITH(validate_material(documented), Catch::Contains("'_note' must be a string"));
+}
+
 TEST_CASE("bad materials are refused naming the field and the value", "[params]") {
     auto with = [](const char* k, nlohmann::json v) {
         auto m = sand();
