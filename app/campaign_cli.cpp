@@ -17,9 +17,12 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
         ->delimiter(',')
         ->check(positive_number())
         ->capture_default_str();
-    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")->check(integer_in(1, orchestrator::kMaxReplicates));
+    cmd->add_option("--replicates,-r", c.replicates, "packings per normal stress")
+        ->check(integer_in(1, orchestrator::kMaxReplicates))
+        ->capture_default_str();
     cmd->add_option("--seed", c.seed, "first packing seed, the same for every material (common random numbers)")
-        ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)));
+        ->check(integer_in(0, static_cast<long long>(orchestrator::find_shear_param("seed")->max)))
+        ->capture_default_str();
     cmd->add_option("--engine", c.engine, "yade or kernel (the same shear box on demcal's kernel with YADE's laws)")
         ->check(CLI::IsMember({"yade", "kernel"}))
         ->capture_default_str();
@@ -27,7 +30,7 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
         ->capture_default_str();
     cmd->add_option("--template", c.template_path, "YADE template (default: yade_scripts/shear_box.py)");
     cmd->add_option("--line", c.line, "failure line to work on")->check(CLI::IsMember({"peak", "residual"}));
-    cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    cmd->add_option("--plot", c.plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}))->capture_default_str();
     add_execution_options(cmd, c.exec);
 }
 

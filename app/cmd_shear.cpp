@@ -379,16 +379,18 @@ void add_shear_commands(CLI::App& app) {
         ->delimiter(',')
         ->check(positive_number());
     shear->add_option("--replicates,-r", opt->replicates, "packings per normal stress (seeds seed, seed+1, ...)")
-        ->check(integer_in(1, orchestrator::kMaxReplicates));
+        ->check(integer_in(1, orchestrator::kMaxReplicates))
+        ->capture_default_str();
     shear->add_option("--seed", opt->seed, "first packing seed")
-        ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)));
-    shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<material name>)");
+        ->check(integer_in(0, static_cast<long long>(find_shear_param("seed")->max)))
+        ->capture_default_str();
+    shear->add_option("--campaign,-c", opt->campaign_dir, "campaign directory (default campaigns/<the material file's name without .json>)");
     shear->add_option("--template", opt->template_path, "YADE template (default: yade_scripts/shear_box.py)");
     shear->add_option("--engine", opt->engine,
                       "yade (yade_scripts/shear_box.py) or kernel (the same box on demcal's kernel with YADE's laws)")
         ->check(CLI::IsMember({"yade", "kernel"}))
         ->capture_default_str();
-    shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}));
+    shear->add_option("--plot", opt->plot_format, "plot format")->check(CLI::IsMember({"png", "svg"}))->capture_default_str();
     shear->add_flag("--force", opt->exec.force, "recompute runs already in the store");
     add_execution_options(shear, opt->exec);
     shear->callback([opt] { run_shear(*opt); });

@@ -10,6 +10,7 @@
 #include <optional>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <deque>
@@ -160,6 +161,8 @@ ShearCampaignSpec resolved(const ShearCampaignSpec& spec) {
         if (s.template_path.empty()) s.template_path = default_shear_template();
         s.template_path = fs::absolute(s.template_path).lexically_normal();
     }
+    // one campaign whatever the order the stresses were typed in (-s 8e3,4e3 opened a second campaign: probe 61)
+    std::sort(s.normal_stresses.begin(), s.normal_stresses.end());
     if (s.material_name.empty() && spec.material.is_object())
         if (const auto name = spec.material.find("name"); name != spec.material.end() && name->is_string())
             s.material_name = name->get<std::string>();

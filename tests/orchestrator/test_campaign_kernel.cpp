@@ -209,8 +209,14 @@ TEST_CASE("status tells a folder's campaigns apart by what they ran",
                              dir / "b.log") == 0);
     REQUIRE(test::run_demcal({"shear", other.string(), "-s", "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
                              dir / "c.log") == 0);
+    // the first campaign's stresses in another order: the same campaign (probe 61: a second one opened)
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "7e3,3e3,5000", "--engine", "kernel", "-c", dir.string()},
+                             dir / "d.log") == 0);
     REQUIRE(test::run_demcal({"status", dir.string()}, dir / "status.log") == 0);
     const std::string status = test::read_file(dir / "status.log");
+    std::size_t campaigns = 0;
+    for (std::size_t at = status.find("\nshear-"); at != std::string::npos; at = status.find("\nshear-", at + 1)) ++campaigns;
+    CHECK(campaigns + (status.rfind("shear-", 0) == 0 ? 1 : 0) == 3);
     INFO(status);
     using Catch::Matchers::Contains;
     // the two campaigns of the common material say only their engine, material name and design; the other names
