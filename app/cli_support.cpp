@@ -437,6 +437,10 @@ void check_output_folder(const std::string& path, const std::string& option) {
     if (path.empty()) throw UserError(option + ": an empty path");
     check_name_lengths(path, named, PathKind::folder);
     std::error_code ec;
+    if (fs::is_symlink(fs::symlink_status(path, ec)) && !fs::exists(path, ec))  // ("File exists" when made: probe 60)
+        throw UserError(named + " is a symbolic link to '" +
+                        analytics::shortened_text(fs::read_symlink(path, ec).string(), 200) +
+                        "', which does not exist: make its target, or give another folder");
     if (fs::exists(path, ec) && !fs::is_directory(path, ec)) throw UserError(named + " is a file, not a folder");
     check_files_can_be_created_below(path, named);
 }

@@ -19,6 +19,12 @@ void check_campaign_folder(const fs::path& dir, const std::string& marker) {
                                     "or log line can name it; give a path without one (a campaign resumes where it "
                                     "is moved)");
     std::error_code ec;
+    // a link whose target is gone: creating the folder failed with "File exists" (probe 60)
+    if (fs::is_symlink(fs::symlink_status(dir, ec)) && !fs::exists(dir, ec))
+        throw std::invalid_argument("campaign = '" + analytics::shortened_text(dir.string(), 200) +
+                                    "' is a symbolic link to '" +
+                                    analytics::shortened_text(fs::read_symlink(dir, ec).string(), 200) +
+                                    "', which does not exist: make its target, or give another folder");
     if (!fs::is_directory(dir, ec) || fs::exists(dir / marker, ec)) return;
     std::vector<std::string> folders;
     std::size_t count = 0;

@@ -431,13 +431,20 @@ TEST_CASE("an output that is a device, a FIFO or a dangling link is refused, and
     fs::create_directories(dir);
     fs::copy_file(test::source_path("examples/diagnose/silo_105mm_wheat.json"), dir / "geometry.json");
     const std::string geometry = (dir / "geometry.json").string(), fifo = (dir / "fifo").string();
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
     REQUIRE(::mkfifo(fifo.c_str(), 0644) == 0);
     fs::create_symlink(dir / "nowhere" / "x.json", dir / "dangling.json");
+    fs::create_symlink(dir / "nowhere" / "folder", dir / "dangling_folder");
     std::ofstream(dir / "p.json") << tiny_run_params().dump();
     refused({{{"predict", geometry, "--json", fifo}, {"--json", "not a regular file"}},
              {{"predict", geometry, "--json", "/dev/null"}, {"--json", "not a regular file"}},
              {{"shear-run", (dir / "p.json").string(), "/dev/null"}, {"result", "not a regular file"}},
-             {{"predict", geometry, "--json", (dir / "dangling.json").string()}, {"--json", "a link to nothing"}}},
+             {{"predict", geometry, "--json", (dir / "dangling.json").string()}, {"--json", "a link to nothing"}},
+             // a folder that is a link to nothing: "File exists" (probe 60)
+             {{"silo", "--theta", "30", "--particles", "200", "--out", (dir / "dangling_folder").string()},
+              {"--out = '", "is a symbolic link to", "which does not exist"}},
+             {{"shear", tiny, "-s", "5e3,1e4,2e4", "--engine", "kernel", "-c", (dir / "dangling_folder").string()},
+              {"dangling_folder' is a symbolic link to", "which does not exist"}}},
             dir);
     CHECK(fs::is_fifo(fifo));
     // a link to a regular file stays a link, and its target gets the output
