@@ -73,6 +73,10 @@ CLI::Validator integer_in(long long lo, long long hi) {
             const std::string shown = "'" + analytics::shortened_text(text) + "'";
             if (end != text.c_str() + text.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
                 return shown + " is not an integer";
+            // CLI11 converts integers as C does: "0400" was octal 256 (--particles 0400 ran 256 grains)
+            const char* digits = begin + (*begin == '-' ? 1 : 0);
+            if (digits[0] == '0' && digits[1] != '\0')
+                return shown + " has a leading zero (read as octal by the converter): write it without";
             // out of range of a long long (a seed above 2^63 was silently clamped to 2^63 - 1)
             if (ec == std::errc::result_out_of_range || v < lo || v > hi) return shown + " is not " + what;
             return {};

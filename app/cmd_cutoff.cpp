@@ -328,9 +328,15 @@ int run_silo_search(const CutoffCli& o, CLI::App& sub) {
     const nlohmann::json settings = silo_campaign_settings(o);
     nlohmann::json named = settings;  // the folder named by the search, not by the spelling of its silo options
     canonicalize_silo_args(named);
-    const fs::path dir = o.campaign.empty()
-                             ? fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(named.dump()).substr(0, 12))
-                             : fs::path(o.campaign);
+    const auto default_folder = [](const nlohmann::json& s) {
+        return fs::path("campaigns") / ("cutoff-" + orchestrator::sha256_hex(s.dump()).substr(0, 12));
+    };
+    // a search begun before that was named by its options as typed: continued there (review of stop 61)
+    std::error_code ec;
+    const fs::path typed_folder = default_folder(settings);
+    const fs::path dir = !o.campaign.empty()                      ? fs::path(o.campaign)
+                         : fs::is_directory(typed_folder, ec)     ? typed_folder
+                                                                  : default_folder(named);
     check_output_folder(dir.string(), "--campaign");
     check_paths_apart(silo_campaign_inputs(o.silo_args, dir), {{o.json, "--json"}});
     if (!base.materials.cohesive())

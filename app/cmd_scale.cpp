@@ -109,7 +109,10 @@ void print_summary(const calibration::EnlargementStudy& study, const ScaleCli& o
         std::cout << study.simulations_failed << " runs failed (left out of their lines); "
                   << study.replacement_rounds << " rounds of fresh packings replaced them where a line could not be fitted\n";
     std::cout << "results: " << output_of(o).string()
-              << (o.no_plot ? " (Markdown: .md; no plot drawn, --no-plot)" : " (Markdown: .md; plots: _macro, _cost, _laws)")
+              << (o.no_plot ? " (Markdown: .md; no plot drawn, --no-plot)"
+                  : study.young_law && study.poisson_law
+                      ? " (Markdown: .md; plots: _macro, _cost, _laws)"
+                      : " (Markdown: .md; plots: _macro, _cost; no _laws: the laws were not fitted)")
               << std::endl;
     for (const auto& w : study.warnings) std::cerr << "demcal: warning: " << w << "\n";
 }

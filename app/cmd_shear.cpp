@@ -321,6 +321,24 @@ void print_status(const std::string& dir) {
                   << "run that command again)\n";
 }
 
+// The commands whose shear campaigns a folder holds beside plain ones (the first word of a campaign's label:
+// sensitivity, calibrate, scale): resume runs their pending runs, not the study, the loop or the fits around them,
+// which exited 0 as if the interrupted calibration were done (probe 62). Said on stderr.
+void warn_of_study_commands(const std::string& dir) {
+    std::set<std::string> commands;
+    for (const auto& o : inspect_campaigns(dir)) {
+        if (o.campaign.kind != orchestrator::CampaignKind::shear) continue;
+        const std::string label = ShearCampaignSpec::from_json(o.campaign.spec).label;
+        const std::string first = label.substr(0, label.find(' '));
+        if (first == "sensitivity" || first == "calibrate" || first == "scale") commands.insert(first);
+    }
+    for (const auto& command : commands)
+        std::cerr << "demcal resume: warning: " << dir << " holds the runs of a `demcal " << command
+                  << "`: resume ran its pending shear runs only; the " << command
+                  << " itself (its study, search, fits and reports) continues when the same `demcal " << command
+                  << "` command is run again, which reuses every finished run" << std::endl;
+}
+
 void run_resume(const ShearCliOptions& opt) {
     check_campaign_folder_argument(opt.campaign_dir, "resume");
     if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite")) {
@@ -365,6 +383,7 @@ void run_resume(const ShearCliOptions& opt) {
     if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";
     int code = 0;
     for (const auto& o : outs) code = std::max(code, report_campaign(runner.dir(), o, opt.plot_format));
+    warn_of_study_commands(opt.campaign_dir);
     if (code != 0) throw CLI::RuntimeError(code);
 }
 

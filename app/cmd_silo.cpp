@@ -1247,10 +1247,12 @@ nlohmann::json canonical_silo_options(const std::vector<std::string>& options) {
     CLI::App parser("silo options", "silo");
     SiloCli o;
     add_silo_options(&parser, o);
+    refuse_empty_values(parser);  // the number and integer rules: a value they refuse (an octal-looking "0400") is
+    read_values_strictly(parser);  // not given a canonical form that could equal another's
     std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
     try {
         parser.parse(reversed);
-    } catch (const CLI::Error&) {
+    } catch (const std::exception&) {  // (CLI11's errors, a rule's UserError)
         return options;  // (refused elsewhere with its message): the text as given
     }
     // one spelling per value: a number by its value (1e-3 and 0.001); a file not by its path (relative, absolute or

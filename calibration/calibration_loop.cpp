@@ -704,8 +704,12 @@ void run_coordinate(Search& s) {
         r.status = CalibrationStatus::converged;
     } else {
         r.status = CalibrationStatus::not_converged;
+        // why it stopped: the budget (--max-evaluations), or a step below what the noise lets it resolve
         r.message = "coordinate search stopped (step " + num(step) + " of the range, " +
-                    std::to_string(r.evaluations) + " evaluations) without a match";
+                    std::to_string(r.evaluations) + " evaluations) without a match" +
+                    (!s.budget_left() ? std::string(": the evaluation budget (--max-evaluations) is spent; a larger "
+                                                    "one lets it go on")
+                                      : std::string(": its step fell below 1/256 of the ranges"));
     }
 }
 

@@ -146,6 +146,15 @@ std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigm
             check_target_value(q, targets.back().value, "the measured failure line's " + q + " = " +
                                                             analytics::number_text(targets.back().value));
     }
+    // the line's interval is the acceptance band: one on mu_b that holds 0 accepts every simulated line, and the
+    // loop "converged" at its start (probe 62), the rule demcal scale holds its reference line to
+    const double mu = macro_value(line, "mu_b"), half = macro_half_width(line, "mu_b");
+    if (!(half < mu))
+        throw std::invalid_argument(
+            "the measured failure line's mu_b = " + analytics::number_text(mu, 4) + " +/- " +
+            analytics::number_text(half, 4) + " (95 %): an interval that holds 0 accepts every simulated line, so no "
+            "calibration to it means anything; measure more points or over a wider range of normal stresses, or give "
+            "its values as --target mu_b=..,tau_c=.. (met within --tol)");
     return targets;
 }
 

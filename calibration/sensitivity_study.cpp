@@ -206,6 +206,15 @@ StudyCampaign StudyCampaign::of(const CampaignSettings& c) {
     StudyCampaign out{orchestrator::to_string(c.engine), c.normal_stresses, ""};
     std::sort(out.normal_stresses.begin(), out.normal_stresses.end());
     if (!c.template_path.empty()) out.template_sha256 = orchestrator::sha256_hex(orchestrator::read_text_file(c.template_path));
+    // a --template that is the stock script, byte for byte, is the stock script (probe 62: a study on one was
+    // refused for a calibration on the other)
+    if (!out.template_sha256.empty()) {
+        std::error_code ec;
+        const auto stock = orchestrator::default_shear_template();
+        if (std::filesystem::is_regular_file(stock, ec) &&
+            out.template_sha256 == orchestrator::sha256_hex(orchestrator::read_text_file(stock)))
+            out.template_sha256.clear();
+    }
     return out;
 }
 
@@ -307,10 +316,15 @@ struct StudyFieldReader {
         return v.get<std::string>();
     }
     // A key the writer (SensitivityStudy::to_json) never writes is an edit or another file's field: refused by name.
+    // A "_" key is a comment, text, as in demcal's other JSON inputs (probe 62: "_comment" was refused).
     static void only_known_keys(const nlohmann::json& j, std::initializer_list<const char*> known,
                                 const std::string& where) {
         if (!j.is_object()) return;  // at() refuses it with its path
         for (const auto& [key, value] : j.items()) {
+            if (key.rfind('_', 0) == 0) {
+                if (!value.is_string()) refuse(path(where, analytics::shortened_text(key)), value, "a comment must be text");
+                continue;
+            }
             if (std::none_of(known.begin(), known.end(), [&key](const char* k) { return key == k; }))
                 refuse(path(where, analytics::shortened_text(key)), value,
                        "unknown key (not written by a sensitivity study)");

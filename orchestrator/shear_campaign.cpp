@@ -139,6 +139,15 @@ fs::path find_yade(const std::string& yade) {
 std::string campaign_name(const ShearCampaignSpec& spec) {
     nlohmann::json identity = spec.to_json();
     identity.erase("material_name");  // a label: campaigns of one material under two names are one campaign
+    // a number by its value: 2650 and 2650.0, 50000000 and 5e7 are one material (probe 61: a second campaign)
+    for (auto& [key, value] : identity["material"].items())
+        if (value.is_number()) value = value.get<double>();
+    return "shear-" + sha256_hex(identity.dump()).substr(0, 12);
+}
+
+std::string legacy_campaign_name(const ShearCampaignSpec& spec) {
+    nlohmann::json identity = spec.to_json();
+    identity.erase("material_name");
     return "shear-" + sha256_hex(identity.dump()).substr(0, 12);
 }
 
@@ -721,7 +730,14 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     const auto plan = plan_runs(spec, engine.identity_text, dir_);
 
     ShearCampaignOutcome out;
-    out.campaign = store_->ensure_campaign(campaign_name(spec), CampaignKind::shear, spec.to_json());
+    // a campaign made before the stresses were sorted and the numbers named by value keeps the name it was given
+    // (the stresses in the order typed, the numbers as written): continued, not doubled (review of stop 61)
+    ShearCampaignSpec as_typed = spec;
+    as_typed.normal_stresses = spec_in.normal_stresses;
+    const std::string name = campaign_name(spec), legacy = legacy_campaign_name(as_typed);
+    const bool typed_campaign = legacy != name && store_->find_campaign(legacy).has_value();
+    out.campaign = typed_campaign ? store_->ensure_campaign(legacy, CampaignKind::shear, as_typed.to_json())
+                                  : store_->ensure_campaign(name, CampaignKind::shear, spec.to_json());
     PreparedRuns runs = prepare_runs(*store_, out.campaign.id, plan, spec.engine, engine, options_.force);
     out.reused = runs.reused;
     auto executor = make_executor(options_, dir_);

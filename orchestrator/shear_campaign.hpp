@@ -149,5 +149,8 @@ private:
 std::vector<ShearCampaignOutcome> inspect_campaigns(const std::filesystem::path& dir);
 
 std::string campaign_name(const ShearCampaignSpec& spec);
+// The name a demcal before stop 61 gave the campaign (its stresses in the order typed, its numbers as written): a
+// store made then keeps its campaigns under these names.
+std::string legacy_campaign_name(const ShearCampaignSpec& spec);
 
 }  // namespace demcal::orchestrator

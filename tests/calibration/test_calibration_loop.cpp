@@ -1,6 +1,7 @@
 // The sensitivity study and the calibration loop on the analytic shear box (tests/calibration/synthetic_material):
 // known shapes, a hidden target material, an unreachable target, and the grid / coordinate baselines.
 #include "calibration/calibration_loop.hpp"
+#include "orchestrator/shear_campaign.hpp"  // default_shear_template
 #include "orchestrator/shear_params.hpp"
 #include "synthetic_material.hpp"
 #include "test_files.hpp"
@@ -122,6 +123,15 @@ TEST_CASE("a stored study keeps the campaign its lines ran on, and names what an
     CHECK(scripted.template_sha256.size() == 64);
     CHECK(ran.difference_from(scripted).find("its lines ran on the stock YADE script, this calibration on a "
                                              "--template of SHA-256 ") == 0);
+    // the stock script named by --template is the stock script (probe 62)
+    settings.template_path = orchestrator::default_shear_template();
+    CHECK(ran.difference_from(StudyCampaign::of(settings)).empty());
+    // a "_" key is a comment
+    auto commented = study.to_json();
+    commented["_comment"] = "study for the report";
+    CHECK(SensitivityStudy::from_json(commented).campaign);
+    commented["_comment"] = 3;
+    CHECK_THROWS_WITH(SensitivityStudy::from_json(commented), Catch::Contains("a comment must be text"));
     // a study written before the campaign was recorded reads back without one
     auto old = study.to_json();
     old.erase("campaign");

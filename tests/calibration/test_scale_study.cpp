@@ -84,6 +84,14 @@ void check_reduced_study(const std::string& engine) {
     CHECK(again.at("simulations_run").get<int>() == 0);
     CHECK(again.at("evaluations") == j.at("evaluations"));
     CHECK(again.at("per_radius").at(1).at("base_line") == radii[1].at("base_line"));
+    // `demcal resume` on the study's folder runs its shear campaigns only, and says the study is the command's
+    // (probe 62: it exited 0 after an interrupted study as if the study were done)
+    const std::string resume = std::string(DEMCAL_BINARY) + " resume " + dir.string() + " > " +
+                               (dir / "resume.log").string() + " 2> " + (dir / "resume.err").string();
+    (void)std::system(resume.c_str());
+    CHECK_THAT(demcal::test::read_file(dir / "resume.err"),
+               Catch::Matchers::Contains("holds the runs of a `demcal scale`") &&
+                   Catch::Matchers::Contains("the same `demcal scale` command is run again"));
     fs::remove_all(dir);
 }
 

@@ -229,3 +229,45 @@ TEST_CASE("status tells a folder's campaigns apart by what they ran",
                                     "stresses"));
     fs::remove_all(dir);
 }
+
+TEST_CASE("a campaign named by its stresses in the order typed (before they were sorted) is continued, not doubled",
+          "[kernel_engine]") {
+    // review of stop 61: sorting the stresses renamed every campaign typed out of order; resume then opened a second
+    const fs::path dir = test::fresh_test_dir("kernel-typed-order");
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "-c", (dir / "new").string()},
+                             dir / "new.log") == 0);
+    nlohmann::json legacy_spec;
+    {
+        orchestrator::CampaignStore store(dir / "new" / "campaign.sqlite");
+        REQUIRE(store.campaigns().size() == 1);
+        legacy_spec = store.campaigns().front().spec;
+    }
+    // the store an earlier demcal made for -s 7e3,3e3,5e3: its spec and name keep the typed order, no runs yet
+    legacy_spec["normal_stresses"] = {7e3, 3e3, 5e3};
+    legacy_spec.erase("material_name");
+    const std::string legacy_name =
+        orchestrator::legacy_campaign_name(orchestrator::ShearCampaignSpec::from_json(legacy_spec));
+    fs::create_directories(dir / "old");
+    {
+        orchestrator::CampaignStore store(dir / "old" / "campaign.sqlite");
+        store.ensure_campaign(legacy_name, orchestrator::CampaignKind::shear, legacy_spec);
+    }
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "7e3,3e3,5e3", "--engine", "kernel", "-c", (dir / "old").string()},
+                             dir / "old.log") == 0);
+    REQUIRE(test::run_demcal({"resume", (dir / "old").string()}, dir / "resume.log") == 0);
+    orchestrator::CampaignStore store(dir / "old" / "campaign.sqlite");
+    const auto campaigns = store.campaigns();
+    REQUIRE(campaigns.size() == 1);
+    CHECK(campaigns.front().name == legacy_name);
+    CHECK(store.campaign_runs(campaigns.front().id).size() == 3);
+    // a number written otherwise (2650.0 for 2650) is the same material: the same campaign (probe 61)
+    nlohmann::json respelled = nlohmann::json::parse(test::read_file(tiny));
+    REQUIRE(respelled.at("density").is_number_integer());
+    respelled["density"] = respelled["density"].get<double>();
+    std::ofstream(dir / "respelled.json") << respelled.dump();
+    REQUIRE(test::run_demcal({"shear", (dir / "respelled.json").string(), "-s", "3e3,5e3,7e3", "--engine", "kernel",
+                              "-c", (dir / "new").string()},
+                             dir / "respelled.log") == 0);
+    CHECK(orchestrator::CampaignStore(dir / "new" / "campaign.sqlite").campaigns().size() == 1);
+    fs::remove_all(dir);
+}

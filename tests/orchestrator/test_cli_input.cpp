@@ -57,6 +57,8 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"shear", tiny, "-s", "5e3,1e4", "-r", "600", "--max-runs", "1000"},
          "shear: 2 normal stresses x 600 replicates = 1200"},
         {{"shear", tiny, "-s", "5e3,1e4", "-r", "600", "--max-runs", "1e9"}, "--max-runs: '1e9' is not an integer"},
+        // C's conversion read "010" as octal 8 (review of stop 61: --particles 0400 ran 256 grains)
+        {{"shear", tiny, "-s", "5e3,1e4", "-r", "010"}, "--replicates: '010' has a leading zero"},
         // a negative cohesion target or negative measured stresses were calibrated against
         {{"calibrate", "--start", tiny, "--target", "mu_b=0.5,tau_c=-800"}, "target tau_c = -800: tau_c must be >= 0"},
         {{"calibrate", "--start", tiny, "--measured", "5e3:-7000,1e4:13000,2e4:25000"},
@@ -67,6 +69,9 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
          "the measured failure line's normal stresses: 4000 to 4200 Pa"},
         {{"calibrate", "--start", tiny, "--measured", "5e3:1000,1e4:6000,2e4:16000,5e3:1100,1e4:6100,2e4:16100"},
          "Pa: below 0, no bulk solid's cohesion"},
+        // probe 62: a line so scattered that its interval on mu_b holds 0 "converged" at the start, --strict or not
+        {{"calibrate", "--start", tiny, "--measured", "4e3:6500,6e3:5000,8e3:8000"},
+         "the measured failure line's mu_b = 0.375 +/- 8.2"},
         {{"calibrate", "--start", tiny, "--measured", "4e3:3e3,6e3:4e3,8e3:5e3,"},
          "--measured = '4e3:3e3,6e3:4e3,8e3:5e3,' has an empty item"},
         // a stress no shear cell reaches (kPa typed as Pa twice) was fitted as a line
