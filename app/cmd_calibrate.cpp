@@ -303,6 +303,12 @@ CalibrationOptions calibration_options(const CalibrateCli& o) {
     return options;
 }
 
+std::string surrogate_control_outside_study(const std::string& name) {
+    return "--controls: '" + name + "' is not a parameter of the sensitivity study, and the surrogate search (the "
+           "default --method) models each control from the study's responses; add it to the study's --params, or "
+           "search it with --method coordinate (with --bounds)";
+}
+
 // Every option checked before the study or the campaign runs, and before the log is rewritten. Fills the study's
 // parameters with the controls when neither they nor a stored study are given.
 void check_calibrate_options(CalibrateCli& o, const nlohmann::json& start, const std::vector<MacroTarget>& targets,
@@ -337,6 +343,12 @@ void check_calibrate_options(CalibrateCli& o, const nlohmann::json& start, const
             for (const auto& name : o.controls) orchestrator::require_micromechanical_param(name, "--controls");
             o.study.params = o.controls;
         }
+        // the surrogate models each control from the study's responses: one the study does not vary was found
+        // only after the study and a first evaluation had run (probe 62)
+        if (options.method == SearchMethod::surrogate)
+            for (const auto& name : o.controls)
+                if (std::find(o.study.params.begin(), o.study.params.end(), name) == o.study.params.end())
+                    throw UserError(surrogate_control_outside_study(name));
         check_study(start, o.study);
     }
     // a grid evaluates all of itself: grid-points ^ controls, whatever --max-evaluations says
@@ -371,6 +383,8 @@ std::vector<ControlParameter> pick_controls(const CalibrateCli& o, const Sensiti
         auto b = bounds.find(name);
         if (!p && b == bounds.end())
             throw UserError("--controls: '" + name + "' is neither in the study nor given --bounds");
+        if (!p && search_method_from_string(o.method) == SearchMethod::surrogate)
+            throw UserError(surrogate_control_outside_study(name));
         picked.push_back({name, b != bounds.end() ? b->second.first : p->low(),
                           b != bounds.end() ? b->second.second : p->high()});
     }

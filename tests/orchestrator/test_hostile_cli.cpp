@@ -900,6 +900,13 @@ TEST_CASE("probe 47: an option the rest of the command line makes void is refuse
              {{"calibrate", "--target", "mu_b=0.5", "--start", tiny, "--engine", "kernel", "--params",
                "friction_coefficient,poisson_ratio", "--bounds", "density=1000:3000", "-c", camp},
               {"--bounds density=...: density is not among the studied --params"}},
+             // probe 62: found after the study and a first evaluation
+             {{"calibrate", "--target", "mu_b=0.5", "--start", tiny, "--engine", "kernel", "--params",
+               "friction_coefficient", "--controls", "young_modulus", "--bounds", "young_modulus=3e7:8e7", "-c", camp},
+              {"--controls: 'young_modulus' is not a parameter of the sensitivity study"}},
+             {{"calibrate", "--target", "mu_b=0.5", "--start", tiny, "--engine", "kernel", "--params",
+               "friction_coefficient", "--controls", "young_modulus", "-c", camp},
+              {"--controls: 'young_modulus' is not a parameter of the sensitivity study", "--method coordinate"}},
              // -0 is 0: `--frequency 0,-0` planned two runs of the same still bin (folders f0 and f-0)
              {{"vibration", "--theta", "30", "--frequency", "0,-0", "--campaign", camp},
               {"the same run folder 'theta30_f0_seed1'"}}},
