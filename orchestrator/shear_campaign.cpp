@@ -136,20 +136,23 @@ fs::path find_yade(const std::string& yade) {
                                 "scripts/setup.sh, or pass --yade PATH)");
 }
 
-std::string campaign_name(const ShearCampaignSpec& spec) {
-    nlohmann::json identity = spec.to_json();
-    identity.erase("material_name");  // a label: campaigns of one material under two names are one campaign
-    // a number by its value: 2650 and 2650.0, 50000000 and 5e7 are one material (probe 61: a second campaign)
-    for (auto& [key, value] : identity["material"].items())
-        if (value.is_number()) value = value.get<double>();
-    return "shear-" + sha256_hex(identity.dump()).substr(0, 12);
-}
-
-std::string legacy_campaign_name(const ShearCampaignSpec& spec) {
+namespace {
+// "shear-" and a digest of the spec without its material's name (a label: one material under two names is one
+// campaign); with numbers_by_value, the material's numbers by value (2650 and 2650.0, 50000000 and 5e7 are one
+// material: probe 61), as names are given since stop 61.
+std::string campaign_name_of(const ShearCampaignSpec& spec, bool numbers_by_value) {
     nlohmann::json identity = spec.to_json();
     identity.erase("material_name");
+    if (numbers_by_value)
+        for (auto& [key, value] : identity["material"].items())
+            if (value.is_number()) value = value.get<double>();
     return "shear-" + sha256_hex(identity.dump()).substr(0, 12);
 }
+}  // namespace
+
+std::string campaign_name(const ShearCampaignSpec& spec) { return campaign_name_of(spec, true); }
+
+std::string legacy_campaign_name(const ShearCampaignSpec& spec) { return campaign_name_of(spec, false); }
 
 namespace {
 
