@@ -77,6 +77,11 @@ void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
     orchestrator::validate_shear_spec(settings_of(c, "check").spec_for(material));
 }
 
+std::string runs_cpu_text(double cpu_seconds, int reused_runs) {
+    return "CPU " + cpu_duration(cpu_seconds) +
+           (reused_runs > 0 ? " (the " + std::to_string(reused_runs) + " reused runs' own included)" : "");
+}
+
 std::string cpu_duration(double s) {
     std::ostringstream o;
     if (s >= 3600)

@@ -42,6 +42,9 @@ void check_campaign(const CampaignCli& c, const nlohmann::json& material);
 
 // "12 s", "3.4 min", "1.2 h": a total CPU time in a summary line.
 std::string cpu_duration(double seconds);
+// "CPU 2.0 min" of a command's runs, "(the N reused runs' own included)" when some were reused: their CPU was spent
+// by the command that computed them (probe 62: "CPU 2 s" beside "0 simulations run").
+std::string runs_cpu_text(double cpu_seconds, int reused_runs);
 
 // Runs in a campaign directory with one runner for all the evaluations of a command.
 struct CampaignSession {

@@ -602,6 +602,8 @@ bool passes_arguments_on(const CLI::App& command) {
 // lists (--radii A,B,C --radii D,E,F was read as six radii), silently.
 const std::set<std::string> kRepeatableOptions{"range", "bounds", "regime-column"};
 
+}  // namespace
+
 void refuse_repeated_option(const CLI::Option& opt, const std::string& value, std::vector<std::string>& earlier) {
     const std::string name = "--" + (opt.get_lnames().empty() ? opt.get_snames().front() : opt.get_lnames().front());
     const bool repeatable = std::any_of(opt.get_lnames().begin(), opt.get_lnames().end(),
@@ -614,6 +616,8 @@ void refuse_repeated_option(const CLI::Option& opt, const std::string& value, st
         throw UserError(name + " = '" + analytics::shortened_text(value, 100) + "' is given twice");
     earlier.push_back(value);
 }
+
+namespace {
 
 // Refuses an option the command does not have, before `--`. CLI11 took it for a positional value of commands that
 // pass arguments on (vibration, cutoff: `-j 2` became a silo option) and named other words than the one mistyped.

@@ -46,6 +46,12 @@ void read_values_strictly(CLI::App& app);
 // has both options. Call once every command is registered (it sets `app`'s parse-complete callback).
 void refuse_inapplicable_options(CLI::App& app);
 
+// Refuses `opt` given again (`earlier`: its values so far, as typed; `value` is appended): twice for an option that
+// takes one value or one list (CLI11 kept the last value, or joined two lists, silently), or the same value twice for
+// the options that may be repeated (--range, --bounds, --regime-column). Throws UserError naming the option and both
+// values, shortened.
+void refuse_repeated_option(const CLI::Option& opt, const std::string& value, std::vector<std::string>& earlier);
+
 // The longest command-line argument demcal takes: a path (PATH_MAX) or a list of numbers.
 inline constexpr std::size_t kMaxArgumentChars = 4096;
 

@@ -129,7 +129,7 @@ void print_level(const std::string& param, const SensitivityLevel& l) {
     std::ostringstream line;
     line << "  " << std::left << std::setw(22) << param << std::right << " = " << std::setw(10) << l.value
          << "  mu_b " << std::fixed << std::setprecision(4) << l.mu_b << " +/- " << l.se_mu_b << "  tau_c "
-         << std::setprecision(1) << l.tau_c << " +/- " << l.se_tau_c << " Pa  (" << l.simulations_run << " run, "
+         << std::setprecision(1) << l.tau_c << " +/- " << l.se_tau_c << " Pa (+/- 1 SE)  (" << l.simulations_run << " run, "
          << l.simulations_reused << " reused)";
     std::cout << line.str() << std::endl;
 }
@@ -225,7 +225,7 @@ void add_sensitivity(CLI::App& app) {
         const auto study = run_study(base, *o, session.evaluate);
         write_study(o->campaign.campaign_dir, study, o->campaign.plot_format);
         std::cout << "\n" << study.table() << "\n" << study.evaluations << " failure lines, " << study.simulations_run
-                  << " simulations run now, " << study.simulations_reused << " reused; CPU " << cpu_duration(study.cpu_s)
+                  << " simulations run now, " << study.simulations_reused << " reused; " << runs_cpu_text(study.cpu_s, study.simulations_reused)
                   << "\nresults: " << (fs::path(o->campaign.campaign_dir) / "sensitivity.json").string()
                   << ", sensitivity_table.txt, sensitivity_<param>." << o->campaign.plot_format << std::endl;
     });
@@ -422,6 +422,9 @@ SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json
         throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': " + why +
                         ": its responses hold for the campaign it ran (calibrate with the same options, or run the "
                         "study for these)");
+    if (const std::string why = study.campaign->packing_difference_from(here); !why.empty())
+        std::cerr << "demcal: warning: --sensitivity = '" << analytics::shortened_text(file, 200) << "': " << why
+                  << ": none of its lines is reused, and the search meets other packings' scatter\n";
     return study;
 }
 
@@ -431,7 +434,7 @@ std::string iteration_line(const CalibrationIteration& it) {
     line << "  #" << std::setw(2) << it.evaluation << " " << std::left << std::setw(10) << it.phase << std::right;
     for (const auto& [name, v] : it.values) line << " " << name << "=" << v;
     line << std::fixed << std::setprecision(4) << "  mu_b " << it.mu_b << " +/- " << it.mu_b_half_width
-         << std::setprecision(1) << "  tau_c " << it.tau_c << " +/- " << it.tau_c_half_width << " Pa"
+         << std::setprecision(1) << "  tau_c " << it.tau_c << " +/- " << it.tau_c_half_width << " Pa (95 %)"
          << std::setprecision(2) << "  miss " << it.mismatch
          << (it.accepted ? "  ACCEPTED (" + it.accepted_by + ")" : "") << "  [" << it.simulations_run << " run, "
          << it.simulations_reused << " reused]";
@@ -443,7 +446,7 @@ void print_calibration_plan(const CalibrateCli& o, const std::vector<MacroTarget
     std::cout << "calibrating";
     for (std::size_t i = 0; i < targets.size(); ++i)
         std::cout << (i ? ", " : " ") << targets[i].quantity << " = " << targets[i].value << " +/- "
-                  << targets[i].acceptance(o.tol) << " with " << controls[i].name << " in [" << controls[i].low
+                  << targets[i].acceptance(o.tol) << (targets[i].quantity == "tau_c" ? " Pa" : "") << " (accepted) with " << controls[i].name << " in [" << controls[i].low
                   << ", " << controls[i].high << "]";
     std::cout << " (" << o.method << (o.sequential ? ", slope first" : "") << ")" << std::endl;
 }
@@ -474,7 +477,8 @@ void print_calibration_summary(const CalibrateCli& o, const CalibrationResult& r
               << "final: mu_b = " << best.mu_b << " +/- " << best.mu_b_half_width << ", tau_c = " << best.tau_c
               << " +/- " << best.tau_c_half_width << " Pa (95 % intervals)\n"
               << "calibration: " << result.evaluations << " failure lines, " << result.simulations_run
-              << " simulations run, " << result.simulations_reused << " reused, CPU " << cpu_duration(result.cpu_s)
+              << " simulations run, " << result.simulations_reused << " reused, "
+              << runs_cpu_text(result.cpu_s, result.simulations_reused)
               << "; sensitivity study: " << study.evaluations << " failure lines, "
               << (o.sensitivity_file.empty() ? std::to_string(study.simulations_run) + " simulations run now"
                                              : "read from " + o.sensitivity_file + " (not run now)")
@@ -705,7 +709,7 @@ void print_enlargement(const analytics::ScalingLawFit& e_law, const analytics::S
               << e_law.r_squared << ")\n"
               << "nu(r) = C r^-D:   C = " << nu_law.params[0].value << " +/- " << nu_law.params[0].std_error
               << ", D = " << nu_law.params[1].value << " +/- " << nu_law.params[1].std_error << " (R^2 "
-              << nu_law.r_squared << "; nu is YADE's ks/kn)\nresults: " << output
+              << nu_law.r_squared << "; nu is YADE's ks/kn; +/- 1 SE)\nresults: " << output
               << (plot_file.empty() ? "" : ", " + plot_file) << "\n";
 }
 

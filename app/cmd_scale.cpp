@@ -104,7 +104,7 @@ void write_outputs(const calibration::EnlargementStudy& study, const ScaleCli& o
 void print_summary(const calibration::EnlargementStudy& study, const ScaleCli& o) {
     std::cout << "\n" << study.markdown() << "\n"
               << study.evaluations << " failure lines, " << study.simulations_run << " simulations run now, "
-              << study.simulations_reused << " reused; CPU " << cpu_duration(study.cpu_s) << "\n";
+              << study.simulations_reused << " reused; " << runs_cpu_text(study.cpu_s, study.simulations_reused) << "\n";
     if (study.simulations_failed > 0)
         std::cout << study.simulations_failed << " runs failed (left out of their lines); "
                   << study.replacement_rounds << " rounds of fresh packings replaced them where a line could not be fitted\n";

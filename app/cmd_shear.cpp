@@ -9,6 +9,7 @@
 #include "app/silo_campaign.hpp"
 #include "analytics/failure_line.hpp"
 #include "analytics/user_input.hpp"
+#include "calibration/campaign_evaluator.hpp"  // replaces_failed_runs
 #include "calibration/failure_line_evaluation.hpp"
 #include "orchestrator/folder_lock.hpp"
 #include "orchestrator/run_identity.hpp"
@@ -209,8 +210,9 @@ std::string field_value_key(const nlohmann::json& v) {
     return v.is_number() ? analytics::number_text(v.get<double>(), 15) : v.dump();
 }
 
-// Each material field's most common value among a store's shear campaigns: what a campaign's own values are told
-// against in `demcal status`, where campaign names are digests (a study's levels, a calibration's steps).
+// Each material field's most common value among a store's shear campaigns, where one value is more common than every
+// other: what a campaign's own values are told against in `demcal status`, where campaign names are digests (a
+// study's levels, a calibration's steps).
 std::map<std::string, std::string> common_material_values(const std::vector<ShearCampaignOutcome>& outs) {
     std::map<std::string, std::map<std::string, int>> counts;
     for (const auto& o : outs) {
@@ -218,11 +220,16 @@ std::map<std::string, std::string> common_material_values(const std::vector<Shea
         const nlohmann::json material = o.campaign.spec.value("material", nlohmann::json::object());
         for (const auto& [k, v] : material.items()) ++counts[k][field_value_key(v)];
     }
+    // a field whose values tie (a study of one parameter: each level once) has no common value: every campaign shows
+    // its own (the smallest text won the tie, and the study's lowest level read as the base, probe 62)
     std::map<std::string, std::string> common;
-    for (const auto& [k, by_value] : counts)
-        common[k] = std::max_element(by_value.begin(), by_value.end(), [](const auto& a, const auto& b) {
-                        return a.second < b.second;
-                    })->first;
+    for (const auto& [k, by_value] : counts) {
+        const auto most = std::max_element(by_value.begin(), by_value.end(),
+                                           [](const auto& a, const auto& b) { return a.second < b.second; });
+        const auto ties = std::count_if(by_value.begin(), by_value.end(),
+                                        [&most](const auto& vc) { return vc.second == most->second; });
+        if (ties == 1) common[k] = most->first;
+    }
     return common;
 }
 
@@ -339,6 +346,30 @@ void warn_of_study_commands(const std::string& dir) {
                   << "` command is run again, which reuses every finished run" << std::endl;
 }
 
+std::size_t failed_runs(const ShearCampaignOutcome& o) {
+    return std::size_t(std::count_if(o.runs.begin(), o.runs.end(), [](const orchestrator::RunRecord& r) {
+        return r.state == orchestrator::RunState::failed;
+    }));
+}
+
+// The stored campaign whose fresh packings replaced the failed runs of `o` (calibration::replaces_failed_runs), if
+// every run of `o` has ended (nothing of it is left to run) and one has failed.
+const ShearCampaignOutcome* replacing_campaign(const ShearCampaignOutcome& o,
+                                               const std::vector<ShearCampaignOutcome>& stored) {
+    const auto ended = [](const orchestrator::RunRecord& r) {
+        return r.state == orchestrator::RunState::done || r.state == orchestrator::RunState::failed;
+    };
+    if (o.campaign.kind != CampaignKind::shear || failed_runs(o) == 0 ||
+        !std::all_of(o.runs.begin(), o.runs.end(), ended))
+        return nullptr;
+    const auto spec = ShearCampaignSpec::from_json(o.campaign.spec);
+    for (const auto& later : stored)
+        if (later.campaign.kind == CampaignKind::shear &&
+            calibration::replaces_failed_runs(ShearCampaignSpec::from_json(later.campaign.spec), spec))
+            return &later;
+    return nullptr;
+}
+
 void run_resume(const ShearCliOptions& opt) {
     check_campaign_folder_argument(opt.campaign_dir, "resume");
     if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite")) {
@@ -381,8 +412,19 @@ void run_resume(const ShearCliOptions& opt) {
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
     const auto outs = runner.resume(print_progress);
     if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";
+    const auto stored = inspect_campaigns(opt.campaign_dir);
     int code = 0;
-    for (const auto& o : outs) code = std::max(code, report_campaign(runner.dir(), o, opt.plot_format));
+    for (const auto& o : outs) {
+        // a study's line whose failed runs fresh packings replaced was fitted over both campaigns: reported as a
+        // failure of its own on every resume (exit 1), it was retried never (probe 62)
+        if (const auto* by = replacing_campaign(o, stored)) {
+            std::cout << "campaign " << o.campaign.name << ": its " << failed_runs(o)
+                      << " failed run(s) were replaced by the fresh packings of campaign " << by->campaign.name
+                      << " (the study fits its line over every round's runs); nothing to resume\n";
+            continue;
+        }
+        code = std::max(code, report_campaign(runner.dir(), o, opt.plot_format));
+    }
     warn_of_study_commands(opt.campaign_dir);
     if (code != 0) throw CLI::RuntimeError(code);
 }

@@ -29,6 +29,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -1202,29 +1203,47 @@ void add_silo_options(CLI::App* sub, SiloCli& o) {
 
 }  // namespace
 
-ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options, const std::string& owner) {
-    CLI::App parser("the silo options of " + owner, "silo");
-    SiloCli o;
-    add_silo_options(&parser, o);
-    refuse_empty_values(parser);  // the number rule, as on demcal silo's own command line
-    read_values_strictly(parser);
-    // an option given twice after --: CLI11 said only "At Most 1 required but received 2" (probe 60b)
-    std::map<std::string, std::string> given;
+namespace {
+
+// demcal silo's options on a parser of their own, read by the rules of demcal silo's command line (no empty value,
+// the number and integer rules, one value per occurrence): for the options a campaign passes on after --
+std::unique_ptr<CLI::App> silo_options_parser(SiloCli& o, const std::string& title) {
+    auto parser = std::make_unique<CLI::App>(title, "silo");
+    add_silo_options(parser.get(), o);
+    refuse_empty_values(*parser);
+    read_values_strictly(*parser);
+    return parser;
+}
+
+// An option given twice after --, by demcal's one rule (refuse_repeated_option): CLI11 said only "At Most 1 required
+// but received 2" (probe 60b). A flag given twice is harmless: it says one thing, and has no value to name.
+void refuse_repeated_silo_options(const CLI::App& parser, const std::vector<std::string>& options,
+                                  const std::string& owner) {
+    std::map<const CLI::Option*, std::vector<std::string>> given;
     for (std::size_t i = 0; i < options.size(); ++i) {
         const std::string& arg = options[i];
         if (arg.size() < 3 || arg.rfind("--", 0) != 0) continue;
         const std::string name = arg.substr(0, arg.find('='));
         const CLI::Option* opt = parser.get_option_no_throw(name);
-        if (!opt || opt->get_expected_max() == 0 || opt->get_type_size_max() == 0) continue;  // (a flag: harmless)
+        if (!opt || opt->get_expected_max() == 0 || opt->get_type_size_max() == 0) continue;
         const std::string value = name.size() < arg.size() ? arg.substr(name.size() + 1)
                                   : i + 1 < options.size() ? options[i + 1]
                                                            : "";
-        if (const auto earlier = given.find(opt->get_name()); earlier != given.end())
-            throw UserError("silo options of " + owner + ": " + name + " is given twice ('" +
-                            analytics::shortened_text(earlier->second, 100) + "' and '" +
-                            analytics::shortened_text(value, 100) + "'): give it once");
-        given[opt->get_name()] = value;
+        try {
+            refuse_repeated_option(*opt, value, given[opt]);
+        } catch (const UserError& e) {
+            throw UserError("silo options of " + owner + ": " + e.what());
+        }
     }
+}
+
+}  // namespace
+
+ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options, const std::string& owner) {
+    SiloCli o;
+    const auto parser_owned = silo_options_parser(o, "the silo options of " + owner);
+    CLI::App& parser = *parser_owned;
+    refuse_repeated_silo_options(parser, options, owner);
     std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
     try {
         parser.parse(reversed);
@@ -1244,28 +1263,26 @@ ks::SiloCaseSettings silo_case_settings(const std::vector<std::string>& options,
 }
 
 nlohmann::json canonical_silo_options(const std::vector<std::string>& options) {
-    CLI::App parser("silo options", "silo");
-    SiloCli o;
-    add_silo_options(&parser, o);
-    refuse_empty_values(parser);  // the number and integer rules: a value they refuse (an octal-looking "0400") is
-    read_values_strictly(parser);  // not given a canonical form that could equal another's
+    SiloCli o;  // (demcal silo's rules: a value they refuse, an octal-looking "0400", gets no canonical form that
+    const auto parser = silo_options_parser(o, "silo options");  // could equal another's)
     std::vector<std::string> reversed(options.rbegin(), options.rend());  // CLI11 takes them last first
     try {
-        parser.parse(reversed);
+        parser->parse(reversed);
     } catch (const std::exception&) {  // (CLI11's errors, a rule's UserError)
         return options;  // (refused elsewhere with its message): the text as given
     }
     // one spelling per value: a number by its value (1e-3 and 0.001); a file not by its path (relative, absolute or
     // through a link): the campaigns compare its contents' digest (silo_input_file_digests)
     const auto value_key = [](const std::string& option, const std::string& value) -> std::string {
-        if (option == "--material" || option == "--geometry") return "(a file: its contents are compared by digest)";
+        if (std::count(kSiloFileOptions.begin(), kSiloFileOptions.end(), option))
+            return "(a file: its contents are compared by digest)";
         char* end = nullptr;
         const double number = std::strtod(value.c_str(), &end);
         if (!value.empty() && end && *end == '\0') return silo_number(number);
         return value;
     };
     nlohmann::json canonical = nlohmann::json::object();  // (sorted by option name)
-    for (const CLI::Option* opt : parser.get_options()) {
+    for (const CLI::Option* opt : parser->get_options()) {
         if (opt->count() == 0 || opt->get_name().empty()) continue;
         const std::string name = opt->get_name(false, true);  // the long name, whichever spelling was typed
         nlohmann::json values = nlohmann::json::array();

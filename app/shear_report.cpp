@@ -35,10 +35,10 @@ void print_line(const char* title, const analytics::FailureLine& fl) {
     saved.copyfmt(std::cout);  // restored at the end: later output keeps cout's default format
     std::cout << std::fixed << std::setprecision(4) << title << ": tau = " << fl.mu_b << " sigma "
               << (fl.tau_c < 0 ? "- " : "+ ") << std::setprecision(1) << std::fabs(fl.tau_c) << " Pa\n"
-              << std::setprecision(4) << "  mu_b  = " << fl.mu_b << " +/- " << fl.se_mu_b << "  (95% CI "
+              << std::setprecision(4) << "  mu_b  = " << fl.mu_b << " +/- " << fl.se_mu_b << " SE  (95% CI "
               << fl.mu_b_low << " .. " << fl.mu_b_high << "),  phi_b = " << std::setprecision(2) << fl.phi_b_deg
               << " +/- " << fl.se_phi_b_deg << " deg\n"
-              << std::setprecision(1) << "  tau_c = " << fl.tau_c << " +/- " << fl.se_tau_c << " Pa  (95% CI "
+              << std::setprecision(1) << "  tau_c = " << fl.tau_c << " +/- " << fl.se_tau_c << " Pa SE  (95% CI "
               << fl.tau_c_low << " .. " << fl.tau_c_high << "),  R^2 = " << std::setprecision(4) << fl.r_squared
               << ", n = " << fl.n << "\n";
     // a friction coefficient is > 0: a slope below 0, or one whose interval holds 0, is the boxes' scatter, not a

@@ -191,7 +191,7 @@ void check_silo_runs(const std::vector<SiloRunPlan>& plans) {
 std::vector<std::pair<std::string, std::string>> silo_input_files(const std::vector<std::string>& silo_args) {
     std::vector<std::pair<std::string, std::string>> files;
     for (std::size_t i = 0; i < silo_args.size(); ++i)
-        for (const std::string option : {"--material", "--geometry"}) {
+        for (const std::string option : kSiloFileOptions) {
             if (silo_args[i] == option && i + 1 < silo_args.size())
                 files.emplace_back(option, silo_args[i + 1]);
             else if (silo_args[i].rfind(option + "=", 0) == 0)

@@ -1,14 +1,19 @@
 // The silo case's settings from `demcal silo`'s own options, for commands that run the silo case themselves
 // (demcal cutoff --silo): the same options, defaults, checks and messages as `demcal silo` (cmd_silo.cpp).
 #pragma once
+#include <array>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
-#include <vector>
 
 #include "kernel/silo/silo_case.hpp"
 
 namespace demcal {
+
+/// The silo options that name an input file: a campaign records their contents' digests and compares those, not the
+/// path as typed.
+inline constexpr std::array<const char*, 2> kSiloFileOptions{"--material", "--geometry"};
 
 /// `options` as `demcal silo` takes them (e.g. {"--material", "meal.json", "--theta", "30"}); `owner` names the
 /// command in messages. Throws UserError naming the option and value; options that set a run's own outputs or

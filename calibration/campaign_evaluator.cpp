@@ -2,7 +2,10 @@
 
 #include "orchestrator/campaign_suspended.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <stdexcept>
+#include <utility>
 
 namespace demcal::calibration {
 
@@ -18,6 +21,31 @@ orchestrator::ShearCampaignSpec CampaignSettings::spec_for(const nlohmann::json&
     return spec;
 }
 
+namespace {
+constexpr const char* kReplacementWord = "replacement ";
+
+// A label's line label and round: "L replacement 2" -> {"L", 2}; a label of no replacement -> {label, 0}.
+std::pair<std::string, int> split_replacement_label(const std::string& label) {
+    const std::size_t at = label.rfind(kReplacementWord);
+    if (at == std::string::npos || (at > 0 && label[at - 1] != ' ')) return {label, 0};
+    const std::string digits = label.substr(at + std::string(kReplacementWord).size());
+    if (digits.empty() || digits.size() > 3 || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) return {label, 0};
+    return {label.substr(0, at == 0 ? 0 : at - 1), std::stoi(digits)};
+}
+}  // namespace
+
+std::string replacement_label(const std::string& label, int round) {
+    return label + (label.empty() ? "" : " ") + kReplacementWord + std::to_string(round);
+}
+
+bool replaces_failed_runs(const orchestrator::ShearCampaignSpec& later, const orchestrator::ShearCampaignSpec& earlier) {
+    const auto [line_label, round] = split_replacement_label(earlier.label);
+    return later.label == replacement_label(line_label, round + 1) && later.material == earlier.material &&
+           later.normal_stresses == earlier.normal_stresses && later.replicates == earlier.replicates &&
+           later.base_seed == earlier.base_seed + earlier.replicates && later.engine == earlier.engine &&
+           later.template_path == earlier.template_path;
+}
+
 FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runner, CampaignSettings settings,
                                         orchestrator::ProgressCallback progress) {
     return [&runner, settings = std::move(settings), progress = std::move(progress)](const nlohmann::json& material) {
@@ -29,7 +57,7 @@ FailureLineEvaluator campaign_evaluator(orchestrator::ShearCampaignRunner& runne
                             ev.outcome.infrastructure_failure.empty();
              ++round) {
             spec.base_seed += spec.replicates;  // the next unused seeds
-            spec.label = label + (label.empty() ? "" : " ") + "replacement " + std::to_string(round);
+            spec.label = replacement_label(label, round);
             ev = failure_lines_of(merged_outcome(ev.outcome, runner.run(spec, progress)));
             ev.replacement_rounds = round;
         }

@@ -26,6 +26,15 @@ struct CampaignSettings {
 // Most rounds of replacement packings for one failure line (see campaign_evaluator).
 inline constexpr int kMaxReplacementRounds = 2;
 
+// The label of round `round` (1, 2, ...) of the fresh packings that replace a line's failed runs, for a line
+// labelled `label` ("scale r=0.004" -> "scale r=0.004 replacement 1").
+std::string replacement_label(const std::string& label, int round);
+
+// Whether campaign `later` holds the fresh packings that replaced the failed runs of `earlier` (the next round of
+// campaign_evaluator): the same material, stresses, replicates, engine and template, the seeds after earlier's, and
+// the next round's label. Such failures are not the line's: the study fitted it over both campaigns' runs.
+bool replaces_failed_runs(const orchestrator::ShearCampaignSpec& later, const orchestrator::ShearCampaignSpec& earlier);
+
 // Evaluates materials through `runner` (which must outlive the evaluator). A run that fails for a physical reason
 // (a packing the lid servo cannot hold, say) fails again whenever it is rerun, so a line left with too few runs to fit
 // would stop a study or a calibration for good, resumed or not: such a line gets up to kMaxReplacementRounds rounds of

@@ -112,7 +112,7 @@ void say(const EnlargementProgress& progress, const std::string& line) {
 std::string line_text(const analytics::FailureLine& l) {
     std::ostringstream o;
     o.precision(4);
-    o << "mu_b " << l.mu_b << " +/- " << l.se_mu_b << ", tau_c " << l.tau_c << " +/- " << l.se_tau_c << " Pa";
+    o << "mu_b " << l.mu_b << " +/- " << l.se_mu_b << ", tau_c " << l.tau_c << " +/- " << l.se_tau_c << " Pa (+/- 1 SE)";
     return o.str();
 }
 

@@ -203,7 +203,7 @@ SensitivityStudy run_sensitivity_study(const nlohmann::json& base, const Failure
 }
 
 StudyCampaign StudyCampaign::of(const CampaignSettings& c) {
-    StudyCampaign out{orchestrator::to_string(c.engine), c.normal_stresses, ""};
+    StudyCampaign out{orchestrator::to_string(c.engine), c.normal_stresses, "", c.replicates, c.base_seed};
     std::sort(out.normal_stresses.begin(), out.normal_stresses.end());
     if (!c.template_path.empty()) out.template_sha256 = orchestrator::sha256_hex(orchestrator::read_text_file(c.template_path));
     // a --template that is the stock script, byte for byte, is the stock script (probe 62: a study on one was
@@ -239,6 +239,16 @@ std::string StudyCampaign::difference_from(const StudyCampaign& here) const {
     return "";
 }
 
+std::string StudyCampaign::packing_difference_from(const StudyCampaign& here) const {
+    if (!replicates || !base_seed || !here.replicates || !here.base_seed) return "";
+    if (*replicates == *here.replicates && *base_seed == *here.base_seed) return "";
+    const auto packings = [](int r, long seed) {
+        return std::to_string(r) + " packing(s) per stress from seed " + std::to_string(seed);
+    };
+    return "its lines sheared " + packings(*replicates, *base_seed) + " (--replicates, --seed), this calibration's " +
+           packings(*here.replicates, *here.base_seed);
+}
+
 nlohmann::json SensitivityStudy::to_json() const {
     nlohmann::json j = {{"schema", "demcal.sensitivity/1"},
                         {"base_material", base_material},
@@ -252,10 +262,13 @@ nlohmann::json SensitivityStudy::to_json() const {
                         {"simulations_reused", simulations_reused},
                         {"cpu_s", cpu_s},
                         {"parameters", nlohmann::json::array()}};
-    if (campaign)
+    if (campaign) {
         j["campaign"] = {{"engine", campaign->engine},
                          {"normal_stresses", campaign->normal_stresses},
                          {"template_sha256", campaign->template_sha256}};
+        if (campaign->replicates) j["campaign"]["replicates"] = *campaign->replicates;
+        if (campaign->base_seed) j["campaign"]["base_seed"] = *campaign->base_seed;
+    }
     for (const auto& p : parameters) {
         nlohmann::json pj = {{"name", p.name}, {"base_value", p.base_value}, {"levels", nlohmann::json::array()}};
         for (const auto& l : p.levels)
@@ -362,7 +375,7 @@ void read_study_settings(const nlohmann::json& j, SensitivityStudy& s) {
 
 // The campaign the study ran on (its "campaign" object).
 StudyCampaign read_study_campaign(const nlohmann::json& c) {
-    R::only_known_keys(c, {"engine", "normal_stresses", "template_sha256"}, "campaign");
+    R::only_known_keys(c, {"engine", "normal_stresses", "template_sha256", "replicates", "base_seed"}, "campaign");
     StudyCampaign out;
     out.engine = R::text(c, "engine", "campaign");
     if (out.engine != "yade" && out.engine != "kernel")
@@ -377,6 +390,15 @@ StudyCampaign read_study_campaign(const nlohmann::json& c) {
     }
     std::sort(out.normal_stresses.begin(), out.normal_stresses.end());
     out.template_sha256 = R::text(c, "template_sha256", "campaign");
+    // (absent in a study written before stop 62)
+    const auto whole = [&c](const char* key, double lo, double hi, const char* range) {
+        const double x = R::number(c, key, "campaign", lo, hi, range);
+        if (!c.at(key).is_number_integer()) R::refuse(R::path("campaign", key), c.at(key), "must be a whole number");
+        return x;
+    };
+    if (c.contains("replicates"))
+        out.replicates = static_cast<int>(whole("replicates", 1, orchestrator::kMaxReplicates, "[1, 1000]"));
+    if (c.contains("base_seed")) out.base_seed = static_cast<long>(whole("base_seed", 0, 2147483647.0, "[0, 2147483647]"));
     return out;
 }
 

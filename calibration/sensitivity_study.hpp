@@ -54,9 +54,15 @@ struct StudyCampaign {
     std::string engine;                   // "yade" or "kernel"
     std::vector<double> normal_stresses;  // [Pa], ascending
     std::string template_sha256;          // SHA-256 of a --template YADE script's text; empty for the stock script
+    std::optional<int> replicates;        // packings per stress (absent in a study written before demcal recorded it)
+    std::optional<long> base_seed;        // the first packing's seed (likewise)
     static StudyCampaign of(const CampaignSettings& c);  // reads the template; throws std::runtime_error if it cannot
     // Empty when a calibration running `here` may use the study; else what differs, both values named.
     std::string difference_from(const StudyCampaign& here) const;
+    // Empty when `here` shears the study's packings; else how they differ. Not a reason to refuse the study (its
+    // responses are the material's), but its lines are then not the calibration's: none is reused, and the search
+    // compares lines of other packings (their scatter included).
+    std::string packing_difference_from(const StudyCampaign& here) const;
 };
 
 struct SensitivityStudy {

@@ -104,10 +104,20 @@ TEST_CASE("a stored study keeps the campaign its lines ran on, and names what an
     const auto again = SensitivityStudy::from_json(study.to_json());
     REQUIRE(again.campaign);
     CHECK(again.campaign->difference_from(ran).empty());
-    // replicates and the seed change the lines' precision only
+    CHECK(again.campaign->replicates == 3);  // the packings, kept since stop 62
+    CHECK(again.campaign->base_seed == 1);
+    CHECK(again.campaign->packing_difference_from(ran).empty());
+    // replicates and the seed change the lines' precision only: not refused, told (probe 62: said nothing)
     settings.replicates = 1;
     settings.base_seed = 7;
     CHECK(ran.difference_from(StudyCampaign::of(settings)).empty());
+    CHECK(ran.packing_difference_from(StudyCampaign::of(settings)) ==
+          "its lines sheared 3 packing(s) per stress from seed 1 (--replicates, --seed), this calibration's 1 "
+          "packing(s) per stress from seed 7");
+    auto unrecorded = ran;  // a study written before stop 62 records neither
+    unrecorded.replicates.reset();
+    unrecorded.base_seed.reset();
+    CHECK(unrecorded.packing_difference_from(StudyCampaign::of(settings)).empty());
     settings.engine = orchestrator::ShearEngine::yade;
     CHECK(ran.difference_from(StudyCampaign::of(settings)) == "its lines ran on --engine kernel, this calibration on yade");
     settings.engine = orchestrator::ShearEngine::kernel;

@@ -3,6 +3,7 @@
 // run follows from the store, so the same command again computes nothing and decides the same.
 // The material shears its box at 2 m/s: the lid servo cannot hold the normal stress, so every kernel run fails by the
 // box's own check (a physical failure: never retried), in well under a second.
+#include "calibration/campaign_evaluator.hpp"
 #include "demcal_cli.hpp"
 #include "orchestrator/campaign_store.hpp"
 #include "test_files.hpp"
@@ -75,5 +76,50 @@ TEST_CASE("a line whose runs all fail gets two rounds of fresh packings, then a 
     const StoredLine again = stored(dir / "c");
     CHECK(again.runs == 9);
     CHECK(again.base_seeds == first.base_seeds);
+
+    // demcal resume on the folder: the two campaigns whose failures fresh packings replaced are said to be so (each
+    // resume reported them as failed lines of their own, exit 1, probe 62); the last round's failures are its own
+    const int rc_resume = test::run_demcal_command("resume '" + (dir / "c").string() + "'", dir / "resume.log");
+    const std::string resumed = test::read_file(dir / "resume.log");
+    INFO(resumed);
+    CHECK(rc_resume == 1);
+    std::size_t replaced = 0;
+    for (std::size_t at = resumed.find("were replaced by the fresh packings of campaign"); at != std::string::npos;
+         at = resumed.find("were replaced by the fresh packings of campaign", at + 1))
+        ++replaced;
+    CHECK(replaced == 2);
+    CHECK(again.runs == stored(dir / "c").runs);  // nothing rerun
     fs::remove_all(dir);
+}
+
+TEST_CASE("a campaign replaces another's failed runs only as the next round of the same line") {
+    orchestrator::ShearCampaignSpec line;
+    line.material = {{"friction_coefficient", 0.5}};
+    line.normal_stresses = {3e3, 5e3};
+    line.replicates = 2;
+    line.base_seed = 1;
+    line.label = "scale r=0.004";
+    auto round1 = line;
+    round1.base_seed = 3;
+    round1.label = calibration::replacement_label(line.label, 1);
+    CHECK(round1.label == "scale r=0.004 replacement 1");
+    auto round2 = round1;
+    round2.base_seed = 5;
+    round2.label = calibration::replacement_label(line.label, 2);
+    CHECK(calibration::replaces_failed_runs(round1, line));
+    CHECK(calibration::replaces_failed_runs(round2, round1));
+    CHECK_FALSE(calibration::replaces_failed_runs(round2, line));   // not the next round
+    CHECK_FALSE(calibration::replaces_failed_runs(line, round1));   // not backwards
+    auto other_material = round1;
+    other_material.material["friction_coefficient"] = 0.6;
+    CHECK_FALSE(calibration::replaces_failed_runs(other_material, line));
+    auto other_seeds = round1;
+    other_seeds.base_seed = 7;
+    CHECK_FALSE(calibration::replaces_failed_runs(other_seeds, line));
+    auto unlabelled = line;
+    unlabelled.label = "";
+    auto unlabelled_round1 = round1;
+    unlabelled_round1.label = calibration::replacement_label("", 1);
+    CHECK(unlabelled_round1.label == "replacement 1");
+    CHECK(calibration::replaces_failed_runs(unlabelled_round1, unlabelled));
 }

@@ -474,6 +474,9 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
                test::source_path("examples/silo/rect_hopper_60deg.json").string()},
               {"--geometry", "\"rectangular\"", "conical silo only"}},
              {{"cutoff", "--bond-number", "10", "--seeds", "1,1"}, {"--seeds: seed 1 is given twice"}},
+             // a silo option given twice after -- (CLI11 said "At Most 1 required but received 2", probe 60b)
+             {{"cutoff", "--bond-number", "10", "--", "--particles", "300", "--particles=400"},
+              {"silo options of demcal cutoff: --particles is given twice ('300' and '400')"}},
              // vibration settings of a still bin were recorded and did nothing (probe 58)
              {{"vibration", "--theta", "30", "--frequency", "0", "--amplitude", "1e-4", "--campaign", camp},
               {"--amplitude applies to a vibrating bin, and every --frequency is 0"}},
@@ -1001,6 +1004,12 @@ TEST_CASE("probe 47: a stored sensitivity study with a damaged field is refused 
                                j["campaign"] = {{"engine", "kernel"}, {"normal_stresses", {1e4, -5}}, {"template_sha256", ""}};
                            })),
               {"campaign.normal_stresses[1] = -5: must lie in (0, 1e100] Pa"}},
+             {with(damaged("campaign_replicates.json",
+                           [](nlohmann::json& j) {
+                               j["campaign"] = {{"engine", "kernel"}, {"normal_stresses", {1e4}},
+                                                {"template_sha256", ""}, {"replicates", 2.5}};
+                           })),
+              {"campaign.replicates = 2.5: must be a whole number"}},
              {with(damaged("count.json",
                            [](nlohmann::json& j) {
                                auto& levels = j["parameters"][0]["levels"];
