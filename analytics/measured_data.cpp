@@ -22,12 +22,7 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-std::string trim(std::string_view s) {
-    const auto first = s.find_first_not_of(" \t\r");
-    if (first == std::string_view::npos) return {};
-    const auto last = s.find_last_not_of(" \t\r");
-    return std::string(s.substr(first, last - first + 1));
-}
+std::string trim(std::string_view s) { return trimmed(s); }
 
 // Strict: the whole cell is one finite number (no "12 kg", no "1,5", no "nan"/"inf").
 std::optional<double> parse_number(const std::string& cell) {

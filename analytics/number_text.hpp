@@ -20,6 +20,15 @@ inline std::string number_text(double value, int significant_digits = 6) {
     return s.str();
 }
 
+// `s` without the blanks (spaces, tabs, line ends) at its two ends: a CSV cell, a list item typed "5e3, 1e4", a
+// value pasted with its line end.
+inline std::string trimmed(std::string_view s) {
+    constexpr const char* blanks = " \t\r\n";
+    const auto first = s.find_first_not_of(blanks);
+    if (first == std::string_view::npos) return {};
+    return std::string(s.substr(first, s.find_last_not_of(blanks) - first + 1));
+}
+
 // A value as a message shows it: whole when short, else its start and how long it was (a 50 MB string in an input
 // must not end up on stderr in full); control characters escaped (\n, \x1b), so that a message stays one line and a
 // value cannot move the terminal's cursor or colour.

@@ -1,6 +1,7 @@
 #include "app/campaign_cli.hpp"
 
 #include "analytics/failure_line.hpp"
+#include "analytics/number_text.hpp"  // trimmed
 #include "app/cli_support.hpp"
 #include "app/commands.hpp"
 #include "orchestrator/shear_params.hpp"
@@ -37,7 +38,15 @@ void add_campaign_options(CLI::App* cmd, CampaignCli& c) {
 std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<std::string>& items,
                                                               const std::string& option) {
     std::map<std::string, std::pair<double, double>> out;
-    for (const auto& item : items) {
+    for (const auto& typed : items) {
+        // blanks around the parts are no part of them ("young_modulus = 1e7 : 2e7")
+        const std::string item = [&typed] {
+            std::string t = analytics::trimmed(typed);
+            for (const char sep : {'=', ':'})
+                if (const auto at = t.find(sep); at != std::string::npos)
+                    t = analytics::trimmed(t.substr(0, at)) + sep + analytics::trimmed(t.substr(at + 1));
+            return t;
+        }();
         const auto eq = item.find('='), colon = item.find(':');
         double lo = NAN, hi = NAN;
         bool ok = eq != std::string::npos && colon != std::string::npos && colon > eq;

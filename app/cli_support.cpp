@@ -129,10 +129,19 @@ void read_values_strictly(CLI::App& app) {
                                      : std::string();
         },
         "");
+    // blanks around a list's items are no part of them: "5e3, 1e4" (probe 61: ' 1e4' was refused); added last, so
+    // it runs before every other check of the value (CLI11 runs the transforms added last first)
+    const CLI::Validator item_blanks_dropped(
+        [](std::string& item) {
+            item = analytics::trimmed(item);
+            return std::string();
+        },
+        "");
     for (CLI::Option* opt : app.get_options()) {
         if (opt->get_type_size_max() <= 0 || !opt->nonpositional()) continue;  // a flag; the words after --
         if (opt->get_items_expected_max() > 1) opt->allow_extra_args(false);
         opt->transform(not_an_option);
+        if (opt->get_delimiter() == ',') opt->transform(item_blanks_dropped);
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) read_values_strictly(*sub);
 }
@@ -403,9 +412,16 @@ void check_output_file(const std::string& path, const std::string& option) {
     check_name_lengths(path, named, PathKind::file);
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
+    // /dev/stderr, /proc/self/fd/2: a stream's name, not a file's. Where the stream was redirected to a file, that
+    // file was replaced whole (a result is written to a temporary file and renamed), the lines before it lost.
+    const std::string absolute = fs::absolute(path, ec).lexically_normal().string();
+    if (absolute.rfind("/dev/", 0) == 0 || absolute.rfind("/proc/", 0) == 0)
+        throw UserError(named + " names a device or a process's stream, not a regular file; give a file name" +
+                        (option == "--json" ? " (--json - writes to standard output)" : ""));
     const fs::file_status st = fs::status(path, ec);  // (through a link: what the output would be written into)
     if (fs::exists(st) && !fs::is_regular_file(st))
-        throw UserError(named + " is not a regular file (a device, FIFO or socket); give a file name");
+        throw UserError(named + " is not a regular file (a device, FIFO or socket); give a file name" +
+                        (option == "--json" ? " (--json - writes to standard output)" : ""));
     if (fs::is_symlink(fs::symlink_status(path, ec)) && !fs::exists(st))
         throw UserError(named + " is a link to nothing (" +
                         analytics::shortened_text(fs::read_symlink(path, ec).string(), 200) + "); give a file name");
@@ -658,9 +674,12 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
         }
         std::string command;
         for (std::size_t k = 1; k < chain.size(); ++k) command += (k > 1 ? " " : "") + chain[k]->get_name();
-        throw UserError(command + ": '" + analytics::shortened_text(name) + "' is not an option of this command (" +
-                        "see demcal " + command + " --help" +
-                        (passes_arguments_on(*chain.back()) ? "; options for the runs go after --" : "") + ")");
+        // "-geo.json": a file whose name starts with -, read as the option -g (probe 61 named '-g')
+        const bool word = arg[1] != '-' && arg.size() > 2;
+        throw UserError(command + ": '" + analytics::shortened_text(word ? arg : name) +
+                        "' is not an option of this command (see demcal " + command + " --help" +
+                        (passes_arguments_on(*chain.back()) ? "; options for the runs go after --" : "") +
+                        (word ? "; a file named so is given as ./" + analytics::shortened_text(arg) : "") + ")");
     }
 }
 

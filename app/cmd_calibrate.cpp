@@ -258,6 +258,7 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
     std::stringstream items(o.measured);
     std::string item;
     while (std::getline(items, item, ',')) {
+        item = analytics::trimmed(item);  // "4e3:6500, 6e3:7200", a pasted line end
         const auto colon = item.find(':');
         try {
             if (colon == std::string::npos) throw std::invalid_argument(item);
@@ -269,8 +270,8 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
                                     analytics::shortened_text(text) + " " + *n.defect);
                 return n.value;
             };
-            sigma.push_back(whole_number(item.substr(0, colon)));
-            tau.push_back(whole_number(item.substr(colon + 1)));
+            sigma.push_back(whole_number(analytics::trimmed(item.substr(0, colon))));
+            tau.push_back(whole_number(analytics::trimmed(item.substr(colon + 1))));
         } catch (const std::invalid_argument&) {
             throw UserError("measured point '" + analytics::shortened_text(item) + "' is not of the form SIGMA:TAU (Pa)");
         }

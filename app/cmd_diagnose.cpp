@@ -41,8 +41,11 @@ optional model constants (defaults in brackets):
   the flow pattern and each model says whether it applies))";
 
 void run_predict(const std::string& geometry_path, const std::string& json_out) {
-    check_output_file_in_new_folders(json_out, "--json");  // before anything is printed as a result
-    check_paths_apart({{geometry_path, "geometry"}}, {{json_out, "--json"}});
+    const JsonOnStandardOutput json_stdout(json_out);
+    if (!json_stdout.active()) {
+        check_output_file_in_new_folders(json_out, "--json");  // before anything is printed as a result
+        check_paths_apart({{geometry_path, "geometry"}}, {{json_out, "--json"}});
+    }
     analytics::SiloGeometry geometry;
     try {
         geometry = analytics::geometry_from_json(read_json_file(geometry_path, "predict"));
@@ -67,7 +70,7 @@ void run_predict(const std::string& geometry_path, const std::string& json_out) 
         if (geometry.effective_friction_deg)
             j["jenike_mass_flow_limit_deg"] =
                 analytics::jenike_mass_flow_limit_deg(*geometry.effective_friction_deg, *geometry.wall_friction_deg);
-        write_result_file(json_out, j.dump(2) + "\n");
+        write_json_result(json_out, j.dump(2) + "\n");
     }
 }
 
@@ -363,7 +366,7 @@ void print_diagnosis(const analytics::DiagnoseResult& r, int max_effects) {
 // --json and --report (with its residual plots unless --no-plots).
 void write_diagnosis_files(const DiagnoseArgs& a, const analytics::DiagnoseResult& r,
                            const analytics::MeasuredData& data) {
-    if (!a.json_out.empty()) write_result_file(a.json_out, r.to_json().dump(2) + "\n");
+    if (!a.json_out.empty()) write_json_result(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
         const std::filesystem::path report(a.report_out);
         std::string before_name, after_name;
@@ -383,9 +386,10 @@ void write_diagnosis_files(const DiagnoseArgs& a, const analytics::DiagnoseResul
 
 // Every output place before any work (issue 23): a path that cannot be written is refused at once.
 void check_diagnosis_outputs(const DiagnoseArgs& a) {
-    check_output_file_in_new_folders(a.json_out, "--json");
+    const std::string json_file = names_standard_output(a.json_out) ? "" : a.json_out;  // (--json -: stdout)
+    check_output_file_in_new_folders(json_file, "--json");
     check_output_file_in_new_folders(a.report_out, "--report");
-    std::vector<NamedPath> outputs = {{a.json_out, "--json"}, {a.report_out, "--report"}};
+    std::vector<NamedPath> outputs = {{json_file, "--json"}, {a.report_out, "--report"}};
     std::vector<std::string> side_files;
     if (!a.report_out.empty() && !a.no_plots)  // the report's plots and their data, beside it by its name
         for (const auto& f : report_plot_files(a.report_out)) {
@@ -421,6 +425,7 @@ int run_diagnose(const DiagnoseArgs& a) {
 
 // The model decides the run: silo-dem (kernel runs), or an analytical model; the options of the other refused.
 void run_diagnose_command(const DiagnoseArgs& args, const CLI::App& diagnose) {
+    const JsonOnStandardOutput json_stdout(args.json_out);
     const auto& analytical = analytics::diagnose_models();
     if (args.model != "silo-dem" && std::find(analytical.begin(), analytical.end(), args.model) == analytical.end()) {
         std::string known;
@@ -462,7 +467,8 @@ void add_predict_command(CLI::App& app) {
     auto geometry = std::make_shared<std::string>();
     auto predict_json = std::make_shared<std::string>();
     predict->add_option("GEOMETRY", *geometry, "silo geometry JSON (keys below)")->required();
-    predict->add_option("--json", *predict_json, "also write the predictions as JSON to this file");
+    predict->add_option("--json", *predict_json,
+                        "also write the predictions as JSON to this file (-: to standard output, the table to stderr)");
     predict->footer(geometry_keys_help);
     predict->callback([geometry, predict_json] { run_predict(*geometry, *predict_json); });
 }
@@ -514,7 +520,8 @@ void add_diagnose_command(CLI::App& app) {
     models += ", silo-dem (the kernel's silo with --material)";
     diagnose->add_option("--model", args->model, "the model: " + models)->required();
     diagnose->add_option("--data", args->data, "measured data, CSV (columns below)")->required();
-    diagnose->add_option("--json", args->json_out, "write the result as JSON to this file");
+    diagnose->add_option("--json", args->json_out,
+                         "write the result as JSON to this file (-: to standard output, the text to stderr)");
     diagnose->add_option("--report", args->report_out,
                          "write a Markdown report here, with residual plots (PNG) beside it");
     diagnose->add_flag("--no-plots", args->no_plots, "report without the gnuplot residual plots");

@@ -352,11 +352,12 @@ SiloDemInputs read_silo_dem_inputs(const SiloDemArgs& a) {
     SiloDemInputs in;
     if (a.material.empty()) throw UserError("--material: silo-dem needs the declared silo material (a JSON file)");
     // outputs first (issue 23): a path that cannot be written is refused before any run
-    check_output_file_in_new_folders(a.json_out, "--json");
+    const std::string json_file = names_standard_output(a.json_out) ? "" : a.json_out;  // (--json -: stdout)
+    check_output_file_in_new_folders(json_file, "--json");
     check_output_file_in_new_folders(a.report_out, "--report");
     std::vector<NamedPath> inputs = silo_campaign_inputs(a.silo_args, a.campaign);
     inputs.insert(inputs.end(), {{a.data, "--data"}, {a.material, "--material"}});
-    check_paths_apart(inputs, {{a.json_out, "--json"}, {a.report_out, "--report"}, {a.campaign, "--campaign"}});
+    check_paths_apart(inputs, {{json_file, "--json"}, {a.report_out, "--report"}, {a.campaign, "--campaign"}});
     if (fs::exists(a.campaign) && !fs::is_directory(a.campaign))
         throw UserError("--campaign = '" + a.campaign + "' is a file; give a folder");
     check_output_file_in_new_folders((fs::path(a.campaign) / "campaign.json").string(), "--campaign");
@@ -450,7 +451,7 @@ void write_diagnosis_outputs(const SiloDemArgs& a, const an::SiloMeasurements& d
     j["silo_args"] = a.silo_args;
     j["runs"] = {{"used", campaign.runs_used()}, {"run_now", campaign.runs_started()},
                  {"wall_s", campaign.wall_seconds()}, {"cpu_s", campaign.cpu_seconds()}};
-    if (!a.json_out.empty()) write_result_file(a.json_out, j.dump(2) + "\n");
+    if (!a.json_out.empty()) write_json_result(a.json_out, j.dump(2) + "\n");
     if (!a.report_out.empty()) {
         const fs::path report(a.report_out);
         std::string before_name, after_name;

@@ -2,7 +2,10 @@
 
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
+#include <iostream>
 #include <mutex>
+#include <ostream>
+#include <stdexcept>
 #include <vector>
 
 namespace demcal {
@@ -27,6 +30,34 @@ void write_result_file(const std::filesystem::path& path, const std::string& tex
     if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
     note_result_file(path);
     orchestrator::write_text_file_atomically(path, text);
+}
+
+namespace {
+std::streambuf* json_stdout = nullptr;  // standard output's own buffer while a JsonOnStandardOutput lives
+}  // namespace
+
+bool names_standard_output(const std::string& path) {
+    return path == kStandardOutputName || path == "/dev/stdout" || path == "/dev/fd/1" || path == "/proc/self/fd/1";
+}
+
+JsonOnStandardOutput::JsonOnStandardOutput(const std::string& json_path) {
+    if (!names_standard_output(json_path) || json_stdout) return;
+    std::cout.flush();
+    saved_stdout_ = std::cout.rdbuf(std::cerr.rdbuf());
+    json_stdout = saved_stdout_;
+}
+
+JsonOnStandardOutput::~JsonOnStandardOutput() {
+    if (!saved_stdout_) return;
+    std::cout.rdbuf(saved_stdout_);
+    json_stdout = nullptr;
+}
+
+void write_json_result(const std::string& path, const std::string& text) {
+    if (!names_standard_output(path)) return write_result_file(path, text);
+    std::ostream out(json_stdout ? json_stdout : std::cout.rdbuf());
+    out << text << std::flush;
+    if (!out) throw std::runtime_error("--json -: standard output could not be written");
 }
 
 void keep_results() {

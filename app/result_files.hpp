@@ -7,6 +7,7 @@
 // kept for `resume` and never pass through here.
 #pragma once
 #include <filesystem>
+#include <streambuf>
 #include <string>
 
 namespace demcal {
@@ -15,6 +16,29 @@ namespace demcal {
 // result; the folders its path names are made. Throws std::runtime_error naming the file and the system's reason (a
 // full disk is exit 1, not bad input).
 void write_result_file(const std::filesystem::path& path, const std::string& text);
+
+// `--json -`: the JSON alone on standard output, for a pipe (`demcal predict g.json --json - | jq .`).
+inline constexpr const char* kStandardOutputName = "-";
+// "-" or a name of standard output (/dev/stdout, /dev/fd/1, /proc/self/fd/1): as a file, a pipe was refused and a
+// redirect's file was replaced whole (through a temporary file and a rename), its earlier lines lost.
+bool names_standard_output(const std::string& path);
+
+// While it lives, with `json_path` "-": every text the command prints on std::cout goes to stderr instead, so that
+// standard output carries the JSON alone (write_json_result). With any other path it does nothing.
+class JsonOnStandardOutput {
+public:
+    explicit JsonOnStandardOutput(const std::string& json_path);  // (names_standard_output)
+    ~JsonOnStandardOutput();
+    JsonOnStandardOutput(const JsonOnStandardOutput&) = delete;
+    JsonOnStandardOutput& operator=(const JsonOnStandardOutput&) = delete;
+    bool active() const { return saved_stdout_ != nullptr; }
+
+private:
+    std::streambuf* saved_stdout_ = nullptr;
+};
+
+// A JSON result: to `path` as write_result_file writes it, or to standard output (names_standard_output).
+void write_json_result(const std::string& path, const std::string& text);
 
 // Notes `path` as this command's result before another program (gnuplot) writes it.
 void note_result_file(const std::filesystem::path& path);

@@ -79,9 +79,15 @@ double MacroTarget::acceptance(double tolerance) const {
 }
 
 void refuse_empty_list_items(const std::string& text, const std::string& option) {
-    if (!text.empty() && (text.back() == ',' || text.front() == ',' || text.find(",,") != std::string::npos))
-        throw std::invalid_argument(option + " = '" + analytics::shortened_text(text) +
-                                    "' has an empty item (two commas in a row, or one at an end)");
+    if (text.empty()) return;
+    for (std::size_t start = 0;;) {  // (an item of blanks only is empty too: "mu_b=0.5, ")
+        const std::size_t end = text.find(',', start);
+        if (analytics::trimmed(std::string_view(text).substr(start, end - start)).empty())
+            throw std::invalid_argument(option + " = '" + analytics::shortened_text(text) +
+                                        "' has an empty item (two commas in a row, or one at an end)");
+        if (end == std::string::npos) return;
+        start = end + 1;
+    }
 }
 
 std::vector<MacroTarget> parse_targets(const std::string& text) {
@@ -90,13 +96,14 @@ std::vector<MacroTarget> parse_targets(const std::string& text) {
     std::stringstream items(text);
     std::string item;
     while (std::getline(items, item, ',')) {
+        item = analytics::trimmed(item);  // "mu_b=0.6, tau_c=800", "mu_b = 0.6"
         const auto eq = item.find('=');
         if (eq == std::string::npos)
             throw std::invalid_argument("target item '" + item + "' is not of the form mu_b=VALUE or tau_c=VALUE");
         MacroTarget t;
-        t.quantity = item.substr(0, eq);
+        t.quantity = analytics::trimmed(item.substr(0, eq));
         check_quantity(t.quantity);
-        const std::string value = item.substr(eq + 1);
+        const std::string value = analytics::trimmed(item.substr(eq + 1));
         const auto number = analytics::read_typed_number(value);
         if (!number.is_number)
             throw std::invalid_argument("target " + t.quantity + " = '" + analytics::shortened_text(value) +

@@ -259,6 +259,13 @@ TEST_CASE("bad targets and options are refused with the field named", "[calibrat
     const auto t = parse_targets("mu_b=0.55,tau_c=800");
     REQUIRE(t.size() == 2);
     CHECK(t[1].value == 800);
+    // blanks around the items and their parts are no part of them (probe 61: ' tau_c' was "not one of mu_b, tau_c")
+    const auto spaced = parse_targets(" mu_b = 0.55, tau_c=800\n");
+    REQUIRE(spaced.size() == 2);
+    CHECK(spaced[0].quantity == "mu_b");
+    CHECK(spaced[0].value == 0.55);
+    CHECK(spaced[1].value == 800);
+    CHECK_THROWS_WITH(parse_targets("mu_b=0.55, "), Catch::Contains("has an empty item"));
     const auto base = test::synthetic_base_material();
     SensitivityOptions o;
     o.params = {"particle_radius"};

@@ -230,6 +230,44 @@ TEST_CASE("status tells a folder's campaigns apart by what they ran",
     fs::remove_all(dir);
 }
 
+TEST_CASE("status names every level of a one-parameter study, the base's too", "[kernel_engine]") {
+    // probe 62: each level is one campaign, so each value is seen once; the tie went to the smallest text, and the
+    // lowest level was shown without its friction, read as the base material
+    const fs::path dir = test::fresh_test_dir("kernel-status-study");
+    REQUIRE(test::run_demcal({"sensitivity", tiny, "--params", "friction_coefficient", "--levels", "3", "-s",
+                              "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
+                             dir / "study.log") == 0);
+    REQUIRE(test::run_demcal({"status", dir.string()}, dir / "status.log") == 0);
+    const std::string status = test::read_file(dir / "status.log");
+    INFO(status);
+    std::size_t labelled = 0, campaigns = 0;
+    for (std::size_t at = status.find("  kernel engine"); at != std::string::npos;
+         at = status.find("  kernel engine", at + 1)) {
+        ++campaigns;
+        const std::string line = status.substr(at, status.find('\n', at) - at);
+        if (line.find(", friction_coefficient ") != std::string::npos) ++labelled;
+    }
+    CHECK(campaigns == 3);
+    CHECK(labelled == campaigns);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a list typed with blanks after its commas is the same list", "[kernel_engine]") {
+    // probe 61: "-s '3e3, 5e3, 7e3'" was refused (' 5e3' is not a number), as were --seeds "1, 2" and --theta "70, 60"
+    const fs::path dir = test::fresh_test_dir("kernel-spaced-list");
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
+                             dir / "a.log") == 0);
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3, 5e3,\t7e3 ", "--engine", "kernel", "-c", dir.string()},
+                             dir / "b.log") == 0);
+    const std::string again = test::read_file(dir / "b.log");
+    INFO(again);
+    CHECK_THAT(again, Catch::Matchers::Contains("0 computed now, 3 reused"));  // the same campaign, its runs reused
+    // an item of blanks only is still an empty item
+    CHECK(test::run_demcal({"shear", tiny, "-s", "3e3, ,7e3", "--engine", "kernel", "-c", dir.string()},
+                           dir / "c.log") == 2);
+    fs::remove_all(dir);
+}
+
 TEST_CASE("a campaign named by its stresses in the order typed (before they were sorted) is continued, not doubled",
           "[kernel_engine]") {
     // review of stop 61: sorting the stresses renamed every campaign typed out of order; resume then opened a second

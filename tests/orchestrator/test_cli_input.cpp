@@ -376,3 +376,36 @@ TEST_CASE("demcal enlarge says when the points do not determine the power law an
     CHECK(fs::exists(dir / "e.json"));
     fs::remove_all(dir);
 }
+
+TEST_CASE("a JSON result to standard output (--json -) comes alone there, the text on stderr", "[cli]") {
+    // probe 61: --json /dev/stdout was refused ("not a regular file") and --json - wrote a file named -
+    const fs::path dir = test::fresh_test_dir("cli-json-stdout");
+    const std::string geometry = test::source_path("examples/diagnose/silo_105mm_wheat.json").string();
+    const std::string data = test::source_path("examples/diagnose/oldal_moisture.csv").string();
+    const auto run = [&dir](const std::string& args, const std::string& name) {
+        const std::string cmd = "cd '" + dir.string() + "' && '" + DEMCAL_BINARY + "' " + args + " > " + name +
+                                ".out 2> " + name + ".err";
+        const int status = std::system(cmd.c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    };
+    for (const auto& [args, name] : std::vector<std::pair<std::string, std::string>>{
+             {"predict '" + geometry + "' --json -", "predict"},
+             {"predict '" + geometry + "' --json /dev/stdout", "predict_dev"},
+             {"diagnose --model oldal --data '" + data + "' --json -", "diagnose"}}) {
+        INFO(args);
+        REQUIRE(run(args, name) == 0);
+        const std::string out = test::read_file(dir / (name + ".out")), err = test::read_file(dir / (name + ".err"));
+        INFO(err);
+        nlohmann::json parsed;
+        CHECK_NOTHROW(parsed = nlohmann::json::parse(out));  // the JSON alone
+        CHECK(parsed.is_object());
+        CHECK_FALSE(err.empty());  // the table went to stderr
+    }
+    CHECK_FALSE(fs::exists(dir / "-"));
+    // a redirect's file is appended to, not replaced (a result file is written through a rename)
+    const std::string appended = "cd '" + dir.string() + "' && (echo first; '" + DEMCAL_BINARY + "' predict '" +
+                                 geometry + "' --json /dev/stdout 2>/dev/null) > appended.out";
+    REQUIRE(std::system(appended.c_str()) == 0);
+    CHECK(test::read_file(dir / "appended.out").rfind("first\n{", 0) == 0);
+    fs::remove_all(dir);
+}

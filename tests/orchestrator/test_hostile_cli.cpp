@@ -438,6 +438,10 @@ TEST_CASE("an output that is a device, a FIFO or a dangling link is refused, and
     std::ofstream(dir / "p.json") << tiny_run_params().dump();
     refused({{{"predict", geometry, "--json", fifo}, {"--json", "not a regular file"}},
              {{"predict", geometry, "--json", "/dev/null"}, {"--json", "not a regular file"}},
+             // a stream's name: where it was redirected to a file, the file was replaced whole (probe 61)
+             {{"predict", geometry, "--json", "/dev/stderr"}, {"--json", "not a regular file", "--json - writes"}},
+             {{"diagnose", "--model", "beverloo", "--data", "x.csv", "--report", "/proc/self/fd/1"},
+              {"--report", "not a regular file"}},
              {{"shear-run", (dir / "p.json").string(), "/dev/null"}, {"result", "not a regular file"}},
              {{"predict", geometry, "--json", (dir / "dangling.json").string()}, {"--json", "a link to nothing"}},
              // a folder that is a link to nothing: "File exists" (probe 60)
@@ -475,7 +479,7 @@ TEST_CASE("repeats that share a run folder, a search without vibration and nonse
               {"--geometry", "\"rectangular\"", "conical silo only"}},
              {{"cutoff", "--bond-number", "10", "--seeds", "1,1"}, {"--seeds: seed 1 is given twice"}},
              // a silo option given twice after -- (CLI11 said "At Most 1 required but received 2", probe 60b)
-             {{"cutoff", "--bond-number", "10", "--", "--particles", "300", "--particles=400"},
+             {{"cutoff", "--", "--particles", "300", "--particles=400"},
               {"silo options of demcal cutoff: --particles is given twice ('300' and '400')"}},
              // vibration settings of a still bin were recorded and did nothing (probe 58)
              {{"vibration", "--theta", "30", "--frequency", "0", "--amplitude", "1e-4", "--campaign", camp},
@@ -849,7 +853,9 @@ TEST_CASE("probe 46: an option the command does not have is named, even where th
               {"vibration: '--bogus' is not an option", "options for the runs go after --"}},
              {{"predict", "--jsn", (dir / "x.json").string(), geometry}, {"predict: '--jsn' is not an option"}},
              {{"crosscheck", "shear", test::source_path("examples/materials/sand-tiny.json").string(), "-q"},
-              {"crosscheck shear: '-q' is not an option"}}},
+              {"crosscheck shear: '-q' is not an option"}},
+             // a file named -geo.json was named '-g' (probe 61)
+             {{"predict", "-geo.json"}, {"predict: '-geo.json' is not an option", "given as ./-geo.json"}}},
             dir);
     // negative numbers stay values, options after -- belong to the runs
     CHECK(test::run_demcal({"silo", "--theta", "30", "--vibration-start", "-1", "--check"}, root / "neg.log") == 2);
