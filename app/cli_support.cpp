@@ -415,7 +415,9 @@ void check_output_file(const std::string& path, const std::string& option) {
     // /dev/stderr, /proc/self/fd/2: a stream's name, not a file's. Where the stream was redirected to a file, that
     // file was replaced whole (a result is written to a temporary file and renamed), the lines before it lost.
     const std::string absolute = fs::absolute(path, ec).lexically_normal().string();
-    if (absolute.rfind("/dev/", 0) == 0 || absolute.rfind("/proc/", 0) == 0)
+    const bool stream_name = absolute.rfind("/proc/", 0) == 0 || absolute.rfind("/dev/fd/", 0) == 0 ||
+                             absolute == "/dev/stdout" || absolute == "/dev/stderr" || absolute == "/dev/stdin";
+    if (stream_name)  // (a file in /dev/shm is a file)
         throw UserError(named + " names a device or a process's stream, not a regular file; give a file name" +
                         (option == "--json" ? " (--json - writes to standard output)" : ""));
     const fs::file_status st = fs::status(path, ec);  // (through a link: what the output would be written into)
