@@ -130,6 +130,9 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
         throw std::runtime_error("gnuplot did not finish " + output.string() +
                                  " (the file was cut short or not written: is the disk full?); it is removed");
     }
+    // a log gnuplot left empty says nothing: one beside every plot was clutter (probe 61); a warning stays
+    if (std::filesystem::is_regular_file(log, ec) && std::filesystem::file_size(log, ec) == 0 && !ec)
+        std::filesystem::remove(log, ec);
 }
 
 }  // namespace demcal
