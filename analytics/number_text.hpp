@@ -29,6 +29,17 @@ inline std::string trimmed(std::string_view s) {
     return std::string(s.substr(first, s.find_last_not_of(blanks) - first + 1));
 }
 
+// Whether a comma-separated list has an empty item: two commas in a row, one at an end, or an item of blanks only
+// ("5e3, ,1e4"); the whole text empty or blank is one empty item.
+inline bool has_empty_list_item(std::string_view list) {
+    for (std::size_t start = 0;;) {
+        const std::size_t end = list.find(',', start);
+        if (trimmed(list.substr(start, end == std::string_view::npos ? end : end - start)).empty()) return true;
+        if (end == std::string_view::npos) return false;
+        start = end + 1;
+    }
+}
+
 // A value as a message shows it: whole when short, else its start and how long it was (a 50 MB string in an input
 // must not end up on stderr in full); control characters escaped (\n, \x1b), so that a message stays one line and a
 // value cannot move the terminal's cursor or colour.

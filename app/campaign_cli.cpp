@@ -88,7 +88,9 @@ void check_campaign(const CampaignCli& c, const nlohmann::json& material) {
 
 std::string runs_cpu_text(double cpu_seconds, int reused_runs) {
     return "CPU " + cpu_duration(cpu_seconds) +
-           (reused_runs > 0 ? " (the " + std::to_string(reused_runs) + " reused runs' own included)" : "");
+           (reused_runs > 0 ? " (the " + std::to_string(reused_runs) + " reused run" + (reused_runs > 1 ? "s'" : "'s") +
+                                  " own included)"
+                            : "");
 }
 
 std::string cpu_duration(double s) {

@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <regex>
 #include <set>
 #include <string_view>
 #include <thread>
@@ -405,6 +406,11 @@ void check_output_outside_run_folders(const std::string& path, const std::string
                         ": a run's files are its own; give a path outside it");
 }
 
+bool names_process_stream(const std::string& absolute) {
+    static const std::regex stream(R"(/dev/(stdin|stdout|stderr|fd/.*)|/proc/[^/]+(/task/[^/]+)?/fd/.*)");
+    return std::regex_match(absolute, stream);
+}
+
 void check_output_file(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
@@ -415,15 +421,11 @@ void check_output_file(const std::string& path, const std::string& option) {
     // /dev/stderr, /proc/self/fd/2: a stream's name, not a file's. Where the stream was redirected to a file, that
     // file was replaced whole (a result is written to a temporary file and renamed), the lines before it lost.
     const std::string absolute = fs::absolute(path, ec).lexically_normal().string();
-    const bool stream_name = absolute.rfind("/proc/", 0) == 0 || absolute.rfind("/dev/fd/", 0) == 0 ||
-                             absolute == "/dev/stdout" || absolute == "/dev/stderr" || absolute == "/dev/stdin";
-    if (stream_name)  // (a file in /dev/shm is a file)
-        throw UserError(named + " names a device or a process's stream, not a regular file; give a file name" +
-                        (option == "--json" ? " (--json - writes to standard output)" : ""));
+    if (names_process_stream(absolute))  // (a file in /dev/shm, or /proc/self/cwd/x, is a file)
+        throw UserError(named + " names a process's stream, not a regular file; give a file name");
     const fs::file_status st = fs::status(path, ec);  // (through a link: what the output would be written into)
     if (fs::exists(st) && !fs::is_regular_file(st))
-        throw UserError(named + " is not a regular file (a device, FIFO or socket); give a file name" +
-                        (option == "--json" ? " (--json - writes to standard output)" : ""));
+        throw UserError(named + " is not a regular file (a device, FIFO or socket); give a file name");
     if (fs::is_symlink(fs::symlink_status(path, ec)) && !fs::exists(st))
         throw UserError(named + " is a link to nothing (" +
                         analytics::shortened_text(fs::read_symlink(path, ec).string(), 200) + "); give a file name");
@@ -590,10 +592,6 @@ void collect_list_options(const CLI::App& app, std::map<std::string, std::string
     for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) collect_list_options(*sub, names);
 }
 
-bool has_empty_item(std::string_view list) {
-    return list.empty() || list.front() == ',' || list.back() == ',' || list.find(",,") != std::string_view::npos;
-}
-
 }  // namespace
 
 namespace {
@@ -677,7 +675,7 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
         std::string command;
         for (std::size_t k = 1; k < chain.size(); ++k) command += (k > 1 ? " " : "") + chain[k]->get_name();
         // "-geo.json": a file whose name starts with -, read as the option -g (probe 61 named '-g')
-        const bool word = arg[1] != '-' && arg.size() > 2;
+        const bool word = arg[1] != '-' && arg.size() > 2 && arg.find_first_of("./") != std::string_view::npos;
         throw UserError(command + ": '" + analytics::shortened_text(word ? arg : name) +
                         "' is not an option of this command (see demcal " + command + " --help" +
                         (passes_arguments_on(*chain.back()) ? "; options for the runs go after --" : "") +
@@ -720,9 +718,9 @@ void check_command_line_shape(const CLI::App& app, int argc, const char* const* 
         if (eq != std::string_view::npos) value = arg.substr(eq + 1);
         else if (i + 1 < argc) value = argv[i + 1];
         else continue;
-        if (value.find(',') != std::string_view::npos && has_empty_item(value))
+        if (value.find(',') != std::string_view::npos && analytics::has_empty_list_item(value))
             throw UserError(lists.at(name) + ": '" + analytics::shortened_text(value) +
-                            "' has an empty item (two commas in a row, or one at an end)");
+                            "' has an empty item (two commas in a row, one at an end, or blanks only)");
     }
 }
 

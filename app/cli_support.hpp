@@ -67,6 +67,10 @@ void check_argument_lengths(int argc, const char* const* argv);
 // Checks, before any work starts, that `path` can be written as an output file: not a folder, its folder exists and
 // is writable (and the file itself, when it exists). Throws UserError naming `option`, the path and the rule.
 void check_output_file(const std::string& path, const std::string& option);
+
+// Whether `absolute` (a normalised absolute path) names a process's stream (/dev/stdout, /dev/fd/2, /proc/self/fd/1):
+// an output there, when the stream was redirected to a file, replaced that file whole through a rename.
+bool names_process_stream(const std::string& absolute);
 // Refuses (UserError naming `option`) an output in a run folder of a campaign (DIR/runs/NAME/ beside
 // DIR/campaign.sqlite or DIR/campaign.json): `scale -o DIR/runs/ID/result.json` replaced a stored run's result.
 // Not for the runs' own outputs (shear-run's result.json, a silo run's files), which live there.

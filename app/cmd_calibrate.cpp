@@ -447,7 +447,7 @@ void print_calibration_plan(const CalibrateCli& o, const std::vector<MacroTarget
     std::cout << "calibrating";
     for (std::size_t i = 0; i < targets.size(); ++i)
         std::cout << (i ? ", " : " ") << targets[i].quantity << " = " << targets[i].value << " +/- "
-                  << targets[i].acceptance(o.tol) << (targets[i].quantity == "tau_c" ? " Pa" : "") << " (accepted) with " << controls[i].name << " in [" << controls[i].low
+                  << targets[i].acceptance(o.tol) << (targets[i].quantity == "tau_c" ? " Pa" : "") << " (acceptance band) with " << controls[i].name << " in [" << controls[i].low
                   << ", " << controls[i].high << "]";
     std::cout << " (" << o.method << (o.sequential ? ", slope first" : "") << ")" << std::endl;
 }
@@ -706,7 +706,7 @@ nlohmann::json enlargement_json(const EnlargementPoints& p, const analytics::Sca
 void print_enlargement(const analytics::ScalingLawFit& e_law, const analytics::ScalingLawFit& nu_law,
                        const std::string& output, const std::string& plot_file) {
     std::cout << "E(r)  = A r + B:  A = " << e_law.params[0].value << " +/- " << e_law.params[0].std_error
-              << " Pa/m, B = " << e_law.params[1].value << " +/- " << e_law.params[1].std_error << " Pa (R^2 "
+              << " Pa/m, B = " << e_law.params[1].value << " +/- " << e_law.params[1].std_error << " Pa (+/- 1 SE; R^2 "
               << e_law.r_squared << ")\n"
               << "nu(r) = C r^-D:   C = " << nu_law.params[0].value << " +/- " << nu_law.params[0].std_error
               << ", D = " << nu_law.params[1].value << " +/- " << nu_law.params[1].std_error << " (R^2 "

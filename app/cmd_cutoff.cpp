@@ -77,7 +77,7 @@ std::pair<double, double> parse_bracket(const std::string& text) {
     const std::string shown = "--bracket = '" + analytics::shortened_text(text, 40) + "'";
     if (comma == std::string::npos) throw UserError(shown + ": give LO,HI in Hz, e.g. 0,400");
     double ends[2];
-    const std::string parts[2] = {text.substr(0, comma), text.substr(comma + 1)};
+    const std::string parts[2] = {analytics::trimmed(text.substr(0, comma)), analytics::trimmed(text.substr(comma + 1))};
     for (int i = 0; i < 2; ++i) {  // the number rule of every option (a subnormal or NaN end was searched)
         const auto n = analytics::read_typed_number(parts[i]);
         if (!n.is_number) throw UserError(shown + ": give LO,HI in Hz, e.g. 0,400");

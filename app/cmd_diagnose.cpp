@@ -366,7 +366,9 @@ void print_diagnosis(const analytics::DiagnoseResult& r, int max_effects) {
 // --json and --report (with its residual plots unless --no-plots).
 void write_diagnosis_files(const DiagnoseArgs& a, const analytics::DiagnoseResult& r,
                            const analytics::MeasuredData& data) {
-    if (!a.json_out.empty()) write_json_result(a.json_out, r.to_json().dump(2) + "\n");
+    // a JSON file first; on standard output last, once every file is whole (a pipe cannot take it back)
+    const bool json_to_stdout = names_standard_output(a.json_out);
+    if (!a.json_out.empty() && !json_to_stdout) write_json_result(a.json_out, r.to_json().dump(2) + "\n");
     if (!a.report_out.empty()) {
         const std::filesystem::path report(a.report_out);
         std::string before_name, after_name;
@@ -382,6 +384,7 @@ void write_diagnosis_files(const DiagnoseArgs& a, const analytics::DiagnoseResul
         write_result_file(a.report_out, markdown_report(r, a.data, before_name, after_name));
         if (plots) plot_residuals(r, data, plots->data, plots->before, plots->after);
     }
+    if (json_to_stdout) write_json_result(a.json_out, r.to_json().dump(2) + "\n");
 }
 
 // Every output place before any work (issue 23): a path that cannot be written is refused at once.

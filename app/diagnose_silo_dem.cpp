@@ -451,7 +451,9 @@ void write_diagnosis_outputs(const SiloDemArgs& a, const an::SiloMeasurements& d
     j["silo_args"] = a.silo_args;
     j["runs"] = {{"used", campaign.runs_used()}, {"run_now", campaign.runs_started()},
                  {"wall_s", campaign.wall_seconds()}, {"cpu_s", campaign.cpu_seconds()}};
-    if (!a.json_out.empty()) write_json_result(a.json_out, j.dump(2) + "\n");
+    // a JSON file first; on standard output last, once every file is whole (a pipe cannot take it back)
+    const bool json_to_stdout = names_standard_output(a.json_out);
+    if (!a.json_out.empty() && !json_to_stdout) write_json_result(a.json_out, j.dump(2) + "\n");
     if (!a.report_out.empty()) {
         const fs::path report(a.report_out);
         std::string before_name, after_name;
@@ -469,6 +471,7 @@ void write_diagnosis_outputs(const SiloDemArgs& a, const an::SiloMeasurements& d
         }
         write_result_file(report, markdown(a, data, r, campaign, before_name, after_name));
     }
+    if (json_to_stdout) write_json_result(a.json_out, j.dump(2) + "\n");
 }
 
 }  // namespace

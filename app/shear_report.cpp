@@ -37,7 +37,7 @@ void print_line(const char* title, const analytics::FailureLine& fl) {
               << (fl.tau_c < 0 ? "- " : "+ ") << std::setprecision(1) << std::fabs(fl.tau_c) << " Pa\n"
               << std::setprecision(4) << "  mu_b  = " << fl.mu_b << " +/- " << fl.se_mu_b << " SE  (95% CI "
               << fl.mu_b_low << " .. " << fl.mu_b_high << "),  phi_b = " << std::setprecision(2) << fl.phi_b_deg
-              << " +/- " << fl.se_phi_b_deg << " deg\n"
+              << " +/- " << fl.se_phi_b_deg << " deg SE\n"
               << std::setprecision(1) << "  tau_c = " << fl.tau_c << " +/- " << fl.se_tau_c << " Pa SE  (95% CI "
               << fl.tau_c_low << " .. " << fl.tau_c_high << "),  R^2 = " << std::setprecision(4) << fl.r_squared
               << ", n = " << fl.n << "\n";

@@ -80,14 +80,11 @@ double MacroTarget::acceptance(double tolerance) const {
 
 void refuse_empty_list_items(const std::string& text, const std::string& option) {
     if (text.empty()) return;
-    for (std::size_t start = 0;;) {  // (an item of blanks only is empty too: "mu_b=0.5, ")
-        const std::size_t end = text.find(',', start);
-        if (analytics::trimmed(std::string_view(text).substr(start, end - start)).empty())
-            throw std::invalid_argument(option + " = '" + analytics::shortened_text(text) +
-                                        "' has an empty item (two commas in a row, or one at an end)");
-        if (end == std::string::npos) return;
-        start = end + 1;
-    }
+    if (analytics::trimmed(text).empty())
+        throw std::invalid_argument(option + " = '" + analytics::shortened_text(text) + "' holds blanks only");
+    if (analytics::has_empty_list_item(text))  // (an item of blanks only is empty too: "mu_b=0.5, ")
+        throw std::invalid_argument(option + " = '" + analytics::shortened_text(text) +
+                                    "' has an empty item (two commas in a row, one at an end, or blanks only)");
 }
 
 std::vector<MacroTarget> parse_targets(const std::string& text) {

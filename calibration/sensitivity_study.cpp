@@ -396,8 +396,10 @@ StudyCampaign read_study_campaign(const nlohmann::json& c) {
         if (!c.at(key).is_number_integer()) R::refuse(R::path("campaign", key), c.at(key), "must be a whole number");
         return x;
     };
-    if (c.contains("replicates"))
-        out.replicates = static_cast<int>(whole("replicates", 1, orchestrator::kMaxReplicates, "[1, 1000]"));
+    if (c.contains("replicates")) {
+        const std::string range = "[1, " + std::to_string(orchestrator::kMaxReplicates) + "]";
+        out.replicates = static_cast<int>(whole("replicates", 1, orchestrator::kMaxReplicates, range.c_str()));
+    }
     if (c.contains("base_seed")) out.base_seed = static_cast<long>(whole("base_seed", 0, 2147483647.0, "[0, 2147483647]"));
     return out;
 }

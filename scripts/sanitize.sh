@@ -12,7 +12,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 # (-Wno-maybe-uninitialized: with ASan, GCC 12 warns falsely inside libstdc++'s regex, which Catch2 includes)
 flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -Wno-maybe-uninitialized"
-# -O1 -g1 (line tables: a report still names file and line) and without the kernel's wide inlining: the fuzz build
+# -O1 -g1 (line tables: a report still names file and line; no -DNDEBUG, so Eigen's, nlohmann's and our asserts check
+# too) and without the kernel's wide inlining: the fuzz build
 # took 25 of CI's 52 min at -O2 -g, 14 min of them in kernel/simulation.cpp alone (2.4 min this way, measured).
 configure() {
   cmake -S . -B "$1" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \

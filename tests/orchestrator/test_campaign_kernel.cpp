@@ -265,6 +265,7 @@ TEST_CASE("a list typed with blanks after its commas is the same list", "[kernel
     // an item of blanks only is still an empty item
     CHECK(test::run_demcal({"shear", tiny, "-s", "3e3, ,7e3", "--engine", "kernel", "-c", dir.string()},
                            dir / "c.log") == 2);
+    CHECK_THAT(test::read_file(dir / "c.log"), Catch::Matchers::Contains("'3e3, ,7e3' has an empty item"));
     fs::remove_all(dir);
 }
 

@@ -439,7 +439,7 @@ TEST_CASE("an output that is a device, a FIFO or a dangling link is refused, and
     refused({{{"predict", geometry, "--json", fifo}, {"--json", "not a regular file"}},
              {{"predict", geometry, "--json", "/dev/null"}, {"--json", "not a regular file"}},
              // a stream's name: where it was redirected to a file, the file was replaced whole (probe 61)
-             {{"predict", geometry, "--json", "/dev/stderr"}, {"--json", "not a regular file", "--json - writes"}},
+             {{"predict", geometry, "--json", "/dev/stderr"}, {"--json", "names a process's stream"}},
              {{"diagnose", "--model", "beverloo", "--data", "x.csv", "--report", "/proc/self/fd/1"},
               {"--report", "not a regular file"}},
              {{"shear-run", (dir / "p.json").string(), "/dev/null"}, {"result", "not a regular file"}},
