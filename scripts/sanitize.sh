@@ -2,7 +2,8 @@
 # AddressSanitizer + UndefinedBehaviorSanitizer. Any memory error, leak or undefined behaviour fails the test that met
 # it. Two scopes:
 #   bash scripts/sanitize.sh [CTEST ARGS]   demcal and its tests in build-asan/, the unit tests run (ctest -LE _heavy:
-#                                           no YADE, no SLURM, not slow, not a benchmark): about 80 min here.
+#                                           no YADE, no SLURM, not slow, not a benchmark): about 80 min here
+#                                           (measured at -O2 -g, stop 21; not again since the -O1 -g1 build).
 #   bash scripts/sanitize.sh --fuzz [ARGS]  only the readers' fuzz tests (every "[fuzz]" case: material and geometry
 #                                           JSON, measured CSV, silo-dem rates, the campaign store, shear results, flow
 #                                           frames, a checkpoint's kernel state) in one executable, test_fuzz, built in
