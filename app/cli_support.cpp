@@ -415,6 +415,11 @@ void check_output_file(const std::string& path, const std::string& option) {
     namespace fs = std::filesystem;
     const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
     if (path.empty()) throw UserError(option + ": an empty path");
+    // "-" is standard output where a command takes it so (predict's and diagnose's --json); elsewhere it wrote a file
+    // named - (probe 62b)
+    if (path == "-")
+        throw UserError(named + ": standard output is no place for this output (only predict's and diagnose's --json "
+                        "write there); give a file name (./- for a file named so)");
     check_name_lengths(path, named, PathKind::file);
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");

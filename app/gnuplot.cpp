@@ -109,7 +109,9 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    // a relative name starting with - ("-r.md"'s plots) is gnuplot's option, not its script (probe 62b)
     std::string program = "gnuplot", script_arg = script.string();
+    if (!script_arg.empty() && script_arg.front() == '-') script_arg = "./" + script_arg;
     char* argv[] = {program.data(), script_arg.data(), nullptr};
     pid_t pid = 0;
     const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);

@@ -440,6 +440,9 @@ TEST_CASE("an output that is a device, a FIFO or a dangling link is refused, and
              {{"predict", geometry, "--json", "/dev/null"}, {"--json", "not a regular file"}},
              // a stream's name: where it was redirected to a file, the file was replaced whole (probe 61)
              {{"predict", geometry, "--json", "/dev/stderr"}, {"--json", "names a process's stream"}},
+             // "-" is standard output only for predict's and diagnose's --json; here it wrote a file named - (probe 62b)
+             {{"diagnose", "--model", "oldal", "--data", "x.csv", "--report", "-", "--no-plots"},
+              {"--report = '-': standard output is no place for this output"}},
              {{"diagnose", "--model", "beverloo", "--data", "x.csv", "--report", "/proc/self/fd/1"},
               {"--report", "not a regular file"}},
              {{"shear-run", (dir / "p.json").string(), "/dev/null"}, {"result", "not a regular file"}},
@@ -781,6 +784,14 @@ TEST_CASE("probe 44: a measured CSV's text reaches gnuplot quoted (a column name
     CHECK_FALSE(fs::exists(root / "PWNED"));
     CHECK(fs::exists(report));
     CHECK(fs::exists(root / "it's_residuals_before.png"));
+    // a report named in the current folder with a leading -: its plot scripts were gnuplot's options (probe 62b:
+    // exit 1, "is the disk full?")
+    const std::string dashed = "cd '" + root.string() + "' && '" + DEMCAL_BINARY + "' diagnose --model oldal --data "
+                               "evil.csv --report=-r.md > dashed.log 2>&1";
+    CHECK(std::system(dashed.c_str()) == 0);
+    INFO(test::read_file(root / "dashed.log"));
+    CHECK(fs::exists(root / "-r_residuals_before.png"));
+    CHECK(fs::exists(root / "-r_residuals_after.png"));
     // without gnuplot on PATH: refused at once, nothing written
     const std::string path = std::getenv("PATH");
     ::setenv("PATH", "/nonexistent", 1);
