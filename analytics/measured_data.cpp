@@ -22,8 +22,6 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-std::string trim(std::string_view s) { return trimmed(s); }
-
 // Strict: the whole cell is one finite number (no "12 kg", no "1,5", no "nan"/"inf").
 std::optional<double> parse_number(const std::string& cell) {
     if (cell.empty()) return std::nullopt;
@@ -77,8 +75,8 @@ private:
     void end_field() {
         // blanks after a closing quote are not the field's: a CRLF file's "last field"\r kept its \r (probe 61: the
         // column "vibration_Hz\r" became another, categorical one; a quoted response column was "missing")
-        if (was_quoted_ && trim(std::string_view(cur_).substr(quoted_end_)).empty()) cur_.resize(quoted_end_);
-        fields_.push_back(was_quoted_ ? cur_ : trim(cur_));
+        if (was_quoted_ && trimmed(std::string_view(cur_).substr(quoted_end_)).empty()) cur_.resize(quoted_end_);
+        fields_.push_back(was_quoted_ ? cur_ : trimmed(cur_));
         cur_.clear();
         cur_blank_ = true;
         was_quoted_ = false;
@@ -219,7 +217,7 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
     while (std::getline(in, line)) {
         ++line_no;
         if (line_no == 1) strip_byte_order_mark(line, source);
-        const std::string t = trim(line);
+        const std::string t = trimmed(line);
         if (t.empty() || t[0] == '#') continue;  // blank lines and comments hold no data
         const int first_line = line_no;
         CsvRecordSplitter record;
