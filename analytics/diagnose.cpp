@@ -47,7 +47,7 @@ std::string unidentified_parameters(const Model& m, const LeastSquaresFit& fit) 
                                   se > kMaxRelativeStdError * std::fabs(value);
         if (undetermined)
             why += (why.empty() ? "" : ", ") + m.param_names[i] + " = " + short_number(value) + " +/- " +
-                   short_number(se);
+                   short_number(se) + " (1 SE)";
     }
     return why;
 }

@@ -20,10 +20,10 @@ inline std::string number_text(double value, int significant_digits = 6) {
     return s.str();
 }
 
-// `s` without the blanks (spaces, tabs, line ends) at its two ends: a CSV cell, a list item typed "5e3, 1e4", a
-// value pasted with its line end.
+// `s` without the blanks (what isspace calls blank: spaces, tabs, line ends, \v, \f) at its two ends: a CSV cell, a
+// list item typed "5e3, 1e4", a value pasted with its line end.
 inline std::string trimmed(std::string_view s) {
-    constexpr const char* blanks = " \t\r\n";
+    constexpr const char* blanks = " \t\r\n\v\f";
     const auto first = s.find_first_not_of(blanks);
     if (first == std::string_view::npos) return {};
     return std::string(s.substr(first, s.find_last_not_of(blanks) - first + 1));

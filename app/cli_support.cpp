@@ -39,6 +39,7 @@ nlohmann::json read_json_file(const std::string& path, const std::string& field)
 namespace {
 
 constexpr const char* kEmptyValue = "an empty value (omit the option to get its default)";
+constexpr const char* kEmptyRequiredValue = "an empty value (this option has no default: give a value)";
 
 // A validator that accepts a number for which `ok` holds; `what` completes "VALUE is not ...". The text is read by
 // strtod, so a subnormal or an overflowing exponent is named as such by analytics::number_defect, not as "not a
@@ -111,7 +112,10 @@ void refuse_empty_values(CLI::App& app) {
         if (opt->check_lname("partition")) opt->check(slurm_partition);  // every command's SLURM partition
         // First of all the option's checks (a transform goes before the others): the option's own check named an
         // empty value by its rule ("--criterion:  not in {...}") instead of as empty.
-        opt->transform(CLI::Validator([](std::string& text) { return text.empty() ? kEmptyValue : std::string(); }, ""));
+        // (a required option has no default to omit it for)
+        const std::string empty_rule = opt->get_required() ? kEmptyRequiredValue : kEmptyValue;
+        opt->transform(CLI::Validator([empty_rule](std::string& text) { return text.empty() ? empty_rule : std::string(); },
+                                      ""));
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
 }
@@ -423,6 +427,8 @@ void check_output_file(const std::string& path, const std::string& option) {
     check_name_lengths(path, named, PathKind::file);
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
+    // ("/dev/stdout/" was told that the folder /dev/stdout does not exist)
+    if (path.back() == '/') throw UserError(named + " ends with '/', a folder's name; give a file name");
     // /dev/stderr, /proc/self/fd/2: a stream's name, not a file's. Where the stream was redirected to a file, that
     // file was replaced whole (a result is written to a temporary file and renamed), the lines before it lost.
     const std::string absolute = fs::absolute(path, ec).lexically_normal().string();
@@ -681,10 +687,14 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
         for (std::size_t k = 1; k < chain.size(); ++k) command += (k > 1 ? " " : "") + chain[k]->get_name();
         // "-geo.json": a file whose name starts with -, read as the option -g (probe 61 named '-g')
         const bool word = arg[1] != '-' && arg.size() > 2 && arg.find_first_of("./") != std::string_view::npos;
-        throw UserError(command + ": '" + analytics::shortened_text(word ? arg : name) +
+        // "-engine": a long option typed with one dash, read as -e (probe 62b named '-e' and no more)
+        const std::string long_name = "-" + std::string(arg.substr(0, arg.find('=')));
+        const bool one_dash_long = arg[1] != '-' && !word && long_name.size() > 3 && option_named(long_name);
+        throw UserError(command + ": '" + analytics::shortened_text(word ? arg : one_dash_long ? long_name.substr(1) : name) +
                         "' is not an option of this command (see demcal " + command + " --help" +
                         (passes_arguments_on(*chain.back()) ? "; options for the runs go after --" : "") +
-                        (word ? "; a file named so is given as ./" + analytics::shortened_text(arg) : "") + ")");
+                        (word ? "; a file named so is given as ./" + analytics::shortened_text(arg) : "") +
+                        (one_dash_long ? "; a long option takes two dashes: " + long_name : "") + ")");
     }
 }
 

@@ -252,7 +252,13 @@ struct CalibrateCli {
 
 std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
     if (o.target.empty() == o.measured.empty()) throw UserError("give exactly one of --target and --measured");
-    if (!o.target.empty()) return parse_targets(o.target);
+    if (!o.target.empty()) {
+        try {
+            return parse_targets(o.target);
+        } catch (const std::invalid_argument& e) {
+            throw UserError(std::string("--target: ") + e.what());
+        }
+    }
     refuse_empty_list_items(o.measured, "--measured");
     std::vector<double> sigma, tau;
     std::stringstream items(o.measured);
@@ -426,6 +432,12 @@ SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json
     if (const std::string why = study.campaign->packing_difference_from(here); !why.empty())
         std::cerr << "demcal: warning: --sensitivity = '" << analytics::shortened_text(file, 200) << "': " << why
                   << ": none of its lines is reused, and the search meets other packings' scatter\n";
+    else if ((!study.campaign->replicates || !study.campaign->base_seed) && here.replicates && here.base_seed)
+        std::cerr << "demcal: warning: --sensitivity = '" << analytics::shortened_text(file, 200)
+                  << "' does not record the packings its lines sheared (written before demcal recorded them): if they "
+                     "were not this calibration's ("
+                  << *here.replicates << " per stress from seed " << *here.base_seed
+                  << "), none of its lines is reused and the search meets other packings' scatter\n";
     return study;
 }
 

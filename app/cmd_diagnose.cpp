@@ -48,7 +48,7 @@ void run_predict(const std::string& geometry_path, const std::string& json_out) 
     }
     analytics::SiloGeometry geometry;
     try {
-        geometry = analytics::geometry_from_json(read_json_file(geometry_path, "predict"));
+        geometry = analytics::geometry_from_json(read_json_file(geometry_path, "GEOMETRY"));
     } catch (const std::invalid_argument& e) {
         throw UserError(geometry_path + ": " + e.what());
     }
@@ -252,7 +252,7 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
     if (r.effects.empty()) md << "None: no candidate was significant after Holm's correction and improved the CV RMSE.\n\n";
     for (const auto& e : r.effects) {
         md << "- **" << effect_name(e.variable, e.kind, e.regime) << "** (" << e.kind << "): `" << e.form << "`; ";
-        for (const auto& p : e.params) md << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << "; ";
+        for (const auto& p : e.params) md << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << " (1 SE); ";
         md << "F = " << sci(e.f_statistic) << ", p = " << sci(e.p_value) << ", Holm p = " << sci(e.p_holm) << " over "
            << e.candidates_tried << " candidates; CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after)
            << "\n";
@@ -277,7 +277,7 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
            << (r.outliers.dropped ? "without them (--drop-outliers)" : "with them (--drop-outliers refits without)")
            << ".\n";
     }
-    md << "\n## Parameters\n\n| parameter | before | after |\n|---|---|---|\n";
+    md << "\n## Parameters\n\n| parameter | before (+/- 1 SE) | after (+/- 1 SE) |\n|---|---|---|\n";
     for (std::size_t i = 0; i < r.params_after.size(); ++i) {
         const auto& a = r.params_after[i];
         md << "| " << a.name << " | "
@@ -340,7 +340,8 @@ void print_diagnosis(const analytics::DiagnoseResult& r, int max_effects) {
     for (const auto& e : r.effects) {
         std::cout << "  + " << effect_name(e.variable, e.kind, e.regime) << " (" << e.kind << "): " << e.form
                   << "\n    ";
-        for (const auto& p : e.params) std::cout << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << "  ";
+        for (const auto& p : e.params)
+            std::cout << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << " (1 SE)  ";
         std::cout << "p = " << sci(e.p_value) << " (Holm " << sci(e.p_holm) << ", " << e.candidates_tried
                   << " candidates), CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after) << "\n";
     }

@@ -2,11 +2,16 @@
 
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
+#include <cerrno>
+#include <cstring>
 #include <iostream>
 #include <mutex>
 #include <ostream>
 #include <stdexcept>
+#include <string>
 #include <vector>
+
+#include <unistd.h>  // getpid
 
 namespace demcal {
 
@@ -34,6 +39,7 @@ void write_result_file(const std::filesystem::path& path, const std::string& tex
 
 namespace {
 std::streambuf* json_stdout = nullptr;  // standard output's own buffer while a JsonOnStandardOutput lives
+bool report_to_stderr_lost = false;     // (report_on_stderr_lost)
 }  // namespace
 
 bool names_standard_output(const std::string& path) {
@@ -41,7 +47,11 @@ bool names_standard_output(const std::string& path) {
     if (path.empty()) return false;
     std::error_code ec;
     const std::string absolute = std::filesystem::absolute(path, ec).lexically_normal().string();
-    return absolute == "/dev/stdout" || absolute == "/dev/fd/1" || absolute == "/proc/self/fd/1";
+    const std::string own = "/proc/" + std::to_string(::getpid());
+    for (const std::string& name : {std::string("/dev/stdout"), std::string("/dev/fd/1"), std::string("/proc/self/fd/1"),
+                                    std::string("/proc/thread-self/fd/1"), own + "/fd/1"})
+        if (absolute == name) return true;
+    return false;
 }
 
 JsonOnStandardOutput::JsonOnStandardOutput(const std::string& json_path) {
@@ -53,6 +63,8 @@ JsonOnStandardOutput::JsonOnStandardOutput(const std::string& json_path) {
 
 JsonOnStandardOutput::~JsonOnStandardOutput() {
     if (!saved_stdout_) return;
+    // (rdbuf() clears the stream's state: a stderr that took none of the report, `2>/dev/full`, ended with exit 0)
+    if (!std::cout.good()) report_to_stderr_lost = true;
     std::cout.rdbuf(saved_stdout_);
     json_stdout = nullptr;
 }
@@ -60,8 +72,17 @@ JsonOnStandardOutput::~JsonOnStandardOutput() {
 void write_json_result(const std::string& path, const std::string& text) {
     if (!names_standard_output(path)) return write_result_file(path, text);
     std::ostream out(json_stdout ? json_stdout : std::cout.rdbuf());
-    out << text << std::flush;  // (a standard output that cannot take it: main's check says so, exit 1)
+    errno = 0;
+    out << text << std::flush;
+    if (!out.good()) {  // (a full disk, a closed pipe: said here, with the reason, while errno still tells it)
+        const int why = errno;
+        keep_results();  // the reports and plots written before it are whole (as for any lost standard output)
+        throw std::runtime_error("the JSON result could not be written to standard output" +
+                                 (why != 0 ? " (" + std::string(std::strerror(why)) + ")" : std::string()));
+    }
 }
+
+bool report_on_stderr_lost() { return report_to_stderr_lost; }
 
 void keep_results() {
     const std::lock_guard<std::mutex> lock(journal_mutex);

@@ -37,8 +37,13 @@ private:
     std::streambuf* saved_stdout_ = nullptr;
 };
 
-// A JSON result: to `path` as write_result_file writes it, or to standard output (names_standard_output).
+// A JSON result: to `path` as write_result_file writes it, or to standard output (names_standard_output); a standard
+// output that does not take it all is a std::runtime_error with the reason.
 void write_json_result(const std::string& path, const std::string& text);
+
+// Whether a report sent to stderr by a JsonOnStandardOutput was not all written there (`2>/dev/full`): the command
+// then fails, as for a lost standard output (main).
+bool report_on_stderr_lost();
 
 // Notes `path` as this command's result before another program (gnuplot) writes it.
 void note_result_file(const std::filesystem::path& path);

@@ -316,12 +316,15 @@ struct StudyFieldReader {
     static double optional_number(const nlohmann::json& j, const std::string& key, const std::string& where) {
         return j.contains(key) ? number(j, key, where, 0, analytics::kLargestPlausibleNumber, "[0, 1e100]") : 0.0;
     }
+    // A count: 3 or 3.0 (JSON has one number type; a tool that rewrote the file may print 3.0), not 3.5.
+    static long whole_number(const nlohmann::json& j, const std::string& key, const std::string& where, double lo,
+                             double hi, const char* range) {
+        const double x = number(j, key, where, lo, hi, range);
+        if (x != std::floor(x)) refuse(path(where, key), j.at(key), "must be a whole number");
+        return static_cast<long>(x);
+    }
     static int optional_count(const nlohmann::json& j, const std::string& key, const std::string& where) {
-        if (!j.contains(key)) return 0;
-        const nlohmann::json& v = j.at(key);
-        if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 1000000000LL)
-            refuse(path(where, key), v, "must be a whole number in [0, 1e9]");
-        return static_cast<int>(v.get<long long>());
+        return j.contains(key) ? static_cast<int>(whole_number(j, key, where, 0, 1e9, "[0, 1e9]")) : 0;
     }
     static std::string text(const nlohmann::json& j, const std::string& key, const std::string& where) {
         const nlohmann::json& v = at(j, key, where);
@@ -361,8 +364,7 @@ constexpr double big = analytics::kLargestPlausibleNumber;
 void read_study_settings(const nlohmann::json& j, SensitivityStudy& s) {
     s.base_material = R::at(j, "base_material", "");
     if (!s.base_material.is_object()) R::refuse("base_material", s.base_material, "must be a JSON object");
-    s.options.levels = static_cast<int>(R::number(j, "levels", "", 3, kMaxLevels, "[3, 101]"));
-    if (!j.at("levels").is_number_integer()) R::refuse("levels", j.at("levels"), "must be a whole number");
+    s.options.levels = static_cast<int>(R::whole_number(j, "levels", "", 3, kMaxLevels, "[3, 101]"));
     s.options.relative_span = R::number(j, "relative_span", "", 1e-6, 0.999, "(0, 1)");
     s.options.line = line_kind_from_string(R::text(j, "line", ""));
     s.options.shape.criterion = analytics::shape_criterion_from_string(R::text(j, "criterion", ""));
@@ -391,16 +393,12 @@ StudyCampaign read_study_campaign(const nlohmann::json& c) {
     std::sort(out.normal_stresses.begin(), out.normal_stresses.end());
     out.template_sha256 = R::text(c, "template_sha256", "campaign");
     // (absent in a study written before stop 62)
-    const auto whole = [&c](const char* key, double lo, double hi, const char* range) {
-        const double x = R::number(c, key, "campaign", lo, hi, range);
-        if (!c.at(key).is_number_integer()) R::refuse(R::path("campaign", key), c.at(key), "must be a whole number");
-        return x;
-    };
     if (c.contains("replicates")) {
         const std::string range = "[1, " + std::to_string(orchestrator::kMaxReplicates) + "]";
-        out.replicates = static_cast<int>(whole("replicates", 1, orchestrator::kMaxReplicates, range.c_str()));
+        out.replicates =
+            static_cast<int>(R::whole_number(c, "replicates", "campaign", 1, orchestrator::kMaxReplicates, range.c_str()));
     }
-    if (c.contains("base_seed")) out.base_seed = static_cast<long>(whole("base_seed", 0, 2147483647.0, "[0, 2147483647]"));
+    if (c.contains("base_seed")) out.base_seed = R::whole_number(c, "base_seed", "campaign", 0, 2147483647.0, "[0, 2147483647]");
     return out;
 }
 

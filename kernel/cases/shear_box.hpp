@@ -62,7 +62,7 @@ struct ShearBoxProcedure {
 
 /// Names this engine and the version of its procedure: part of a run's identity (a change of the physics or the
 /// procedure bumps it, so that no cached result of the old one is reused).
-inline constexpr const char* kShearBoxEngine = "demcal-kernel-shear-box/1";
+inline constexpr const char* kShearBoxEngine = "demcal-kernel-shear-box/2";
 
 /// A run that could not finish: `cause` is one of the script's (params, nan, kinetic_energy, escaped,
 /// normal_stress), what() the evidence.

@@ -119,6 +119,23 @@ TEST_CASE("a tiny bonded box consolidates, bonds and shears under the held norma
   CHECK(again.steps == r.steps);
 }
 
+TEST_CASE("a stiff material consolidates under the lid servo", "[kernel][shear_box]") {
+  // sand-scale-tiny.json with E = 1e9 Pa (held-back case p59_12): at the approach speed the lid closes 25x the
+  // equilibrium overlap per servo period, and the fast approach, re-armed by every dip of the instantaneous force,
+  // kept the lid in a limit cycle until the step limit ("consolidation did not reach 4000 Pa")
+  ShearBoxParams p = tiny_box();
+  p.young_modulus = 1e9;
+  p.particle_radius = 0.0035;
+  p.box_height = 0.04;
+  p.shear_velocity = 0.1;
+  p.shear_displacement = 0.003;
+  p.samples = 10;
+  const ShearBoxResult r = run_shear_box(p);
+  CHECK(r.consolidation_unbalanced_force < 0.02);  // quasi-static, not the step limit's leniency
+  CHECK(std::abs(r.normal_stress_held - p.normal_stress) < 0.1 * p.normal_stress);
+  CHECK(r.peak_shear_stress > 0.3 * p.normal_stress);
+}
+
 TEST_CASE("the kernel's shear box refuses what it cannot run, naming the field", "[kernel][shear_box]") {
   auto refused = [](ShearBoxParams p, const std::string& field) {
     try {
