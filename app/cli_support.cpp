@@ -114,8 +114,8 @@ void refuse_empty_values(CLI::App& app) {
         // empty value by its rule ("--criterion:  not in {...}") instead of as empty.
         // (a required option has no default to omit it for)
         const std::string empty_rule = opt->get_required() ? kEmptyRequiredValue : kEmptyValue;
-        opt->transform(CLI::Validator([empty_rule](std::string& text) { return text.empty() ? empty_rule : std::string(); },
-                                      ""));
+        opt->transform(CLI::Validator(
+            [empty_rule](std::string& text) { return text.empty() ? empty_rule : std::string(); }, ""));
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
 }
@@ -690,7 +690,8 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
         // "-engine": a long option typed with one dash, read as -e (probe 62b named '-e' and no more)
         const std::string long_name = "-" + std::string(arg.substr(0, arg.find('=')));
         const bool one_dash_long = arg[1] != '-' && !word && long_name.size() > 3 && option_named(long_name);
-        throw UserError(command + ": '" + analytics::shortened_text(word ? arg : one_dash_long ? long_name.substr(1) : name) +
+        const std::string shown = word ? std::string(arg) : one_dash_long ? long_name.substr(1) : name;
+        throw UserError(command + ": '" + analytics::shortened_text(shown) +
                         "' is not an option of this command (see demcal " + command + " --help" +
                         (passes_arguments_on(*chain.back()) ? "; options for the runs go after --" : "") +
                         (word ? "; a file named so is given as ./" + analytics::shortened_text(arg) : "") +

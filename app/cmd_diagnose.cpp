@@ -252,7 +252,8 @@ std::string markdown_report(const analytics::DiagnoseResult& r, const std::strin
     if (r.effects.empty()) md << "None: no candidate was significant after Holm's correction and improved the CV RMSE.\n\n";
     for (const auto& e : r.effects) {
         md << "- **" << effect_name(e.variable, e.kind, e.regime) << "** (" << e.kind << "): `" << e.form << "`; ";
-        for (const auto& p : e.params) md << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << " (1 SE); ";
+        for (const auto& p : e.params)
+            md << p.name << " = " << sci(p.value) << " +/- " << sci(p.std_error) << " (1 SE); ";
         md << "F = " << sci(e.f_statistic) << ", p = " << sci(e.p_value) << ", Holm p = " << sci(e.p_holm) << " over "
            << e.candidates_tried << " candidates; CV RMSE " << sci(e.cv_rmse_before) << " -> " << sci(e.cv_rmse_after)
            << "\n";

@@ -210,26 +210,24 @@ std::string field_value_key(const nlohmann::json& v) {
     return v.is_number() ? analytics::number_text(v.get<double>(), 15) : v.dump();
 }
 
-// Each material field's most common value among a store's shear campaigns, where one value is more common than every
-// other: what a campaign's own values are told against in `demcal status`, where campaign names are digests (a
-// study's levels, a calibration's steps).
+// Each material field's value held by more than half of a store's shear campaigns: what a campaign's own values are
+// told against in `demcal status`, where campaign names are digests (a study's levels, a calibration's steps).
+// A field with no such value (a study of one parameter: each level once) has none: every campaign shows its own. (The
+// most common value, ties to the smallest text, read a study's lowest level as the base (probe 62); a calibration
+// added to a one-parameter study's folder broke the tie and hid a level again (probe 62b).)
 std::map<std::string, std::string> common_material_values(const std::vector<ShearCampaignOutcome>& outs) {
     std::map<std::string, std::map<std::string, int>> counts;
+    int campaigns = 0;
     for (const auto& o : outs) {
         if (o.campaign.kind != CampaignKind::shear) continue;
+        ++campaigns;
         const nlohmann::json material = o.campaign.spec.value("material", nlohmann::json::object());
         for (const auto& [k, v] : material.items()) ++counts[k][field_value_key(v)];
     }
-    // a field whose values tie (a study of one parameter: each level once) has no common value: every campaign shows
-    // its own (the smallest text won the tie, and the study's lowest level read as the base, probe 62)
     std::map<std::string, std::string> common;
-    for (const auto& [k, by_value] : counts) {
-        const auto most = std::max_element(by_value.begin(), by_value.end(),
-                                           [](const auto& a, const auto& b) { return a.second < b.second; });
-        const auto ties = std::count_if(by_value.begin(), by_value.end(),
-                                        [&most](const auto& vc) { return vc.second == most->second; });
-        if (ties == 1) common[k] = most->first;
-    }
+    for (const auto& [k, by_value] : counts)
+        for (const auto& [value, n] : by_value)
+            if (2 * n > campaigns) common[k] = value;
     return common;
 }
 

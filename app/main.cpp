@@ -103,6 +103,7 @@ int with_standard_output_checked(int status) {
     std::cout.flush();
     const bool flushed = std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good();
     if (demcal::report_on_stderr_lost()) return status == 0 ? 1 : status;  // (no message: stderr is what failed)
+    if (demcal::json_on_stdout_lost()) return status == 0 ? 1 : status;    // (said when it happened)
     if (flushed) return status;
     const int why = errno;
     std::cerr << "demcal: error: the standard output could not be written"

@@ -3,6 +3,7 @@
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <mutex>
@@ -40,6 +41,7 @@ void write_result_file(const std::filesystem::path& path, const std::string& tex
 namespace {
 std::streambuf* json_stdout = nullptr;  // standard output's own buffer while a JsonOnStandardOutput lives
 bool report_to_stderr_lost = false;     // (report_on_stderr_lost)
+bool json_to_stdout_lost = false;       // (json_on_stdout_lost)
 }  // namespace
 
 bool names_standard_output(const std::string& path) {
@@ -47,11 +49,10 @@ bool names_standard_output(const std::string& path) {
     if (path.empty()) return false;
     std::error_code ec;
     const std::string absolute = std::filesystem::absolute(path, ec).lexically_normal().string();
-    const std::string own = "/proc/" + std::to_string(::getpid());
-    for (const std::string& name : {std::string("/dev/stdout"), std::string("/dev/fd/1"), std::string("/proc/self/fd/1"),
-                                    std::string("/proc/thread-self/fd/1"), own + "/fd/1"})
+    const std::string own = "/proc/" + std::to_string(::getpid()) + "/fd/1";
+    for (const char* name : {"/dev/stdout", "/dev/fd/1", "/proc/self/fd/1", "/proc/thread-self/fd/1"})
         if (absolute == name) return true;
-    return false;
+    return absolute == own;
 }
 
 JsonOnStandardOutput::JsonOnStandardOutput(const std::string& json_path) {
@@ -74,15 +75,20 @@ void write_json_result(const std::string& path, const std::string& text) {
     std::ostream out(json_stdout ? json_stdout : std::cout.rdbuf());
     errno = 0;
     out << text << std::flush;
-    if (!out.good()) {  // (a full disk, a closed pipe: said here, with the reason, while errno still tells it)
+    // A full disk, a closed pipe: said here, while errno still tells the reason. (The stream's own state did not show
+    // a write the system refused; stdio's does.)
+    if (!out.good() || std::fflush(stdout) != 0 || std::ferror(stdout)) {
         const int why = errno;
         keep_results();  // the reports and plots written before it are whole (as for any lost standard output)
+        json_to_stdout_lost = true;
         throw std::runtime_error("the JSON result could not be written to standard output" +
                                  (why != 0 ? " (" + std::string(std::strerror(why)) + ")" : std::string()));
     }
 }
 
 bool report_on_stderr_lost() { return report_to_stderr_lost; }
+
+bool json_on_stdout_lost() { return json_to_stdout_lost; }
 
 void keep_results() {
     const std::lock_guard<std::mutex> lock(journal_mutex);

@@ -45,6 +45,9 @@ void write_json_result(const std::string& path, const std::string& text);
 // then fails, as for a lost standard output (main).
 bool report_on_stderr_lost();
 
+// Whether write_json_result found standard output refusing the JSON (and said so, with the reason).
+bool json_on_stdout_lost();
+
 // Notes `path` as this command's result before another program (gnuplot) writes it.
 void note_result_file(const std::filesystem::path& path);
 

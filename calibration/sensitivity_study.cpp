@@ -395,10 +395,11 @@ StudyCampaign read_study_campaign(const nlohmann::json& c) {
     // (absent in a study written before stop 62)
     if (c.contains("replicates")) {
         const std::string range = "[1, " + std::to_string(orchestrator::kMaxReplicates) + "]";
-        out.replicates =
-            static_cast<int>(R::whole_number(c, "replicates", "campaign", 1, orchestrator::kMaxReplicates, range.c_str()));
+        out.replicates = static_cast<int>(
+            R::whole_number(c, "replicates", "campaign", 1, orchestrator::kMaxReplicates, range.c_str()));
     }
-    if (c.contains("base_seed")) out.base_seed = R::whole_number(c, "base_seed", "campaign", 0, 2147483647.0, "[0, 2147483647]");
+    if (c.contains("base_seed"))
+        out.base_seed = R::whole_number(c, "base_seed", "campaign", 0, 2147483647.0, "[0, 2147483647]");
     return out;
 }
 

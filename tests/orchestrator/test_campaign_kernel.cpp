@@ -249,6 +249,22 @@ TEST_CASE("status names every level of a one-parameter study, the base's too", "
     }
     CHECK(campaigns == 3);
     CHECK(labelled == campaigns);
+    // a campaign of the base material added to the folder (probe 62b: a calibration's) made the base's friction the
+    // most common value, and the study's base level lost its label again: a common value is now a majority's
+    REQUIRE(test::run_demcal({"shear", tiny, "-s", "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
+                             dir / "plain.log") == 0);
+    REQUIRE(test::run_demcal({"status", dir.string()}, dir / "status2.log") == 0);
+    const std::string status2 = test::read_file(dir / "status2.log");
+    INFO(status2);
+    campaigns = labelled = 0;
+    for (std::size_t at = status2.find("  kernel engine"); at != std::string::npos;
+         at = status2.find("  kernel engine", at + 1)) {
+        ++campaigns;
+        const std::string line = status2.substr(at, status2.find('\n', at) - at);
+        if (line.find(", friction_coefficient ") != std::string::npos) ++labelled;
+    }
+    CHECK(campaigns == 4);
+    CHECK(labelled == campaigns);
     fs::remove_all(dir);
 }
 

@@ -36,6 +36,11 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         // an empty value was read as 0, a subnormal called "not a number", a seed above 2^63 clamped to 2^63 - 1
         {{"shear", tiny, "-s", "5e3", "--replicates", ""}, "--replicates: an empty value"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", ""}, "--levels: an empty value"},
+        // a required option has no default to omit it for (probe 62b); a vertical tab is a blank
+        {{"shear", tiny, "-s", " "}, "--normal-stress: an empty value (this option has no default: give a value)"},
+        {{"shear", tiny, "-s", "5e3,\v1e4,x"}, "--normal-stress: 'x' is not a number"},
+        // the option named (probe 62b: "target mu_b = '' is not a number")
+        {{"calibrate", "--start", tiny, "--target", "mu_b = "}, "--target: target mu_b = '' is not a number"},
         {{"shear", tiny, "-s", "5e3", "--timeout", "1e-320"}, "--timeout: '1e-320' is subnormal"},
         // 1e99 s passed, and a SLURM campaign's --time in minutes overflowed a long
         {{"shear", tiny, "-s", "5e3", "--timeout", "1e99"}, "--timeout: 1e99 is not a number of seconds from 1 to 1e+07"},
@@ -391,6 +396,7 @@ TEST_CASE("a JSON result to standard output (--json -) comes alone there, the te
     for (const auto& [args, name] : std::vector<std::pair<std::string, std::string>>{
              {"predict '" + geometry + "' --json -", "predict"},
              {"predict '" + geometry + "' --json /dev/stdout", "predict_dev"},
+             {"predict '" + geometry + "' --json /proc/thread-self/fd/1", "predict_thread"},  // (was refused)
              {"diagnose --model oldal --data '" + data + "' --json -", "diagnose"}}) {
         INFO(args);
         REQUIRE(run(args, name) == 0);
@@ -407,5 +413,21 @@ TEST_CASE("a JSON result to standard output (--json -) comes alone there, the te
                                  geometry + "' --json /dev/stdout 2>/dev/null) > appended.out";
     REQUIRE(std::system(appended.c_str()) == 0);
     CHECK(test::read_file(dir / "appended.out").rfind("first\n{", 0) == 0);
+    // a standard output that refuses the JSON: exit 1, the reason named once (probe 62b: no reason); a stderr that
+    // refuses the report: exit 1 (it was 0)
+    const auto full = [&](const std::string& redirect) {
+        const std::string cmd = "cd '" + dir.string() + "' && '" + DEMCAL_BINARY + "' predict '" + geometry +
+                                "' --json - " + redirect;
+        const int status = std::system(cmd.c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    };
+    CHECK(full("> /dev/full 2> full.err") == 1);
+    const std::string full_err = test::read_file(dir / "full.err");
+    CHECK_THAT(full_err, Contains("the JSON result could not be written to standard output (No space left on device)"));
+    CHECK(full_err.find("demcal: error: the standard output") == std::string::npos);  // said once
+    CHECK(full("> stdout.out 2> /dev/full") == 1);
+    // a folder's name, /dev/stdout/ too, is no output file (it was "the folder /dev/stdout does not exist")
+    CHECK(run("predict '" + geometry + "' --json /dev/stdout/", "slash") == 2);
+    CHECK_THAT(test::read_file(dir / "slash.err"), Contains("--json = '/dev/stdout/' ends with '/', a folder's name"));
     fs::remove_all(dir);
 }

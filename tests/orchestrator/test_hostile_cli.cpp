@@ -863,10 +863,16 @@ TEST_CASE("probe 46: an option the command does not have is named, even where th
                "--campaign", (dir / "vib").string(), "--", "--particles", "400"},
               {"vibration: '--bogus' is not an option", "options for the runs go after --"}},
              {{"predict", "--jsn", (dir / "x.json").string(), geometry}, {"predict: '--jsn' is not an option"}},
+             // the argument named as the usage names it (it said "predict = ...")
+             {{"predict", (dir / "no-such.json").string()}, {"GEOMETRY = '", "no-such.json' does not exist"}},
              {{"crosscheck", "shear", test::source_path("examples/materials/sand-tiny.json").string(), "-q"},
               {"crosscheck shear: '-q' is not an option"}},
              // a file named -geo.json was named '-g' (probe 61)
-             {{"predict", "-geo.json"}, {"predict: '-geo.json' is not an option", "given as ./-geo.json"}}},
+             {{"predict", "-geo.json"}, {"predict: '-geo.json' is not an option", "given as ./-geo.json"}},
+             // a long option with one dash was named '-e' (probe 62b)
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3", "-engine",
+               "kernel"},
+              {"shear: '-engine' is not an option", "a long option takes two dashes: --engine"}}},
             dir);
     // negative numbers stay values, options after -- belong to the runs
     CHECK(test::run_demcal({"silo", "--theta", "30", "--vibration-start", "-1", "--check"}, root / "neg.log") == 2);
