@@ -3,6 +3,7 @@
 #include "analytics/number_text.hpp"
 #include "analytics/user_input.hpp"
 #include "app/commands.hpp"
+#include "app/result_files.hpp"  // same_file_as_descriptor
 #include "orchestrator/slurm_executor.hpp"
 
 #include <algorithm>
@@ -107,15 +108,29 @@ void refuse_empty_values(CLI::App& app) {
         if (opt->get_type_size_max() <= 0) continue;  // a flag takes no value
         const std::string type = opt->get_type_name();
         // (a type name carries the descriptions of the option's own checks after a ':': "FLOAT:between 0 and 90")
-        if (type == "FLOAT" || type.rfind("FLOAT:", 0) == 0) opt->transform(any_number);  // a transform: -0 becomes 0
-        else if (type == "INT" || type == "UINT") opt->check(any_integer);
+        const auto of_type = [&type](const std::string& t) { return type == t || type.rfind(t + ":", 0) == 0; };
+        const bool real = of_type("FLOAT"), whole = of_type("INT") || of_type("UINT");
+        if (real) opt->transform(any_number);  // a transform: -0 becomes 0
+        else if (whole) opt->check(any_integer);
+        // blanks around a number are no part of it, as in a list (`--timeout " 5"` was "not a number", probe 63);
+        // a transform added later runs earlier: this runs before the number's checks
+        if (real || whole)
+            opt->transform(CLI::Validator([](std::string& text) { return text = analytics::trimmed(text), std::string(); },
+                                          ""));
         if (opt->check_lname("partition")) opt->check(slurm_partition);  // every command's SLURM partition
         // First of all the option's checks (a transform goes before the others): the option's own check named an
         // empty value by its rule ("--criterion:  not in {...}") instead of as empty.
-        // (a required option has no default to omit it for)
+        // (a required option has no default to omit it for). Blanks only are no value either: `--json " "` wrote a
+        // file named " ", `-c " "` a campaign folder so named (probe 63).
         const std::string empty_rule = opt->get_required() ? kEmptyRequiredValue : kEmptyValue;
         opt->transform(CLI::Validator(
-            [empty_rule](std::string& text) { return text.empty() ? empty_rule : std::string(); }, ""));
+            [empty_rule](std::string& text) {
+                if (text.empty()) return empty_rule;
+                return analytics::trimmed(text).empty() ? "'" + analytics::shortened_text(text) + "': blanks only, " +
+                                                              empty_rule
+                                                        : std::string();
+            },
+            ""));
     }
     for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*sub);
 }
@@ -410,6 +425,25 @@ void check_output_outside_run_folders(const std::string& path, const std::string
                         ": a run's files are its own; give a path outside it");
 }
 
+namespace {
+// A path ending in '/' names a folder ("/dev/stdout/" was told that the folder /dev/stdout does not exist; predict
+// --json out/ made the folder out, did its work and failed on the write, probe 63).
+void refuse_folder_name(const std::string& path, const std::string& named) {
+    if (!path.empty() && path.back() == '/')
+        throw UserError(named + " ends with '/', a folder's name; give a file name");
+}
+
+// An output that is the very file a standard stream is redirected to, by its own name or through a link
+// (`--report r.md > r.md`, a link to /dev/stderr): written whole through a rename, it replaced what the command
+// printed there (probe 63).
+void refuse_standard_stream_file(const std::string& path, const std::string& named) {
+    for (const auto& [fd, stream] : {std::pair{1, "standard output"}, std::pair{2, "standard error"}})
+        if (same_file_as_descriptor(path, fd))
+            throw UserError(named + " is the file " + stream + " is redirected to; give another file" +
+                            (fd == 1 ? " (or - where the option takes standard output)" : ""));
+}
+}  // namespace
+
 bool names_process_stream(const std::string& absolute) {
     static const std::regex stream(R"(/dev/(stdin|stdout|stderr|fd/.*)|/proc/[^/]+(/task/[^/]+)?/fd/.*)");
     return std::regex_match(absolute, stream);
@@ -427,8 +461,7 @@ void check_output_file(const std::string& path, const std::string& option) {
     check_name_lengths(path, named, PathKind::file);
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UserError(named + " is a folder; give a file name");
-    // ("/dev/stdout/" was told that the folder /dev/stdout does not exist)
-    if (path.back() == '/') throw UserError(named + " ends with '/', a folder's name; give a file name");
+    refuse_folder_name(path, named);
     // /dev/stderr, /proc/self/fd/2: a stream's name, not a file's. Where the stream was redirected to a file, that
     // file was replaced whole (a result is written to a temporary file and renamed), the lines before it lost.
     const std::string absolute = fs::absolute(path, ec).lexically_normal().string();
@@ -437,6 +470,7 @@ void check_output_file(const std::string& path, const std::string& option) {
     const fs::file_status st = fs::status(path, ec);  // (through a link: what the output would be written into)
     if (fs::exists(st) && !fs::is_regular_file(st))
         throw UserError(named + " is not a regular file (a device, FIFO or socket); give a file name");
+    refuse_standard_stream_file(path, named);
     if (fs::is_symlink(fs::symlink_status(path, ec)) && !fs::exists(st))
         throw UserError(named + " is a link to nothing (" +
                         analytics::shortened_text(fs::read_symlink(path, ec).string(), 200) + "); give a file name");
@@ -484,9 +518,10 @@ void check_output_file_in_new_folders(const std::string& path, const std::string
     namespace fs = std::filesystem;
     if (path.empty()) return;
     std::error_code ec;
+    const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
+    refuse_folder_name(path, named);
     const fs::path parent = fs::path(path).parent_path();
     if (parent.empty() || fs::exists(parent, ec)) return check_output_file(path, option);
-    const std::string named = option + " = '" + analytics::shortened_text(path, 200) + "'";
     check_name_lengths(path, named, PathKind::file);
     check_files_can_be_created_below(parent, named);
 }
@@ -674,6 +709,13 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
         if (std::isdigit(static_cast<unsigned char>(arg[1])) || arg[1] == '.') continue;  // "-10,400": a value
         std::string name(arg.substr(0, arg.find('=')));
         if (arg[1] != '-') name = std::string(arg.substr(0, 2));  // -j2: the short option -j with its value
+        // "-campaign": a long option typed with one dash, read as -c with the value "ampaign" (a campaign ran into
+        // ./ampaign, probe 63); a value glued to a short option is never a long option's whole name
+        if (const std::string long_name = "-" + std::string(arg.substr(0, arg.find('=')));
+            arg[1] != '-' && arg.size() > 2 && option_named(name) && option_named(long_name))
+            throw UserError("'" + analytics::shortened_text(arg) + "': a long option takes two dashes: " + long_name +
+                            " (a value glued to " + name + " is written apart: " + name + " " +
+                            analytics::shortened_text(arg.substr(2)) + ")");
         if (const CLI::Option* opt = option_named(name)) {
             // its value, whatever it looks like, is the option's to check ("--partition -x")
             std::string value = name.size() < arg.size() ? std::string(arg.substr(name.size() + (arg[1] == '-'))) : "";

@@ -272,17 +272,23 @@ std::vector<MacroTarget> targets_of(const CalibrateCli& o) {
                 const auto n = analytics::read_typed_number(text);
                 if (!n.is_number) throw std::invalid_argument(text);
                 if (n.defect)
-                    throw UserError("measured point '" + analytics::shortened_text(item) + "': " +
+                    throw UserError("--measured: point '" + analytics::shortened_text(item) + "': " +
                                     analytics::shortened_text(text) + " " + *n.defect);
                 return n.value;
             };
             sigma.push_back(whole_number(analytics::trimmed(item.substr(0, colon))));
             tau.push_back(whole_number(analytics::trimmed(item.substr(colon + 1))));
         } catch (const std::invalid_argument&) {
-            throw UserError("measured point '" + analytics::shortened_text(item) + "' is not of the form SIGMA:TAU (Pa)");
+            throw UserError("--measured: point '" + analytics::shortened_text(item) +
+                            "' is not of the form SIGMA:TAU (Pa)");
         }
     }
-    auto targets = targets_from_measured_line(sigma, tau);  // (its own checks first: the points' values and spread)
+    std::vector<MacroTarget> targets;
+    try {
+        targets = targets_from_measured_line(sigma, tau);  // (its own checks first: the points' values and spread)
+    } catch (const std::invalid_argument& e) {
+        throw UserError(std::string("--measured: ") + e.what());
+    }
     // the simulated lines are compared with the measured one over the stresses they share: a line measured at
     // 100-300 kPa was "reproduced" by boxes at 4-8 kPa, an extrapolation of both
     const auto& stresses = o.study.campaign.normal_stresses;

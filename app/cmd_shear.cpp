@@ -296,6 +296,8 @@ void check_campaign_folder_argument(const std::string& dir, const std::string& c
     const bool there = fs::exists(dir, ec);
     if (ec) return;  // a path the file system will not take (a link loop): named with its reason further on
     if (!there) throw UserError(named + " does not exist");
+    if (!fs::is_directory(dir, ec))  // (a FIFO or a device was told it "holds no campaign.sqlite", probe 63)
+        throw UserError(named + " is not a folder (a device, FIFO or socket): give a campaign folder");
     const fs::path d(dir);
     if (fs::exists(d / "campaign.sqlite", ec) || fs::exists(d / "campaign.json", ec)) return;
     if (fs::exists(d / "checkpoint.bin", ec) || fs::exists(d / "summary.json", ec))
@@ -312,6 +314,8 @@ void check_campaign_folder_argument(const std::string& dir, const std::string& c
         for (const auto& n : inside) list += (list.empty() ? "" : ", ") + n;
         throw UserError(named + " holds no campaign itself; its folders " + list + " do: give one of them");
     }
+    if (command == "status")  // (resume says so itself, naming a silo sweep's folder)
+        throw UserError(named + " holds no campaign.sqlite nor a silo sweep's campaign.json: no campaign");
 }
 
 void print_status(const std::string& dir) {
@@ -378,6 +382,7 @@ void run_resume(const ShearCliOptions& opt) {
                                      : "";
         throw UserError("resume: DIR = '" + opt.campaign_dir + "' holds no campaign.sqlite" + what);
     }
+    orchestrator::check_stored_shear_specs(opt.campaign_dir);
     if (opt.yade_given) {  // void where every unfinished campaign runs on the kernel (it was silently ignored)
         bool unfinished = false, on_yade = false;
         for (const auto& o : inspect_campaigns(opt.campaign_dir)) {

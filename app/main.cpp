@@ -6,6 +6,7 @@
 
 #include <gsl/gsl_errno.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
@@ -43,13 +44,18 @@ int run_command(int argc, char** argv) {
     // rule, and where the options are listed (CLI11's own text took two lines without the prefix)
     app.failure_message([](const CLI::App* a, const CLI::Error& e) {
         std::string command = "demcal";
+        const CLI::App* innermost = a;
         for (const CLI::App* sub = a; sub;) {  // the subcommands given so far: the help that lists the options
             const auto given = sub->get_subcommands();
             sub = given.empty() ? nullptr : given.front();
-            if (sub) command += " " + sub->get_name();
+            if (sub) command += " " + sub->get_name(), innermost = sub;
         }
-        // words left over are mostly a list typed with spaces (-s 5e3 10e3 15e3: "not expected: 15e3 10e3")
-        const std::string list_hint = dynamic_cast<const CLI::ExtrasError*>(&e)
+        // words left over are mostly a list typed with spaces (-s 5e3 10e3 15e3: "not expected: 15e3 10e3"), where
+        // the command takes a list (predict g.json g.json was told about -s, which predict does not have)
+        const auto options = innermost->get_options();
+        const bool takes_lists = std::any_of(options.begin(), options.end(),
+                                             [](const CLI::Option* o) { return o->get_delimiter() == ','; });
+        const std::string list_hint = dynamic_cast<const CLI::ExtrasError*>(&e) && takes_lists
                                           ? "; a list is one word, its values separated by commas without spaces "
                                             "(-s 5e3,10e3,15e3)"
                                           : "";

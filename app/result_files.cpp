@@ -1,5 +1,6 @@
 #include "app/result_files.hpp"
 
+#include "app/cli_support.hpp"  // names_process_stream
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <cerrno>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>  // getpid
 
 namespace demcal {
@@ -44,6 +46,12 @@ bool report_to_stderr_lost = false;     // (report_on_stderr_lost)
 bool json_to_stdout_lost = false;       // (json_on_stdout_lost)
 }  // namespace
 
+bool same_file_as_descriptor(const std::string& path, int fd) {
+    struct stat named {}, open_file {};
+    return !path.empty() && ::stat(path.c_str(), &named) == 0 && ::fstat(fd, &open_file) == 0 &&
+           S_ISREG(named.st_mode) && named.st_dev == open_file.st_dev && named.st_ino == open_file.st_ino;
+}
+
 bool names_standard_output(const std::string& path) {
     if (path == kStandardOutputName) return true;
     if (path.empty()) return false;
@@ -52,7 +60,11 @@ bool names_standard_output(const std::string& path) {
     const std::string own = "/proc/" + std::to_string(::getpid()) + "/fd/1";
     for (const char* name : {"/dev/stdout", "/dev/fd/1", "/proc/self/fd/1", "/proc/thread-self/fd/1"})
         if (absolute == name) return true;
-    return absolute == own;
+    if (absolute == own) return true;
+    // the file standard output is redirected to, by its name or a link (`--json r.json > r.json`: the JSON was
+    // written over the text printed there, probe 63); but /dev/stderr named is stderr, whatever file it shares with
+    // standard output (`> log 2>&1`)
+    return !names_process_stream(absolute) && same_file_as_descriptor(path, 1);
 }
 
 JsonOnStandardOutput::JsonOnStandardOutput(const std::string& json_path) {

@@ -19,9 +19,13 @@ void write_result_file(const std::filesystem::path& path, const std::string& tex
 
 // `--json -`: the JSON alone on standard output, for a pipe (`demcal predict g.json --json - | jq .`).
 inline constexpr const char* kStandardOutputName = "-";
-// "-" or a name of standard output (/dev/stdout, /dev/fd/1, /proc/self/fd/1): as a file, a pipe was refused and a
-// redirect's file was replaced whole (through a temporary file and a rename), its earlier lines lost.
+// "-", a name of standard output (/dev/stdout, /dev/fd/1, /proc/self/fd/1) or the file it is redirected to: as a
+// file, a pipe was refused and a redirect's file was replaced whole (through a temporary file and a rename), its
+// earlier lines lost.
 bool names_standard_output(const std::string& path);
+
+// Whether `path` is the regular file open as descriptor `fd` (a redirect's file, by its name or through a link).
+bool same_file_as_descriptor(const std::string& path, int fd);
 
 // While it lives, with `json_path` "-": every text the command prints on std::cout goes to stderr instead, so that
 // standard output carries the JSON alone (write_json_result). With any other path it does nothing.

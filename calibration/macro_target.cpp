@@ -131,6 +131,12 @@ std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigm
         analytics::check_measured_stress(sigma[i], point + " SIGMA");
         analytics::check_measured_stress(tau[i], point + " TAU");
     }
+    // a line through 2 points leaves nothing to estimate its interval by, which is the calibration's band (one point
+    // was told its stresses were not 20 % apart, probe 63)
+    if (sigma.size() < 3)
+        throw std::invalid_argument("the measured failure line has " + std::to_string(sigma.size()) +
+                                    " point(s): a line and its 95 % interval need at least 3, at 2 or more normal "
+                                    "stresses");
     if (!sigma.empty())
         analytics::check_normal_stress_spread(*std::min_element(sigma.begin(), sigma.end()),
                                               *std::max_element(sigma.begin(), sigma.end()),

@@ -409,12 +409,14 @@ SensitivityLevel read_study_level(const nlohmann::json& lj, const std::string& l
                        {"value", "mu_b", "se_mu_b", "mu_b_half_width", "tau_c", "se_tau_c", "tau_c_half_width",
                         "simulations_run", "simulations_reused", "cpu_s"},
                        lw);
-    // a braced list is evaluated left to right: the fields are checked in this order
+    // a braced list is evaluated left to right: the fields are checked in this order. A line's mu_b and tau_c are a
+    // shear box's (|mu_b| up to tan 89.4 deg, |tau_c| up to the largest Young modulus a material may have): an edited
+    // tau_c of 1e50 Pa was read and the calibration told the study's ranges were too narrow (probe 63)
     return {R::number(lj, "value", lw, -big, big, "[-1e100, 1e100]"),
-            R::number(lj, "mu_b", lw, -big, big, "[-1e100, 1e100]"),
+            R::number(lj, "mu_b", lw, -100, 100, "[-100, 100]"),
             R::number(lj, "se_mu_b", lw, 0, big, "[0, 1e100]"),
             R::optional_number(lj, "mu_b_half_width", lw),
-            R::number(lj, "tau_c", lw, -big, big, "[-1e100, 1e100]"),
+            R::number(lj, "tau_c", lw, -1e12, 1e12, "[-1e12, 1e12] Pa"),
             R::number(lj, "se_tau_c", lw, 0, big, "[0, 1e100]"),
             R::optional_number(lj, "tau_c_half_width", lw),
             R::optional_count(lj, "simulations_run", lw),
@@ -460,6 +462,10 @@ ParameterSensitivity read_study_parameter(const nlohmann::json& pj, const std::s
     for (std::size_t k = 0; k < levels.size(); ++k) {
         const std::string lw = where + ".levels[" + std::to_string(k) + "]";
         p.levels.push_back(read_study_level(levels[k], lw));
+        // the material the level ran: within the field's own limits (a friction level of 1e99 was read, probe 63)
+        nlohmann::json level_material = s.base_material;
+        level_material[p.name] = p.levels[k].value;
+        orchestrator::validate_material(level_material, lw + " (base_material with " + p.name + " = its value)");
         if (k > 0 && !(p.levels[k].value > p.levels[k - 1].value))
             R::refuse(lw + ".value", levels[k].at("value"),
                       "not above the level before it (" + analytics::number_text(p.levels[k - 1].value) +

@@ -84,12 +84,18 @@ std::string sqlite_failure(sqlite3* db) {
     return m;
 }
 
+// "campaign store 'PATH'": a failure names the file (a full disk said "store: cannot commit", probe 63).
+std::string store_named(sqlite3* db) {
+    const char* file = sqlite3_db_filename(db, "main");
+    return std::string("campaign store '") + (file ? file : "") + "'";
+}
+
 // A prepared statement that finalises itself; bind by 1-based position.
 class Statement {
 public:
     Statement(sqlite3* db, const std::string& sql) : db_(db) {
         if (sqlite3_prepare_v2(db, sql.c_str(), -1, &st_, nullptr) != SQLITE_OK)
-            throw std::runtime_error("store: " + sqlite_failure(db) + " in: " + sql);
+            throw std::runtime_error(store_named(db) + ": " + sqlite_failure(db) + " in: " + sql);
     }
     ~Statement() { sqlite3_finalize(st_); }
     Statement& bind(int i, const std::string& v) {
@@ -111,8 +117,8 @@ public:
         if (rc == SQLITE_ROW) return true;
         if (rc == SQLITE_DONE) return false;
         if (rc == SQLITE_CORRUPT || rc == SQLITE_NOTADB)  // the file's fault, not the machine's: bad input
-            throw std::invalid_argument(std::string("store: damaged: ") + sqlite3_errmsg(db_));
-        throw std::runtime_error("store: " + sqlite_failure(db_));
+            throw std::invalid_argument(store_named(db_) + " is damaged: " + sqlite3_errmsg(db_));
+        throw std::runtime_error(store_named(db_) + ": " + sqlite_failure(db_));
     }
     std::string text(int c) const {
         auto p = sqlite3_column_text(st_, c);
@@ -134,7 +140,7 @@ void in_transaction(sqlite3* db, F&& f) {
     if (sqlite3_exec(db, "BEGIN IMMEDIATE", nullptr, nullptr, &err) != SQLITE_OK) {
         std::string m = sqlite_failure(db);
         sqlite3_free(err);
-        throw std::runtime_error("store: cannot begin transaction: " + m);
+        throw std::runtime_error(store_named(db) + ": cannot begin a transaction: " + m);
     }
     try {
         f();
@@ -145,7 +151,7 @@ void in_transaction(sqlite3* db, F&& f) {
     if (sqlite3_exec(db, "COMMIT", nullptr, nullptr, &err) != SQLITE_OK) {
         std::string m = sqlite_failure(db);
         sqlite3_free(err);
-        throw std::runtime_error("store: cannot commit: " + m);
+        throw std::runtime_error(store_named(db) + ": cannot commit: " + m);
     }
 }
 
@@ -167,8 +173,10 @@ nlohmann::json stored_json(const Statement& st, int column, const char* name) {
 // into a run's folder, so following it would write over files outside the campaign.
 std::filesystem::path resolved_run_dir(const std::filesystem::path& stored, const std::filesystem::path& base_dir) {
     const auto refuse = [&](const char* why) -> std::filesystem::path {
-        throw std::invalid_argument("campaign store in '" + analytics::shortened_text(base_dir.string(), 200) +
-                                    "': runs.run_dir = '" + analytics::shortened_text(stored.string(), 200) + "' " +
+        // (without a folder: the caller names the store; "campaign store in ''" named none, probe 63)
+        const std::string where =
+            base_dir.empty() ? "" : "campaign store in '" + analytics::shortened_text(base_dir.string(), 200) + "': ";
+        throw std::invalid_argument(where + "runs.run_dir = '" + analytics::shortened_text(stored.string(), 200) + "' " +
                                     why + " (the store is damaged or was edited; demcal writes into run folders)");
     };
     if (stored.is_relative()) {
@@ -243,8 +251,8 @@ void check_store_identity(sqlite3* db, const std::string& store) {
                          "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name IN "
                          "('meta', 'campaigns', 'runs', 'campaign_runs', 'attempts')");
         has_demcal_tables = tables.step() && tables.integer(0) == 5;
-    } catch (const std::exception& e) {  // not a database at all, or its first page is damaged
-        throw std::invalid_argument(store + " is not a readable SQLite database (" + e.what() +
+    } catch (const std::exception&) {  // not a database at all, or its first page is damaged
+        throw std::invalid_argument(store + " is not a readable SQLite database (" + sqlite3_errmsg(db) +
                                     "); nothing was written to it");
     }
     // stores written before demcal set application_id (0) are recognised by their tables
@@ -262,9 +270,9 @@ void check_store_columns(sqlite3* db, const std::string& store) {
                                 "wall_s, cpu_s FROM attempts"}) {
         try {
             Statement(db, std::string(columns) + " LIMIT 0");
-        } catch (const std::exception& e) {
-            throw std::invalid_argument(store + " does not have the tables of a demcal store (" + e.what() +
-                                        "); nothing was written to it");
+        } catch (const std::exception&) {
+            throw std::invalid_argument(store + " does not have the tables of a demcal store (" +
+                                        sqlite3_errmsg(db) + "); nothing was written to it");
         }
     }
 }
@@ -275,8 +283,8 @@ void check_store_integrity(sqlite3* db, const std::string& store) {
     try {
         Statement check(db, "PRAGMA quick_check(1)");
         verdict = check.step() ? check.text(0) : "no answer";
-    } catch (const std::exception& e) {
-        verdict = e.what();
+    } catch (const std::exception&) {
+        verdict = sqlite3_errmsg(db);
     }
     if (verdict != "ok")
         throw std::invalid_argument(store + " is damaged (SQLite quick_check: " + analytics::shortened_text(verdict, 200) +
@@ -430,8 +438,9 @@ CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess a
             CampaignStore made(fresh, db_path.parent_path());
         } catch (const std::exception& e) {
             std::string why = e.what();  // named by the store, not by its temporary name
-            const std::string inner = "store " + fresh.string() + ": ";
-            if (why.compare(0, inner.size(), inner) == 0) why.erase(0, inner.size());
+            for (const std::string& temporary : {std::filesystem::absolute(fresh, ec).string(), fresh.string()})
+                for (std::size_t at; !temporary.empty() && (at = why.find(temporary)) != std::string::npos;)
+                    why.replace(at, temporary.size(), db_path.string());
             throw std::runtime_error("cannot create the campaign store " + db_path.string() + ": " + why);
         }
         std::filesystem::rename(fresh, db_path);

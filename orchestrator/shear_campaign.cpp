@@ -46,15 +46,36 @@ nlohmann::json ShearCampaignSpec::to_json() const {
 }
 
 ShearCampaignSpec ShearCampaignSpec::from_json(const nlohmann::json& j) {
+    // A stored spec an edit or a damaged store changed: its field named, not the JSON library's text (status and
+    // resume printed "[json.exception.out_of_range.403] key 'material' not found", exit 1, probe 63).
+    if (!j.is_object()) throw std::invalid_argument("the campaign's spec is not a JSON object");
+    const auto field = [&j](const char* key, bool (nlohmann::json::*is_type)() const noexcept,
+                            const char* type) -> const nlohmann::json& {
+        if (!j.contains(key)) throw std::invalid_argument(std::string("the campaign's spec has no '") + key + "'");
+        const nlohmann::json& v = j.at(key);
+        if (!(v.*is_type)())
+            throw std::invalid_argument(std::string("the campaign's spec field '") + key + "' = " +
+                                        analytics::json_value_text(v) + " is not " + type);
+        return v;
+    };
+    const auto optional_text = [&](const char* key, const char* fallback) -> std::string {
+        return j.contains(key) ? field(key, &nlohmann::json::is_string, "a text").get<std::string>() : fallback;
+    };
     ShearCampaignSpec s;
-    s.material = j.at("material");
-    s.normal_stresses = j.at("normal_stresses").get<std::vector<double>>();
-    s.replicates = j.at("replicates").get<int>();
-    s.base_seed = j.at("base_seed").get<long>();
-    s.template_path = j.at("template").get<std::string>();
-    s.label = j.value("label", "");
-    s.engine = parse_shear_engine(j.value("engine", "yade"));
-    s.material_name = j.value("material_name", "");
+    s.material = field("material", &nlohmann::json::is_object, "a JSON object");
+    const nlohmann::json& stresses = field("normal_stresses", &nlohmann::json::is_array, "a list of numbers");
+    for (const auto& x : stresses) {
+        if (!x.is_number())
+            throw std::invalid_argument("the campaign's spec field 'normal_stresses' holds " +
+                                        analytics::json_value_text(x) + ", not a number");
+        s.normal_stresses.push_back(x.get<double>());
+    }
+    s.replicates = field("replicates", &nlohmann::json::is_number_integer, "a whole number").get<int>();
+    s.base_seed = field("base_seed", &nlohmann::json::is_number_integer, "a whole number").get<long>();
+    s.template_path = field("template", &nlohmann::json::is_string, "a text").get<std::string>();
+    s.label = optional_text("label", "");
+    s.engine = parse_shear_engine(optional_text("engine", "yade"));
+    s.material_name = optional_text("material_name", "");
     return s;
 }
 
@@ -759,9 +780,24 @@ std::vector<ShearCampaignOutcome> ShearCampaignRunner::resume(const ProgressCall
     return outs;
 }
 
+void check_stored_shear_specs(const fs::path& dir) {
+    const fs::path file = dir / "campaign.sqlite";
+    CampaignStore store(file, StoreAccess::read_only);
+    for (const auto& c : store.campaigns()) {
+        if (c.kind != CampaignKind::shear) continue;
+        try {
+            ShearCampaignSpec::from_json(c.spec);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument("campaign store '" + file.string() + "': campaign " + std::to_string(c.id) +
+                                        ": " + e.what() + "; nothing was written to it");
+        }
+    }
+}
+
 std::vector<ShearCampaignOutcome> inspect_campaigns(const fs::path& dir) {
     if (!fs::exists(dir / "campaign.sqlite"))
         throw std::invalid_argument("campaign = '" + dir.string() + "' holds no campaign.sqlite");
+    check_stored_shear_specs(dir);  // before anything of them is printed
     CampaignStore store(dir / "campaign.sqlite", StoreAccess::read_only);
     std::vector<ShearCampaignOutcome> outs;
     for (const auto& c : store.campaigns()) {

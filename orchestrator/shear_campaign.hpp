@@ -148,6 +148,10 @@ private:
 // Summary of a campaign directory without running anything (for `demcal status`): opens the store read-only.
 std::vector<ShearCampaignOutcome> inspect_campaigns(const std::filesystem::path& dir);
 
+// Refuses (std::invalid_argument naming the store, the campaign and the field) a store whose shear campaigns' specs
+// an edit or damage made unreadable, reading only: before status prints or resume runs anything of them.
+void check_stored_shear_specs(const std::filesystem::path& dir);
+
 std::string campaign_name(const ShearCampaignSpec& spec);
 // The name a demcal before stop 61 gave the campaign (its stresses in the order typed, its numbers as written): a
 // store made then keeps its campaigns under these names.

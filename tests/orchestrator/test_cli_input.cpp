@@ -37,7 +37,8 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
         {{"shear", tiny, "-s", "5e3", "--replicates", ""}, "--replicates: an empty value"},
         {{"sensitivity", tiny, "-s", "5e3,1e4", "--levels", ""}, "--levels: an empty value"},
         // a required option has no default to omit it for (probe 62b); a vertical tab is a blank
-        {{"shear", tiny, "-s", " "}, "--normal-stress: an empty value (this option has no default: give a value)"},
+        {{"shear", tiny, "-s", ""}, "--normal-stress: an empty value (this option has no default: give a value)"},
+        {{"shear", tiny, "-s", "5e3", "--template", " "}, "--template: ' ': blanks only, an empty value"},  // probe 63
         {{"shear", tiny, "-s", "5e3,\v1e4,x"}, "--normal-stress: 'x' is not a number"},
         // the option named (probe 62b: "target mu_b = '' is not a number")
         {{"calibrate", "--start", tiny, "--target", "mu_b = "}, "--target: target mu_b = '' is not a number"},
@@ -96,7 +97,10 @@ TEST_CASE("campaign commands refuse bad input before the campaign directory exis
          "--params: 'Young' is not a micromechanical parameter"},
         {{"calibrate", "--start", tiny, "--target", "mu_b=1.3,tau_c=800", "--bounds", "friction_coefficient=-5:50"},
          "'friction_coefficient' = -5"},
-        {{"calibrate", "--start", tiny, "--measured", "5e3x:7000,1e4:13000,2e4:25000"}, "measured point '5e3x:7000'"},
+        {{"calibrate", "--start", tiny, "--measured", "5e3x:7000,1e4:13000,2e4:25000"}, "--measured: point '5e3x:7000'"},
+        // one point was told its stresses were not 20 % apart (probe 63)
+        {{"calibrate", "--start", tiny, "--measured", "4e3:6500"},
+         "--measured: the measured failure line has 1 point(s): a line and its 95 % interval need at least 3"},
     };
     for (const auto& c : cases) {
         std::vector<std::string> args = c.args;
@@ -426,6 +430,13 @@ TEST_CASE("a JSON result to standard output (--json -) comes alone there, the te
     CHECK_THAT(full_err, Contains("the JSON result could not be written to standard output (No space left on device)"));
     CHECK(full_err.find("demcal: error: the standard output") == std::string::npos);  // said once
     CHECK(full("> stdout.out 2> /dev/full") == 1);
+    // the file standard output is redirected to is standard output: the JSON is added there, the text goes to stderr
+    // (it replaced the text, exit 0, probe 63); as a report it is refused
+    CHECK(run("predict '" + geometry + "' --json same.out", "same") == 0);
+    CHECK_NOTHROW(nlohmann::json::parse(test::read_file(dir / "same.out")));
+    CHECK_THAT(test::read_file(dir / "same.err"), Contains("beverloo"));
+    CHECK(run("diagnose --model oldal --data '" + data + "' --report report.out --no-plots", "report") == 2);
+    CHECK_THAT(test::read_file(dir / "report.err"), Contains("is the file standard output is redirected to"));
     // a folder's name, /dev/stdout/ too, is no output file (it was "the folder /dev/stdout does not exist")
     CHECK(run("predict '" + geometry + "' --json /dev/stdout/", "slash") == 2);
     CHECK_THAT(test::read_file(dir / "slash.err"), Contains("--json = '/dev/stdout/' ends with '/', a folder's name"));

@@ -872,8 +872,16 @@ TEST_CASE("probe 46: an option the command does not have is named, even where th
              // a long option with one dash was named '-e' (probe 62b)
              {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3", "-engine",
                "kernel"},
-              {"shear: '-engine' is not an option", "a long option takes two dashes: --engine"}}},
+              {"shear: '-engine' is not an option", "a long option takes two dashes: --engine"}},
+             // -campaign was -c ampaign: a campaign ran into ./ampaign (probe 63)
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4,2e4",
+               "--engine", "kernel", "-campaign"},
+              {"'-campaign': a long option takes two dashes: --campaign", "written apart: -c ampaign"}},
+             {{"shear", test::source_path("examples/materials/sand-tiny.json").string(), "-s", "5e3,1e4,2e4",
+               "--engine", "kernel", "-seed", "3"},
+              {"'-seed': a long option takes two dashes: --seed"}}},
             dir);
+    CHECK_FALSE(fs::exists("ampaign"));
     // negative numbers stay values, options after -- belong to the runs
     CHECK(test::run_demcal({"silo", "--theta", "30", "--vibration-start", "-1", "--check"}, root / "neg.log") == 2);
     CHECK_THAT(test::read_file(root / "neg.log"), Contains("vibration-start") && !Contains("is not an option"));
@@ -1046,7 +1054,12 @@ TEST_CASE("probe 47: a stored sensitivity study with a damaged field is refused 
                            })),
               {"parameters[0].name = \"box_height\": not a micromechanical parameter"}},
              {with(damaged("twice.json", [](nlohmann::json& j) { j["parameters"][1]["name"] = j["parameters"][0]["name"]; j["parameters"][1]["base_value"] = j["parameters"][0]["base_value"]; })),
-              {"parameters[1].name = ", "named by an earlier parameter too"}}},
+              {"parameters[1].name = ", "named by an earlier parameter too"}},
+             // read, and then the calibration said the study's ranges were too narrow (probe 63)
+             {with(damaged("huge_tau.json", [](nlohmann::json& j) { j["parameters"][0]["levels"][2]["tau_c"] = 1e50; })),
+              {"parameters[0].levels[2].tau_c = ", "must lie in [-1e12, 1e12] Pa"}},
+             {with(damaged("huge_level.json", [](nlohmann::json& j) { j["parameters"][0]["levels"][2]["value"] = 1e99; })),
+              {"parameters[0].levels[2] (base_material with ", "= 1e+99"}}},
             dir);
     fs::remove_all(root);
 }

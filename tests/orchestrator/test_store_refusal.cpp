@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include <sqlite3.h>
+#include <sys/stat.h>  // mkfifo
 
 #include <algorithm>
 #include <chrono>
@@ -118,6 +119,12 @@ TEST_CASE("status and resume refuse a newer schema, an unknown kind or an unread
         {"UPDATE campaigns SET status = 'paused'",
          "campaign 1: campaign status 'paused' is not one demcal knows (open, complete, interrupted, failed)"},
         {"UPDATE campaigns SET spec = '{not json'", "campaigns.spec is not valid JSON"},
+        // valid JSON, not a spec: the JSON library's text, exit 1, after part of the output (probe 63)
+        {"UPDATE campaigns SET spec = json_remove(spec, '$.material')", "campaign 1: the campaign's spec has no 'material'"},
+        {"UPDATE campaigns SET spec = json_set(spec, '$.replicates', 'x')",
+         "the campaign's spec field 'replicates' = \"x\" is not a whole number"},
+        {"UPDATE campaigns SET spec = '[]'", "the campaign's spec is not a JSON object"},
+        {"UPDATE campaigns SET spec = json_set(spec, '$.engine', 'warp')", "campaign 1: engine = 'warp' is not one of"},
         {"UPDATE runs SET result = '{\"peak' WHERE rowid = 1", "runs.result is not valid JSON"},
         // rows edited to send demcal's writes outside the campaign, or to make nonsense of its line (probe 44)
         {"UPDATE runs SET run_dir = '/tmp' WHERE rowid = 1", "runs.run_dir = '/tmp' is not a folder of the campaign"},
@@ -170,6 +177,11 @@ TEST_CASE("status and resume on a folder without a store refuse it as holding no
         CHECK_THAT(test::read_file(dir / "out.log"), Contains("missing' does not exist"));
         CHECK(fs::is_empty(dir / "empty"));
         CHECK_FALSE(fs::exists(dir / "missing"));
+        // a FIFO is no folder (it was told it "holds no campaign.sqlite", probe 63)
+        REQUIRE(::mkfifo((dir / "fifo").c_str(), 0600) == 0);
+        CHECK(test::run_demcal({command, (dir / "fifo").string()}, dir / "out.log") == 2);
+        CHECK_THAT(test::read_file(dir / "out.log"), Contains(command + ": DIR = '") && Contains("is not a folder"));
+        fs::remove(dir / "fifo");
         // the store file itself given for its folder: named as a file, the folder to give named
         std::ofstream(dir / "campaign.sqlite") << "";
         CHECK(test::run_demcal({command, (dir / "campaign.sqlite").string()}, dir / "out.log") == 2);
