@@ -61,7 +61,7 @@ std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<
                 ok = false;
             }
         }
-        if (!ok)  // (as typed: its blanks trimmed, " " was shown as '')
+        if (!ok)  // shown as typed (the trimmed item showed " " as '')
             throw UserError(option + " '" + analytics::shortened_text(typed) + "' is not of the form NAME=LOW:HIGH");
         const std::string name = item.substr(0, eq);
         if (!orchestrator::find_shear_param(name)) throw UserError(option + " '" + item + "': unknown parameter '" + name + "'");

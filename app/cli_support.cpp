@@ -440,7 +440,7 @@ void refuse_standard_stream_file(const std::string& path, const std::string& nam
     for (const auto& [fd, stream] : {std::pair{1, "standard output"}, std::pair{2, "standard error"}})
         if (same_file_as_descriptor(path, fd))
             throw UserError(named + " is the file " + stream + " is redirected to; give another file" +
-                            (fd == 1 ? " (or - where the option takes standard output)" : ""));
+                            (fd == 1 && named.rfind("--json", 0) == 0 ? " (or -: standard output)" : ""));
 }
 }  // namespace
 
@@ -710,9 +710,11 @@ void check_options_known(const CLI::App& app, int argc, const char* const* argv)
         std::string name(arg.substr(0, arg.find('=')));
         if (arg[1] != '-') name = std::string(arg.substr(0, 2));  // -j2: the short option -j with its value
         // "-campaign": a long option typed with one dash, read as -c with the value "ampaign" (a campaign ran into
-        // ./ampaign, probe 63); a value glued to a short option is never a long option's whole name
+        // ./ampaign, probe 63); a value glued to a short option is never a long option's whole name. (A flag takes
+        // no value: `-help` is CLI11's, as before.)
+        const CLI::Option* short_option = arg[1] != '-' && arg.size() > 2 ? option_named(name) : nullptr;
         if (const std::string long_name = "-" + std::string(arg.substr(0, arg.find('=')));
-            arg[1] != '-' && arg.size() > 2 && option_named(name) && option_named(long_name))
+            short_option && short_option->get_items_expected_min() > 0 && option_named(long_name))
             throw UserError("'" + analytics::shortened_text(arg) + "': a long option takes two dashes: " + long_name +
                             " (a value glued to " + name + " is written apart: " + name + " " +
                             analytics::shortened_text(arg.substr(2)) + ")");

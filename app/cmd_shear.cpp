@@ -210,11 +210,11 @@ std::string field_value_key(const nlohmann::json& v) {
     return v.is_number() ? analytics::number_text(v.get<double>(), 15) : v.dump();
 }
 
-// Each material field's value held by more than half of a store's shear campaigns: what a campaign's own values are
-// told against in `demcal status`, where campaign names are digests (a study's levels, a calibration's steps).
-// A field with no such value (a study of one parameter: each level once) has none: every campaign shows its own. (The
-// most common value, ties to the smallest text, read a study's lowest level as the base (probe 62); a calibration
-// added to a one-parameter study's folder broke the tie and hid a level again (probe 62b).)
+// Each material field's value held by every one of a store's shear campaigns: `demcal status` shows, for each
+// campaign, the fields in which the campaigns differ (campaign names are digests: a study's levels, a calibration's
+// steps). (The most common value, ties to the smallest text, read a study's lowest level as the base (probe 62); a
+// calibration added to a one-parameter study's folder broke the tie and hid a level again (probe 62b); a majority
+// hid the base level of a study once the base material was run beside it (review of stop 63).)
 std::map<std::string, std::string> common_material_values(const std::vector<ShearCampaignOutcome>& outs) {
     std::map<std::string, std::map<std::string, int>> counts;
     int campaigns = 0;
@@ -227,7 +227,7 @@ std::map<std::string, std::string> common_material_values(const std::vector<Shea
     std::map<std::string, std::string> common;
     for (const auto& [k, by_value] : counts)
         for (const auto& [value, n] : by_value)
-            if (2 * n > campaigns) common[k] = value;
+            if (n == campaigns) common[k] = value;
     return common;
 }
 

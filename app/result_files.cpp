@@ -1,6 +1,8 @@
 #include "app/result_files.hpp"
 
+#include "analytics/number_text.hpp"
 #include "app/cli_support.hpp"  // names_process_stream
+#include "app/commands.hpp"     // UserError
 #include "orchestrator/run_identity.hpp"  // write_text_file_atomically
 
 #include <cerrno>
@@ -67,8 +69,19 @@ bool names_standard_output(const std::string& path) {
     return !names_process_stream(absolute) && same_file_as_descriptor(path, 1);
 }
 
+bool standard_output_shares_stderr_file() {
+    struct stat out {}, err {};
+    return ::fstat(1, &out) == 0 && ::fstat(2, &err) == 0 && S_ISREG(out.st_mode) && out.st_dev == err.st_dev &&
+           out.st_ino == err.st_ino;
+}
+
 JsonOnStandardOutput::JsonOnStandardOutput(const std::string& json_path) {
     if (!names_standard_output(json_path) || json_stdout) return;
+    // (`--json out.json > out.json 2>&1` wrote the text and the JSON into one file that no longer parses)
+    if (standard_output_shares_stderr_file())
+        throw UserError("--json = '" + analytics::shortened_text(json_path, 200) +
+                        "' is standard output, and standard error is the same file here (> FILE 2>&1): the JSON "
+                        "would be mixed into the text report; send stderr elsewhere, or give --json a file of its own");
     std::cout.flush();
     saved_stdout_ = std::cout.rdbuf(std::cerr.rdbuf());
     json_stdout = saved_stdout_;

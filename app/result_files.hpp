@@ -24,6 +24,10 @@ inline constexpr const char* kStandardOutputName = "-";
 // earlier lines lost.
 bool names_standard_output(const std::string& path);
 
+// Whether standard output and standard error are the same regular file (`> log 2>&1`): a JSON result sent to
+// standard output would be mixed into the text report sent to stderr.
+bool standard_output_shares_stderr_file();
+
 // Whether `path` is the regular file open as descriptor `fd` (a redirect's file, by its name or through a link).
 bool same_file_as_descriptor(const std::string& path, int fd);
 

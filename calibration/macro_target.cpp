@@ -135,12 +135,11 @@ std::vector<MacroTarget> targets_from_measured_line(std::span<const double> sigm
     // was told its stresses were not 20 % apart, probe 63)
     if (sigma.size() < 3)
         throw std::invalid_argument("the measured failure line has " + std::to_string(sigma.size()) +
-                                    " point(s): a line and its 95 % interval need at least 3, at 2 or more normal "
-                                    "stresses");
-    if (!sigma.empty())
-        analytics::check_normal_stress_spread(*std::min_element(sigma.begin(), sigma.end()),
-                                              *std::max_element(sigma.begin(), sigma.end()),
-                                              "the measured failure line's normal stresses");
+                                    " point(s): a line and its " + analytics::number_text(100 * confidence) +
+                                    " % interval need at least 3, at 2 or more normal stresses");
+    analytics::check_normal_stress_spread(*std::min_element(sigma.begin(), sigma.end()),
+                                          *std::max_element(sigma.begin(), sigma.end()),
+                                          "the measured failure line's normal stresses");
     const auto line = analytics::fit_failure_line(sigma, tau, confidence);
     // a line may cross 0 a little below (tau_c < 0 within its interval is noise); wholly below 0 it is not a bulk
     // solid's (tau_c = -37 kPa from points whose shear stress rose faster than any friction explains)

@@ -435,6 +435,12 @@ TEST_CASE("a JSON result to standard output (--json -) comes alone there, the te
     CHECK(run("predict '" + geometry + "' --json same.out", "same") == 0);
     CHECK_NOTHROW(nlohmann::json::parse(test::read_file(dir / "same.out")));
     CHECK_THAT(test::read_file(dir / "same.err"), Contains("beverloo"));
+    // ... unless stderr is that file too: the JSON would be mixed into the text (review of stop 63)
+    const std::string mixed = "cd '" + dir.string() + "' && '" + DEMCAL_BINARY + "' predict '" + geometry +
+                              "' --json mixed.out > mixed.out 2>&1";
+    const int mixed_status = std::system(mixed.c_str());
+    CHECK((WIFEXITED(mixed_status) && WEXITSTATUS(mixed_status) == 2));
+    CHECK_THAT(test::read_file(dir / "mixed.out"), Contains("standard error is the same file here"));
     CHECK(run("diagnose --model oldal --data '" + data + "' --report report.out --no-plots", "report") == 2);
     CHECK_THAT(test::read_file(dir / "report.err"), Contains("is the file standard output is redirected to"));
     // a folder's name, /dev/stdout/ too, is no output file (it was "the folder /dev/stdout does not exist")

@@ -882,6 +882,9 @@ TEST_CASE("probe 46: an option the command does not have is named, even where th
               {"'-seed': a long option takes two dashes: --seed"}}},
             dir);
     CHECK_FALSE(fs::exists("ampaign"));
+    // a flag glued to letters is CLI11's to read: -help shows the help, as before (review of stop 63)
+    CHECK(test::run_demcal({"shear", "-help"}, root / "help.log") == 0);
+    CHECK_THAT(test::read_file(root / "help.log"), Contains("--normal-stress"));
     // negative numbers stay values, options after -- belong to the runs
     CHECK(test::run_demcal({"silo", "--theta", "30", "--vibration-start", "-1", "--check"}, root / "neg.log") == 2);
     CHECK_THAT(test::read_file(root / "neg.log"), Contains("vibration-start") && !Contains("is not an option"));
