@@ -780,10 +780,9 @@ std::vector<ShearCampaignOutcome> ShearCampaignRunner::resume(const ProgressCall
     return outs;
 }
 
-void check_stored_shear_specs(const fs::path& dir) {
-    const fs::path file = dir / "campaign.sqlite";
-    CampaignStore store(file, StoreAccess::read_only);
-    for (const auto& c : store.campaigns()) {
+namespace {
+void check_shear_specs_of(const std::vector<CampaignRecord>& campaigns, const fs::path& file) {
+    for (const auto& c : campaigns) {
         if (c.kind != CampaignKind::shear) continue;
         try {
             ShearCampaignSpec::from_json(c.spec);
@@ -793,14 +792,22 @@ void check_stored_shear_specs(const fs::path& dir) {
         }
     }
 }
+}  // namespace
+
+void check_stored_shear_specs(const fs::path& dir) {
+    const fs::path file = dir / "campaign.sqlite";
+    CampaignStore store(file, StoreAccess::read_only);
+    check_shear_specs_of(store.campaigns(), file);
+}
 
 std::vector<ShearCampaignOutcome> inspect_campaigns(const fs::path& dir) {
     if (!fs::exists(dir / "campaign.sqlite"))
         throw std::invalid_argument("campaign = '" + dir.string() + "' holds no campaign.sqlite");
-    check_stored_shear_specs(dir);  // before anything of them is printed
     CampaignStore store(dir / "campaign.sqlite", StoreAccess::read_only);
+    const std::vector<CampaignRecord> campaigns = store.campaigns();
+    check_shear_specs_of(campaigns, dir / "campaign.sqlite");  // before anything of them is printed
     std::vector<ShearCampaignOutcome> outs;
-    for (const auto& c : store.campaigns()) {
+    for (const auto& c : campaigns) {
         ShearCampaignOutcome o;
         o.campaign = c;
         o.runs = store.campaign_runs(c.id);

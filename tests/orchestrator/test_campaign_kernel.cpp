@@ -14,6 +14,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <set>
+#include <string>
+#include <tuple>
+#include <utility>
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -239,15 +242,20 @@ TEST_CASE("status names every level of a one-parameter study, the base's too", "
                               "3e3,5e3,7e3", "--engine", "kernel", "-c", dir.string()},
                              dir / "study.log") == 0);
     REQUIRE(test::run_demcal({"status", dir.string()}, dir / "status.log") == 0);
+    // (campaigns listed, campaigns whose line names the friction) in a status output
+    const auto count_labelled = [](const std::string& status) {
+        std::size_t labelled = 0, campaigns = 0;
+        for (std::size_t at = status.find("  kernel engine"); at != std::string::npos;
+             at = status.find("  kernel engine", at + 1)) {
+            ++campaigns;
+            const std::string line = status.substr(at, status.find('\n', at) - at);
+            if (line.find(", friction_coefficient ") != std::string::npos) ++labelled;
+        }
+        return std::pair{campaigns, labelled};
+    };
     const std::string status = test::read_file(dir / "status.log");
     INFO(status);
-    std::size_t labelled = 0, campaigns = 0;
-    for (std::size_t at = status.find("  kernel engine"); at != std::string::npos;
-         at = status.find("  kernel engine", at + 1)) {
-        ++campaigns;
-        const std::string line = status.substr(at, status.find('\n', at) - at);
-        if (line.find(", friction_coefficient ") != std::string::npos) ++labelled;
-    }
+    auto [campaigns, labelled] = count_labelled(status);
     CHECK(campaigns == 3);
     CHECK(labelled == campaigns);
     // a campaign of the base material added to the folder (probe 62b: a calibration's) made the base's friction the
@@ -261,13 +269,7 @@ TEST_CASE("status names every level of a one-parameter study, the base's too", "
     REQUIRE(test::run_demcal({"status", dir.string()}, dir / "status2.log") == 0);
     const std::string status2 = test::read_file(dir / "status2.log");
     INFO(status2);
-    campaigns = labelled = 0;
-    for (std::size_t at = status2.find("  kernel engine"); at != std::string::npos;
-         at = status2.find("  kernel engine", at + 1)) {
-        ++campaigns;
-        const std::string line = status2.substr(at, status2.find('\n', at) - at);
-        if (line.find(", friction_coefficient ") != std::string::npos) ++labelled;
-    }
+    std::tie(campaigns, labelled) = count_labelled(status2);
     CHECK(campaigns == 5);
     CHECK(labelled == campaigns);
     fs::remove_all(dir);
