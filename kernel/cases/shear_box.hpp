@@ -51,6 +51,9 @@ struct ShearBoxProcedure {
   static constexpr double integral_leak = 0.1;
   static constexpr double integral_band = 0.25;
   static constexpr double approach_below = 0.10;
+  static constexpr double approach_rearm_below = 0.50;
+  static constexpr double growth_pause_above = 1.0;
+  static constexpr double growth_step_limit = 20.0;
   static constexpr int consolidation_chunk = 200;
   static constexpr double consolidation_unbalanced = 0.02;
   static constexpr double consolidation_stress_tol = 0.02;
@@ -62,7 +65,7 @@ struct ShearBoxProcedure {
 
 /// Names this engine and the version of its procedure: part of a run's identity (a change of the physics or the
 /// procedure bumps it, so that no cached result of the old one is reused).
-inline constexpr const char* kShearBoxEngine = "demcal-kernel-shear-box/2";
+inline constexpr const char* kShearBoxEngine = "demcal-kernel-shear-box/3";
 
 /// A run that could not finish: `cause` is one of the script's (params, nan, kinetic_energy, escaped,
 /// normal_stress), what() the evidence.
