@@ -201,14 +201,17 @@ Model failure_line_model(const MeasuredData& d, Setting& s) {
     Model m;
     const auto& sigma = d.at("sigma_Pa").values;
     const auto& tau = d.at("tau_Pa").values;
+    if (sigma.size() < 3)
+        throw std::invalid_argument(d.source + ": " + std::to_string(sigma.size()) + " rows: a failure line needs at "
+                                    "least 3 points on at least 2 normal stresses");
     if (is_constant(d.at("sigma_Pa")))
-        throw std::invalid_argument("sigma_Pa: every row has the normal stress " + short_number(sigma.front()) +
+        throw std::invalid_argument(d.source + ": sigma_Pa: every row has the normal stress " + short_number(sigma.front()) +
                                     " Pa: a failure line needs at least two different normal stresses");
     const auto [lowest, highest] = std::minmax_element(sigma.begin(), sigma.end());
-    check_normal_stress_spread(*lowest, *highest, "sigma_Pa");  // 5000, 5000.0000001, ... gave mu_b = 3.7e8
+    check_normal_stress_spread(*lowest, *highest, d.source + ": sigma_Pa");  // 5000, 5000.0000001, ... gave mu_b = 3.7e8
     // a shear strength that falls with the normal stress is no bulk solid's: mu_b = -0.98 was reported as determined
     if (const FailureLine line = fit_failure_line(sigma, tau); line.mu_b_high < 0)
-        throw std::invalid_argument("sigma_Pa, tau_Pa: the failure line's slope mu_b = " + short_number(line.mu_b) +
+        throw std::invalid_argument(d.source + ": sigma_Pa, tau_Pa: the failure line's slope mu_b = " + short_number(line.mu_b) +
                                     " (95 % interval up to " + short_number(line.mu_b_high) +
                                     ") is negative: the shear strength falls as the normal stress rises, which no bulk "
                                     "solid's does (columns swapped, or a sign lost?)");

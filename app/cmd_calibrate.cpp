@@ -37,6 +37,7 @@ namespace {
 // it did not vary (box, density, radius, a parameter left out) must equal the start's. Throws UserError naming it.
 void check_study_matches_start(const SensitivityStudy& study, const nlohmann::json& start, const std::string& file) {
     nlohmann::json base = study.base_material, here = start;
+    std::vector<std::string> warnings;  // said once every check passed: a refusal is one line
     for (const auto& p : study.parameters) {
         // a studied parameter may start elsewhere in its studied range (the search moves it there anyway), not
         // outside it, where the study measured nothing (held-back suite: friction 0.3 against a study of 0.5)
@@ -49,9 +50,9 @@ void check_study_matches_start(const SensitivityStudy& study, const nlohmann::js
                                 " around " + analytics::number_text(p.base_value) + "): run the study around this " +
                                 "start, or start inside that range");
             if (v != p.base_value)
-                std::cerr << "demcal: warning: --start's " << p.name << " = " << analytics::number_text(v)
-                          << " is not the study's base (" << analytics::number_text(p.base_value)
-                          << "): its responses, measured around the base, steer the search from there" << std::endl;
+                warnings.push_back("--start's " + p.name + " = " + analytics::number_text(v) + " is not the study's " +
+                                   "base (" + analytics::number_text(p.base_value) + "): its responses, measured " +
+                                   "around the base, steer the search from there");
         }
         base.erase(p.name);
         here.erase(p.name);
@@ -71,6 +72,7 @@ void check_study_matches_start(const SensitivityStudy& study, const nlohmann::js
         if (!here.contains(key))
             throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
                             key + ", the start material has not");
+    for (const auto& w : warnings) std::cerr << "demcal: warning: " << w << std::endl;
 }
 
 // ---- sensitivity ----

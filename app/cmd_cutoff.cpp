@@ -220,6 +220,7 @@ int conclude(const kc::CutoffResult& res, nlohmann::json out, const std::string&
         out["cutoff_hz"] = nullptr;
         out["reason"] = res.reason;
         std::printf("no cut-off found: %s\n", res.reason);
+        std::fprintf(stderr, "demcal: no cut-off found: %s (exit 1; the runs are kept)\n", res.reason);
     }
     if (res.runs.size() > 0) report_seed_brackets(res, out);
     if (!json_file.empty()) write_result_file(json_file, out.dump(1) + "\n");

@@ -600,6 +600,11 @@ void check_out_folder_free(const fs::path& dir) {
         throw UserError("--out = '" + dir.string() + "' holds the checkpoint of an unfinished run: continue it with "
                         "`demcal silo --resume " + shell_word(dir.string()) + "`, or remove " + (dir / kCheckpointName).string() +
                         " to start over");
+    // a campaign's own folder (a shear store, a silo sweep's campaign.json): the run's files would mix with its runs
+    for (const char* marker : {"campaign.sqlite", "campaign.json"})
+        if (fs::exists(fs::symlink_status(dir / marker)))
+            throw UserError("--out = '" + dir.string() + "' holds a campaign (" + marker + "): a silo run's files "
+                            "would mix with it; give another --out (a new or empty folder)");
     if (fs::is_regular_file(dir / "summary.json"))  // a new run would leave the old results beside its own until its end
         throw UserError("--out = '" + dir.string() + "' holds the results of a finished run (summary.json): give "
                         "another --out, or remove them to run again there");
@@ -859,6 +864,7 @@ void resume_silo(const SiloCli& given, CLI::App& sub) {
     // the results, the next checkpoints and the snapshots go where the run wrote before: still writable?
     check_output_folder(dir.string(), "--resume");
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk (the run's snapshot folder, in its checkpoint)");
+    const bool folder_had_lock = fs::exists(fs::symlink_status(dir / ".lock"));
     const auto lock = lock_output_folder(dir);  // two resumes of one run read and wrote one checkpoint at once
     const auto vtk_lock = lock_vtk_folder(s.vtk_dir, dir);
     if (!o.no_plots) require_gnuplot("--no-plots");
@@ -871,10 +877,17 @@ void resume_silo(const SiloCli& given, CLI::App& sub) {
     if (s.vibration.vibrates()) std::cout << "\n  vibration: " << vibration_text(s);
     std::cout << std::endl;
     const StopOnSignal stop_on_signal;
-    write_outputs(dir, s,
-                  ks::resume_silo_case(file.string(), {threads, o.checkpoint_every, o.wall_limit, StopOnSignal::reason},
-                                       print_progress),
-                  o.no_plots);
+    ks::SiloCaseResult result;
+    try {
+        result = ks::resume_silo_case(file.string(), {threads, o.checkpoint_every, o.wall_limit, StopOnSignal::reason},
+                                      print_progress);
+    } catch (const std::invalid_argument&) {
+        // a damaged checkpoint is found while it loads, before anything runs: the folder is left as it was
+        std::error_code ec;
+        if (!folder_had_lock) fs::remove(dir / ".lock", ec);
+        throw;
+    }
+    write_outputs(dir, s, result, o.no_plots);
 }
 
 // CPU time with the sessions it covers, e.g. "21.3 h CPU" or "12.0 h CPU (the last 3 of 5 sessions)".

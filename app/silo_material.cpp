@@ -22,7 +22,7 @@ using json = nlohmann::json;
 // Refuses keys other than `known` (keys starting with '_' are comments) and returns the object at `where`.
 const json& object_with(const json& j, const std::string& file, const std::string& where,
                         const std::set<std::string>& known) {
-    if (!j.is_object()) throw UserError(file + ": " + where + " must be a JSON object");
+    if (!j.is_object()) throw UserError(file + ": " + (where.empty() ? "the top level" : where) + " must be a JSON object");
     for (const auto& [key, value] : j.items()) {
         if (key.rfind("_", 0) == 0 || known.count(key)) continue;
         std::string list;
@@ -84,8 +84,9 @@ ks::PairCoefficients pair(const json& root, const std::string& file, const std::
 
 }  // namespace
 
-ks::WheatMaterials read_silo_material(const std::string& file, const std::string& what) {
-    const json root = read_json_file(file, what);
+ks::WheatMaterials read_silo_material(const std::string& path, const std::string& what) {
+    const json root = read_json_file(path, what);
+    const std::string file = "--" + what + " = '" + analytics::shortened_text(path, 200) + "'";  // for the messages
     if (root.is_object() && !root.contains("grain") && (root.contains("young_modulus") || root.contains("density")))
         throw UserError(file + ": a shear box's material (density, young_modulus, ...: demcal shear, sensitivity, "
                         "calibrate), not a silo material (grain, wall, grain_grain, grain_wall)");

@@ -64,7 +64,7 @@ class CampaignStore {
 public:
     // Opens the store, creating it when the file does not exist (read_write). An existing file must be an intact
     // demcal store this demcal can read (application_id, or the tables of a store written before it was set; PRAGMA
-    // quick_check; a schema_version not newer than its own; every campaign and run row readable, its kind known):
+    // integrity_check; a schema_version not newer than its own; every campaign and run row readable, its kind known):
     // anything else is refused with std::invalid_argument naming the file, before anything is written to it.
     explicit CampaignStore(const std::filesystem::path& db_path, StoreAccess access = StoreAccess::read_write);
     ~CampaignStore();

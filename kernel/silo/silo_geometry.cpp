@@ -122,11 +122,15 @@ void validate(const SiloGeometry& g, double particle_size, double min_outlet_par
                 setting_text(min_outlet_particles * particle_size) + " m for d_p = " + setting_text(particle_size) +
                 " m), or the grains arch over it");
     if (g.shape == SiloShape::conical) {
-        if (!(g.diameter > g.outlet) || !std::isfinite(g.diameter))
+        if (!(g.diameter > 0) || !std::isfinite(g.diameter))
             reject_setting("diameter", g.diameter, "the silo diameter D must be larger than the outlet (" + setting_text(g.outlet) + " m)");
+        if (!(g.diameter > g.outlet))  // a rule on both: the outlet may be the one given wrong
+            throw SettingRejected("diameter", g.diameter, outlet_name, g.outlet, "the silo diameter D must be larger than the outlet");
     } else {
-        if (!(g.width > g.outlet) || !std::isfinite(g.width))
+        if (!(g.width > 0) || !std::isfinite(g.width))
             reject_setting("c (width)", g.width, "the silo width c must be larger than the outlet width a (" + setting_text(g.outlet) + " m)");
+        if (!(g.width > g.outlet))
+            throw SettingRejected("c (width)", g.width, outlet_name, g.outlet, "the silo width c must be larger than the outlet width a");
         if (!(g.depth > 0) || !std::isfinite(g.depth)) reject_setting("b (depth)", g.depth, "must be positive");
         if (g.depth < min_outlet_particles * particle_size)
             reject_setting("b (depth)", g.depth,

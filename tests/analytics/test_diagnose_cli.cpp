@@ -11,6 +11,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -93,5 +94,26 @@ TEST_CASE("diagnose CLI: the flow-mode effect and the outlier are named in conso
     CHECK(o.at("dropped") == true);
     CHECK(o.at("without_outliers").at("rmse").get<double>() < o.at("with_outliers").at("rmse").get<double>());
     CHECK(read_file(dir / "o.md").find("| 19 |") != std::string::npos);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("diagnose CLI: a void --no-plots and a two-row failure line are refused, naming the option and the file",
+          "[diagnose]") {
+    // held-back probe of stop 64: --no-plots without --report did nothing and exited 0; two rows of a failure line
+    // were refused as "failure line: needs at least 3 points" without the file that held them
+    const fs::path dir = fs::temp_directory_path() / ("demcal_test_diagnose_cli_void_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const auto no_report = run_diagnose("--model oldal --no-plots --data '" + example("oldal_clean.csv") + "'", dir);
+    INFO("stderr: " << no_report.err);
+    CHECK(no_report.rc == 2);
+    CHECK(no_report.err.find("--no-plots") != std::string::npos);
+    CHECK(no_report.err.find("--report") != std::string::npos);
+    const fs::path two_rows = dir / "two_rows.csv";
+    std::ofstream(two_rows) << "sigma_Pa,tau_Pa\n4000,3000\n8000,5000\n";
+    const auto short_line = run_diagnose("--model failure-line --data '" + two_rows.string() + "'", dir);
+    INFO("stderr: " << short_line.err);
+    CHECK(short_line.rc == 2);
+    CHECK(short_line.err.find(two_rows.string()) != std::string::npos);
+    CHECK(short_line.err.find("2 rows") != std::string::npos);
     fs::remove_all(dir);
 }

@@ -80,7 +80,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
     for (const Case& c : {Case{"--theta 95", "theta = 95"}, Case{"--theta 0", "theta = 0"},
                           Case{"--theta 30 --outlet 0.01", "outlet = 0.01"},
                           Case{"--theta 30 --diameter 0.02", "diameter = 0.02"},
-                          Case{"--theta 30 --rect --c 0.02", "--c = 0.02: the silo width c"},
+                          Case{"--theta 30 --rect --c 0.02", "--c = 0.02 with a (outlet width) = 0.03: the silo width c"},
                           Case{"--theta 30 --rect --b 0.01", "--b = 0.01: the slot spans the depth b"},
                           Case{"--theta 30 --particles 0", "particles = 0"},
                           Case{"--theta 30 --stiffness-scale -1", "--stiffness-scale = -1"},
@@ -162,7 +162,7 @@ TEST_CASE("demcal silo: bad input exits 2 naming the field and the value", "[sil
                        "--rect: the --geometry file gives the diameter of a conical silo"},
           GeometryCase{R"({"shape": "conical", "theta_deg": 30})", "--rect", "--rect: the --geometry file is a conical"},
           // a file of neither shape's own keys takes --rect, and the rest of the rules stand
-          GeometryCase{R"({"theta_deg": 30})", "--rect --c 0.02", "--c = 0.02: the silo width c"}}) {
+          GeometryCase{R"({"theta_deg": 30})", "--rect --c 0.02", "--c = 0.02 with a (outlet width) = 0.03: the silo width c"}}) {
         INFO(c.json + " " + c.options);
         std::ofstream(dir / "g.json") << c.json;
         const Run r = run_silo("--geometry '" + (dir / "g.json").string() + "' " + c.options + " --out '" +
@@ -380,6 +380,7 @@ TEST_CASE("demcal silo: a run killed with -9 or stopped by SIGTERM or SIGHUP res
     CHECK(damaged.rc == 2);
     CHECK_THAT(damaged.err, Catch::Matchers::Contains("checkpoint"));
     CHECK(read_file(dir / "cut" / "checkpoint.bin") == bytes.substr(0, bytes.size() / 2));
+    CHECK(std::distance(fs::directory_iterator(dir / "cut"), fs::directory_iterator()) == 1);  // nor a .lock added
     // a resumed run keeps its stored settings
     const Run mixed = run_silo("--resume '" + out.string() + "' --theta 30", dir);
     CHECK(mixed.rc == 2);

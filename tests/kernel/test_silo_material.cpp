@@ -120,7 +120,7 @@ TEST_CASE("demcal silo --material: bad files name the file, the field and the va
        "grain.aspect_ratio = 0.5"},
       {file(R"({"aspect_ratio": "long", "shear_modulus_Pa": 3.58e8, "poisson": 0.4, "density_kg_m3": 1430})",
             good_pair), "grain.aspect_ratio = \"long\": must be a number"},
-      {"[1, 2]", "must be a JSON object"}};
+      {"[1, 2]", "': the top level must be a JSON object"}};
   int k = 0;
   for (const auto& [text, expect] : cases) {
     INFO(text);
@@ -129,7 +129,7 @@ TEST_CASE("demcal silo --material: bad files name the file, the field and the va
     const fs::path out = dir / "never";
     CHECK(run_silo(kTiny + " --material '" + f.string() + "' --out '" + out.string() + "'", dir / "log") == 2);
     const std::string log = demcal::test::read_file(dir / "log");
-    CHECK_THAT(log, Catch::Matchers::Contains(expect));
+    CHECK_THAT(log, Catch::Matchers::Contains(expect) && Catch::Matchers::Contains("--material = '" + f.string()));
     CHECK_FALSE(fs::exists(out));
   }
   CHECK(run_silo(kTiny + " --material '" + dir.string() + "' --out '" + (dir / "never").string() + "'", dir / "log") == 2);

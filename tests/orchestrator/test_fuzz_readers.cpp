@@ -68,7 +68,7 @@ TEST_CASE("fuzz: a damaged campaign store is refused or read, never crashes", "[
         try {
             orchestrator::CampaignStore store(file);
             ++opened;
-            try {  // a page that quick_check passes may still hold values demcal refuses
+            try {  // a page that integrity_check passes may still hold values demcal refuses
                 for (const auto& c : store.campaigns()) store.campaign_runs(c.id);
             } catch (const std::invalid_argument&) {
                 ++read_errors;

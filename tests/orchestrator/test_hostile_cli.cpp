@@ -746,9 +746,13 @@ TEST_CASE("probe 44: outputs beside an output never replace a user's files, and 
     fs::create_directories(dir / "data");
     std::ofstream(dir / "data" / "discharge.csv") << "t,mass\n0,1\n";  // a user's measurement, not a run's output
     std::ofstream(dir / "laws.png") << "my photo";
+    fs::create_directories(dir / "camp");
+    std::ofstream(dir / "camp" / "campaign.sqlite") << "a shear campaign's store";  // (stop 64: the run wrote beside it)
     // enlarge's materials: any three radii of one material (refused before they are read further)
     refused({{{"silo", "--theta", "30", "--particles", "200", "--out", (dir / "data").string()},
               {"out = ", "already holds discharge.csv", "a file a silo run writes"}},
+             {{"silo", "--theta", "30", "--particles", "200", "--out", (dir / "camp").string()},
+              {"out = ", "holds a campaign (campaign.sqlite)"}},
              {{"enlarge", "-o", (dir / "laws.json").string(), test::source_path("examples/materials/sand-tiny.json").string(),
                test::source_path("examples/materials/sand.json").string(),
                test::source_path("examples/materials/sand-bonded.json").string()},
@@ -1116,6 +1120,9 @@ TEST_CASE("probe 49: a silo geometry refusal names the quantity as it was given,
              {{"silo", "--geometry", geometry("slot.json", {{"shape", "rectangular"}, {"theta_deg", 30}, {"a_m", 0}}),
                "--check"},
               {"slot.json: a_m = 0: must be positive"}},
+             // a rule on two settings names the one typed (stop 64: only the default width c was named)
+             {{"silo", "--theta", "30", "--rect", "--a", "0.5", "--check"},
+              {"c (width) = 0.1 with --a = 0.5: the silo width c must be larger than the outlet width a"}},
              {{"silo", "--theta", "0.5", "--check"}, {"--theta = 0.5: the hopper would be"}},
              {{"silo", "--theta", "30", "--diameter", "20", "--check"},
               {"--diameter = 20: more than 1000 particle sizes across"}}},
