@@ -413,9 +413,21 @@ void run_resume(const ShearCliOptions& opt) {
                         "campaign recorded in it (the command that made it stopped first): run that command again");
     find_yade(opt.exec.yade);  // before the store is opened: a bad --yade costs nothing
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
-    const auto outs = runner.resume(print_progress);
-    if (outs.empty()) std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete\n";
+    auto outs = runner.resume(print_progress);
     const auto stored = inspect_campaigns(opt.campaign_dir);
+    if (outs.empty()) {
+        // A campaign counts as complete once its last run is stored, before its report is written: a stop in
+        // between (kill -9, a full disk) left the report cut short or missing, and every resume said only "nothing
+        // to resume" (probe 64). The report is written again from the store: a fit and two plots, no simulation.
+        std::cout << "nothing to resume: every campaign in " << runner.dir().string()
+                  << " is complete; their reports are written again from the store\n";
+        for (auto o : stored)
+            if (o.campaign.kind == CampaignKind::shear) {
+                o.reused = int(std::count_if(o.runs.begin(), o.runs.end(),
+                                             [](const RunRecord& r) { return r.state == RunState::done; }));
+                outs.push_back(std::move(o));
+            }
+    }
     int code = 0;
     for (const auto& o : outs) {
         // a study's line whose failed runs fresh packings replaced was fitted over both campaigns: reported as a

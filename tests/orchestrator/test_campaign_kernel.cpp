@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sys/wait.h>
@@ -58,6 +59,27 @@ TEST_CASE("a kernel-engine campaign fits a failure line, stores its runs beside 
     // the second time everything is reused
     REQUIRE(test::run_demcal(args, dir / "second.log") == 0);
     CHECK(test::read_file(dir / "second.log").find("0 computed now, 3 reused") != std::string::npos);
+    CHECK(test::stored_runs(dir).size() == 3);
+    // a stop between the last run and the report (probe 64: kill -9 left 0-byte or cut plots, a missing JSON) is
+    // mended by resume, which writes a complete campaign's report again from the store
+    std::vector<fs::path> reports;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().rfind("failure_line_", 0) == 0) reports.push_back(e.path());
+    REQUIRE_FALSE(reports.empty());
+    for (const auto& f : reports) std::ofstream(f, std::ios::trunc).close();  // cut to nothing
+    const auto json_it = std::find_if(reports.begin(), reports.end(), [](const fs::path& f) {
+        return f.extension() == ".json";
+    });
+    REQUIRE(json_it != reports.end());
+    const fs::path json = *json_it;
+    fs::remove(json);
+    REQUIRE(test::run_demcal({"resume", dir.string()}, dir / "resume.log") == 0);
+    const std::string resumed = test::read_file(dir / "resume.log");
+    INFO(resumed);
+    CHECK(resumed.find("their reports are written again") != std::string::npos);
+    CHECK(resumed.find("0 computed now, 3 reused") != std::string::npos);
+    for (const auto& f : reports) CHECK(fs::file_size(f) > 0);
+    CHECK(nlohmann::json::parse(test::read_file(json)).at("peak_failure_line").at("mu_b").get<double>() > 0);
     CHECK(test::stored_runs(dir).size() == 3);
 }
 
