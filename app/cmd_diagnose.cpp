@@ -438,9 +438,6 @@ void run_diagnose_command(const DiagnoseArgs& args, const CLI::App& diagnose) {
         throw UserError("--model = '" + analytics::shortened_text(args.model, 60) + "' is unknown; expected one of " +
                         known + "silo-dem");
     }
-    if (args.no_plots && args.report_out.empty())
-        throw UserError("--no-plots leaves out the report's plots: it applies with --report FILE only (no report is "
-                        "asked for); leave it out or give --report");
     if (args.model == "silo-dem") {
         for (const char* option : kAnalyticalOnlyOptions)
             if (diagnose.count(option))

@@ -255,7 +255,7 @@ TEST_CASE("crosscheck silo: repeated angles, too many angles and settings the ke
               {"theta = 30: the kernel run refuses its settings", "--max-time 1e+99 s", "the run would not end"}},
              // a shear material given as the silo's
              {{"crosscheck", "silo", "--theta", "30", "--material", shear_material, "--campaign", camp},
-              {"sand-tiny.json: a shear box's material", "not a silo material"}}},
+              {"sand-tiny.json': a shear box's material", "not a silo material"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);
@@ -984,7 +984,7 @@ TEST_CASE("probe 47: a silo geometry or material names the file and its field, a
     refused({{{"silo", "--geometry", geometry_file.string(), "--check"},
               {"long_shape.json: shape = \"xxxx", "(100002 characters)"}},
              {{"silo", "--theta", "30", "--material", material_file.string(), "--check"},
-              {"light_grain.json: grain.density_kg_m3 = 3", "must lie in [10, 1e5]"}}},
+              {"light_grain.json': grain.density_kg_m3 = 3", "must lie in [10, 1e5]"}}},
             dir);
     fs::remove_all(root);
 }
@@ -1270,7 +1270,7 @@ TEST_CASE("probe 50: a material of the other kind, or a JSON file given as a tab
     refused({{{"shear", wheat, "-s", "5e3,8e3,11e3", "--engine", "kernel", "-c", (dir / "c").string()},
               {"silo_wheat_table21.json: a silo material", "not a shear box's"}},
              {{"silo", "--material", tiny, "--theta", "30", "--particles", "100", "--out", (dir / "o").string()},
-              {"sand-tiny.json: a shear box's material", "not a silo material"}},
+              {"sand-tiny.json': a shear box's material", "not a silo material"}},
              {{"diagnose", "--model", "beverloo", "--data", tiny}, {"starts with '{': a JSON file, not a table"}}},
             dir);
     fs::remove_all(root);
