@@ -35,9 +35,9 @@ namespace {
 
 // A study read with --sensitivity must be of the --start material: its responses hold around its base, so any field
 // it did not vary (box, density, radius, a parameter left out) must equal the start's. Throws UserError naming it.
-void check_study_matches_start(const SensitivityStudy& study, const nlohmann::json& start, const std::string& file) {
+void check_study_matches_start(const SensitivityStudy& study, const nlohmann::json& start, const std::string& file,
+                               std::vector<std::string>& warnings) {
     nlohmann::json base = study.base_material, here = start;
-    std::vector<std::string> warnings;  // said once every check passed: a refusal is one line
     for (const auto& p : study.parameters) {
         // a studied parameter may start elsewhere in its studied range (the search moves it there anyway), not
         // outside it, where the study measured nothing (held-back suite: friction 0.3 against a study of 0.5)
@@ -72,7 +72,6 @@ void check_study_matches_start(const SensitivityStudy& study, const nlohmann::js
         if (!here.contains(key))
             throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': its base material has " +
                             key + ", the start material has not");
-    for (const auto& w : warnings) std::cerr << "demcal: warning: " << w << std::endl;
 }
 
 // ---- sensitivity ----
@@ -406,15 +405,16 @@ std::vector<ControlParameter> pick_controls(const CalibrateCli& o, const Sensiti
     return picked;
 }
 
+// Its warnings go to `warnings`, said by the caller once every check has passed: a refusal is one line.
 SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json& start, LineKind line,
-                                   const CampaignCli& campaign) {
+                                   const CampaignCli& campaign, std::vector<std::string>& warnings) {
     SensitivityStudy study;
     try {
         study = SensitivityStudy::from_json(read_json_file(file, "sensitivity"));
     } catch (const std::invalid_argument& e) {  // a field missing, of the wrong type or out of range
         throw UserError("--sensitivity = '" + file + "': " + e.what());
     }
-    check_study_matches_start(study, start, file);
+    check_study_matches_start(study, start, file, warnings);
     // its responses are of the line it studied: a study of the peak line steered a calibration of the residual one
     if (study.options.line != line)
         throw UserError("--sensitivity = '" + analytics::shortened_text(file, 200) + "': a study of the " +
@@ -422,9 +422,9 @@ SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json
                         ": its responses are of the other line (run the study with --line " + to_string(line) +
                         ", or calibrate the " + to_string(study.options.line) + " line)");
     if (!study.campaign) {
-        std::cerr << "demcal: warning: --sensitivity = '" << analytics::shortened_text(file, 200)
-                  << "' does not record the engine, normal stresses and YADE script its lines ran on (written "
-                     "before demcal recorded them): not checked against this calibration's\n";
+        warnings.push_back("--sensitivity = '" + analytics::shortened_text(file, 200) +
+                           "' does not record the engine, normal stresses and YADE script its lines ran on (written "
+                           "before demcal recorded them): not checked against this calibration's");
         return study;
     }
     StudyCampaign here;
@@ -529,12 +529,14 @@ void run_calibrate(CalibrateCli& o) {
     check_calibrate_options(o, start, targets, bounds, options);
     SensitivityStudy study;
     std::vector<ControlParameter> controls;
+    std::vector<std::string> warnings;
     if (!o.sensitivity_file.empty()) {
         study = read_stored_study(o.sensitivity_file, start, line_kind_from_string(o.study.campaign.line),
-                                  o.study.campaign);
+                                  o.study.campaign, warnings);
         controls = pick_controls(o, study, targets, bounds);  // a study that cannot serve: refused before the campaign
     }
     CampaignSession session(camp, "calibrate");
+    for (const auto& w : warnings) std::cerr << "demcal: warning: " << w << std::endl;
     const fs::path dir = camp.campaign_dir;
     if (o.sensitivity_file.empty()) {
         study = run_study(start, o.study, session.evaluate);

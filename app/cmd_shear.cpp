@@ -372,6 +372,26 @@ const ShearCampaignOutcome* replacing_campaign(const ShearCampaignOutcome& o,
     return nullptr;
 }
 
+// A campaign counts as complete once its last run is stored, before its report is written: a stop in between (kill
+// -9, a full disk) left the report cut short or missing, and resume said only "nothing to resume" (probe 64). So
+// resume writes again, from the store (a fit and two plots, no simulation), the report of a complete campaign it did
+// not just run that `demcal shear` made (no label: studies and crosschecks write reports of their own) or whose
+// report was begun (a file of it in the folder).
+bool report_written_again(const fs::path& dir, const ShearCampaignOutcome& o,
+                          const std::vector<ShearCampaignOutcome>& resumed) {
+    if (o.campaign.kind != CampaignKind::shear || o.campaign.status != CampaignStatus::complete) return false;
+    for (const auto& r : resumed)
+        if (r.campaign.name == o.campaign.name) return false;
+    if (ShearCampaignSpec::from_json(o.campaign.spec).label.empty()) return true;
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        for (const std::string& stem : {"failure_line_" + o.campaign.name, "shear_curves_" + o.campaign.name})
+            if (name.rfind(stem, 0) == 0) return true;
+    }
+    return false;
+}
+
 void run_resume(const ShearCliOptions& opt) {
     check_campaign_folder_argument(opt.campaign_dir, "resume");
     if (!fs::exists(fs::path(opt.campaign_dir) / "campaign.sqlite")) {
@@ -415,19 +435,20 @@ void run_resume(const ShearCliOptions& opt) {
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
     auto outs = runner.resume(print_progress);
     const auto stored = inspect_campaigns(opt.campaign_dir);
-    if (outs.empty()) {
-        // A campaign counts as complete once its last run is stored, before its report is written: a stop in
-        // between (kill -9, a full disk) left the report cut short or missing, and every resume said only "nothing
-        // to resume" (probe 64). The report is written again from the store: a fit and two plots, no simulation.
-        std::cout << "nothing to resume: every campaign in " << runner.dir().string()
-                  << " is complete; their reports are written again from the store\n";
-        for (auto o : stored)
-            if (o.campaign.kind == CampaignKind::shear) {
-                o.reused = int(std::count_if(o.runs.begin(), o.runs.end(),
-                                             [](const RunRecord& r) { return r.state == RunState::done; }));
-                outs.push_back(std::move(o));
-            }
-    }
+    const std::size_t resumed = outs.size();
+    std::size_t rewritten = 0;
+    for (auto o : stored)
+        if (report_written_again(runner.dir(), o, outs)) {
+            o.reused = int(std::count_if(o.runs.begin(), o.runs.end(),
+                                         [](const RunRecord& r) { return r.state == RunState::done; }));
+            outs.push_back(std::move(o));
+            ++rewritten;
+        }
+    if (resumed == 0)
+        std::cout << "nothing to resume: every campaign in " << runner.dir().string() << " is complete"
+                  << (rewritten > 0 ? "; the report of each `demcal shear` campaign is written again from the store"
+                                    : "")
+                  << "\n";
     int code = 0;
     for (const auto& o : outs) {
         // a study's line whose failed runs fresh packings replaced was fitted over both campaigns: reported as a

@@ -864,11 +864,18 @@ void resume_silo(const SiloCli& given, CLI::App& sub) {
     // the results, the next checkpoints and the snapshots go where the run wrote before: still writable?
     check_output_folder(dir.string(), "--resume");
     if (!s.vtk_dir.empty()) check_output_folder(s.vtk_dir, "--vtk (the run's snapshot folder, in its checkpoint)");
-    const bool folder_had_lock = fs::exists(fs::symlink_status(dir / ".lock"));
+    if (!o.no_plots) require_gnuplot("--no-plots");
     const auto lock = lock_output_folder(dir);  // two resumes of one run read and wrote one checkpoint at once
     const auto vtk_lock = lock_vtk_folder(s.vtk_dir, dir);
-    if (!o.no_plots) require_gnuplot("--no-plots");
-    if (!fs::exists(file)) throw UserError("resume = '" + dir.string() + "': another demcal has just finished it");
+    // a refusal after the locks leaves the folders as found: no .lock file that this command made (probe 64)
+    const auto forget_locks = [&] {
+        if (vtk_lock) vtk_lock->release_and_forget();
+        lock->release_and_forget();
+    };
+    if (!fs::exists(file)) {
+        forget_locks();
+        throw UserError("resume = '" + dir.string() + "': another demcal has just finished it");
+    }
     s.threads = threads;
     s.checkpoint_file = file.string();  // removed once the outputs are written
     s.wall_limit = o.wall_limit;
@@ -881,10 +888,8 @@ void resume_silo(const SiloCli& given, CLI::App& sub) {
     try {
         result = ks::resume_silo_case(file.string(), {threads, o.checkpoint_every, o.wall_limit, StopOnSignal::reason},
                                       print_progress);
-    } catch (const std::invalid_argument&) {
-        // a damaged checkpoint is found while it loads, before anything runs: the folder is left as it was
-        std::error_code ec;
-        if (!folder_had_lock) fs::remove(dir / ".lock", ec);
+    } catch (const std::invalid_argument&) {  // a damaged checkpoint, refused as it loads (bad input, exit 2)
+        forget_locks();
         throw;
     }
     write_outputs(dir, s, result, o.no_plots);

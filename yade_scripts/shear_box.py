@@ -420,8 +420,8 @@ def main():
         # "Far below" is judged on the force's running mean: a stiff sample (E 1e9 Pa in the 4 cm box) swings between
         # no lid contact and 25x the target within one servo period at the approach speed, and each dip of the
         # instantaneous force re-armed the fast approach: a limit cycle that never consolidated (measured).
-        # With hysteresis: the mean reaching the target disarms it until the mean falls far below again (the lid lost
-        # the sample). Re-armed at every mean below 90 %, a stiffer sample (E 1e10 Pa) still cycled: each approach
+        # With hysteresis: the mean reaching 90 % of the target disarms it until the mean falls below 50 % (the lid
+        # lost the sample). Re-armed at every mean below 90 %, a stiffer sample (E 1e10 Pa) still cycled: each approach
         # pressed 10x the target for one period, the spikes held the mean near the target while the force between
         # them stayed at 50-80 % of it, never settling (measured).
         # The present force must be below the target too: with the mean lagging, the approach held down a lid already

@@ -64,7 +64,8 @@ TEST_CASE("a kernel-engine campaign fits a failure line, stores its runs beside 
     // mended by resume, which writes a complete campaign's report again from the store
     std::vector<fs::path> reports;
     for (const auto& e : fs::directory_iterator(dir))
-        if (e.path().filename().string().rfind("failure_line_", 0) == 0) reports.push_back(e.path());
+        for (const char* stem : {"failure_line_", "shear_curves_"})
+            if (e.path().filename().string().rfind(stem, 0) == 0) reports.push_back(e.path());
     REQUIRE_FALSE(reports.empty());
     for (const auto& f : reports) std::ofstream(f, std::ios::trunc).close();  // cut to nothing
     const auto json_it = std::find_if(reports.begin(), reports.end(), [](const fs::path& f) {
@@ -76,7 +77,7 @@ TEST_CASE("a kernel-engine campaign fits a failure line, stores its runs beside 
     REQUIRE(test::run_demcal({"resume", dir.string()}, dir / "resume.log") == 0);
     const std::string resumed = test::read_file(dir / "resume.log");
     INFO(resumed);
-    CHECK(resumed.find("their reports are written again") != std::string::npos);
+    CHECK(resumed.find("is written again from the store") != std::string::npos);
     CHECK(resumed.find("0 computed now, 3 reused") != std::string::npos);
     for (const auto& f : reports) CHECK(fs::file_size(f) > 0);
     CHECK(nlohmann::json::parse(test::read_file(json)).at("peak_failure_line").at("mu_b").get<double>() > 0);

@@ -195,10 +195,10 @@ TEST_CASE("the work estimate is the run's own: particle count, time step and ste
     // the smallest sphere is a little above r (1 - spread), so the estimated step is a little shorter
     CHECK(work.timestep <= r.at("timestep").get<double>());
     CHECK(work.timestep > 0.95 * r.at("timestep").get<double>());
-    // growth runs in chunks of 200 steps and pauses while the lid holds more than the target: the nominal steps at
-    // least (to a chunk), the growth's step limit (20x) at most; the consolidation's step limit bounds what it takes
+    // growth runs in chunks of 200 steps and pauses while the lid holds more than the target: at least the nominal
+    // steps (to a chunk), and on this box not twice them (2200 against 1778 at stop 64; the run's own limit is 20x)
     CHECK(r.at("growth_steps").get<double>() >= 0.8 * work.growth_steps);
-    CHECK(r.at("growth_steps").get<double>() <= 20 * work.growth_steps + 200);
+    CHECK(r.at("growth_steps").get<double>() <= 2 * work.growth_steps + 200);
     CHECK(r.at("steps").get<double>() - r.at("consolidation_steps").get<double>() ==
           Approx(work.shear_steps).epsilon(0.05));
     CHECK(r.at("steps").get<double>() < work.steps());
