@@ -81,6 +81,10 @@ std::string sqlite_failure(sqlite3* db) {
         m += std::string(" (") + std::strerror(sys) + ")";
     else if (code == SQLITE_FULL)  // a short write: SQLite keeps no errno for it (demcal sets no page limit)
         m += " (no space left on the device)";
+    // what a user of an overnight campaign on a full disk needs next (probe 64 D6: the reason alone was said)
+    if (code == SQLITE_FULL || sys == ENOSPC || sys == EDQUOT || sys == EFBIG)
+        m += "; the store keeps every change before this one: once there is room, the same command (or `demcal "
+             "resume` of its campaign folder) goes on from there";
     return m;
 }
 
@@ -540,11 +544,27 @@ void CampaignStore::exec(const std::string& sql) {
     }
 }
 
+void CampaignStore::insert_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec) {
+    Statement(db_, "INSERT OR IGNORE INTO campaigns(name, kind, spec, created_at) VALUES(?,?,?,?)")
+        .bind(1, name).bind(2, to_string(kind)).bind(3, spec.dump()).bind(4, now_seconds()).step();
+}
+
 CampaignRecord CampaignStore::ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec) {
     if (auto c = find_campaign(name)) return *c;
+    in_transaction(db_, [&] { insert_campaign(name, kind, spec); });
+    return *find_campaign(name);
+}
+
+CampaignRecord CampaignStore::ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec,
+                                              const std::vector<RunEntry>& runs) {
     in_transaction(db_, [&] {
-        Statement(db_, "INSERT INTO campaigns(name, kind, spec, created_at) VALUES(?,?,?,?)")
-            .bind(1, name).bind(2, to_string(kind)).bind(3, spec.dump()).bind(4, now_seconds()).step();
+        insert_campaign(name, kind, spec);
+        Statement id(db_, "SELECT id FROM campaigns WHERE name = ?");
+        id.bind(1, name);
+        if (!id.step()) throw std::runtime_error(store_named(db_) + ": campaign '" + name + "' was not stored");
+        const std::int64_t campaign_id = id.integer(0);
+        std::int64_t next_position = linked_runs(campaign_id);
+        for (const auto& r : runs) insert_run(campaign_id, r, next_position);
     });
     return *find_campaign(name);
 }
@@ -580,26 +600,42 @@ void CampaignStore::set_setting_once(const std::string& key, const std::string& 
     in_transaction(db_, [&] { Statement(db_, "INSERT OR IGNORE INTO meta VALUES(?, ?)").bind(1, key).bind(2, value).step(); });
 }
 
+std::int64_t CampaignStore::linked_runs(std::int64_t campaign_id) {
+    Statement count(db_, "SELECT COUNT(*) FROM campaign_runs WHERE campaign_id = ?");
+    count.bind(1, campaign_id);
+    return count.step() ? count.integer(0) : 0;
+}
+
+void CampaignStore::insert_run(std::int64_t campaign_id, const RunEntry& run, std::int64_t& next_position) {
+    const double t = now_seconds();
+    Statement ins(db_,
+                  "INSERT OR IGNORE INTO runs(hash, params, state, run_dir, created_at, updated_at) "
+                  "VALUES(?,?,'pending',?,?,?)");
+    ins.bind(1, run.hash).bind(2, run.params.dump()).bind(3, stored_run_dir(run.run_dir, base_dir_)).bind(4, t).bind(5, t).step();
+    if (sqlite3_changes(db_) > 0) {
+        for (const auto& [k, v] : run.params.items())
+            if (v.is_number())
+                Statement(db_, "INSERT INTO run_parameters VALUES(?,?,?)").bind(1, run.hash).bind(2, k).bind(3, v.get<double>()).step();
+    }
+    Statement link(db_, "INSERT OR IGNORE INTO campaign_runs(campaign_id, hash, label, position) VALUES(?,?,?,?)");
+    link.bind(1, campaign_id).bind(2, run.hash).bind(3, run.label.dump()).bind(4, next_position).step();
+    if (sqlite3_changes(db_) > 0) ++next_position;  // (a run linked before keeps its place)
+}
+
 RunRecord CampaignStore::ensure_run(std::int64_t campaign_id, const std::string& hash, const nlohmann::json& params,
                                     const std::filesystem::path& run_dir, const nlohmann::json& label) {
+    return ensure_runs(campaign_id, {RunEntry{hash, params, run_dir, label}}).front();
+}
+
+std::vector<RunRecord> CampaignStore::ensure_runs(std::int64_t campaign_id, const std::vector<RunEntry>& runs) {
     in_transaction(db_, [&] {
-        const double t = now_seconds();
-        Statement ins(db_,
-                      "INSERT OR IGNORE INTO runs(hash, params, state, run_dir, created_at, updated_at) "
-                      "VALUES(?,?,'pending',?,?,?)");
-        ins.bind(1, hash).bind(2, params.dump()).bind(3, stored_run_dir(run_dir, base_dir_)).bind(4, t).bind(5, t).step();
-        if (sqlite3_changes(db_) > 0) {
-            for (const auto& [k, v] : params.items())
-                if (v.is_number())
-                    Statement(db_, "INSERT INTO run_parameters VALUES(?,?,?)")
-                        .bind(1, hash).bind(2, k).bind(3, v.get<double>()).step();
-        }
-        Statement link(db_,
-                       "INSERT OR IGNORE INTO campaign_runs(campaign_id, hash, label, position) "
-                       "VALUES(?,?,?,(SELECT COUNT(*) FROM campaign_runs WHERE campaign_id = ?))");
-        link.bind(1, campaign_id).bind(2, hash).bind(3, label.dump()).bind(4, campaign_id).step();
+        std::int64_t next_position = linked_runs(campaign_id);
+        for (const auto& r : runs) insert_run(campaign_id, r, next_position);
     });
-    return *run(hash);
+    std::vector<RunRecord> out;
+    out.reserve(runs.size());
+    for (const auto& r : runs) out.push_back(*run(r.hash));
+    return out;
 }
 
 std::optional<RunRecord> CampaignStore::run(const std::string& hash) {

@@ -77,8 +77,21 @@ public:
     // (CampaignDirectory calls it before it makes the folder).
     static void check_store_path(const std::filesystem::path& db_path);
 
+    // A run to register: its identity (hash), what it depends on, its folder and its label in the campaign.
+    struct RunEntry {
+        std::string hash;
+        nlohmann::json params;
+        std::filesystem::path run_dir;
+        nlohmann::json label;
+    };
+
     // Returns the campaign of that name, creating it with `spec` if new.
     CampaignRecord ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec);
+    // The same, with every run of the campaign registered in the same transaction (ensure_runs): a kill leaves the
+    // campaign with all its planned runs or not stored at all. (A campaign stored without all its runs was counted
+    // complete by `status` with the runs it had; probe 64 D5.)
+    CampaignRecord ensure_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec,
+                                   const std::vector<RunEntry>& runs);
     std::optional<CampaignRecord> find_campaign(const std::string& name);
     std::vector<CampaignRecord> campaigns();
     void set_campaign_status(std::int64_t campaign_id, CampaignStatus status);
@@ -92,6 +105,8 @@ public:
     // Registers a run (new identity: pending) and links it to the campaign with its label. Returns the stored record.
     RunRecord ensure_run(std::int64_t campaign_id, const std::string& hash, const nlohmann::json& params,
                          const std::filesystem::path& run_dir, const nlohmann::json& label);
+    // Registers every run as ensure_run does, all in one transaction; their stored records in the order given.
+    std::vector<RunRecord> ensure_runs(std::int64_t campaign_id, const std::vector<RunEntry>& runs);
     std::optional<RunRecord> run(const std::string& hash);
     std::vector<RunRecord> campaign_runs(std::int64_t campaign_id);
     std::vector<RunRecord> runs_in_state(RunState s);
@@ -116,6 +131,10 @@ private:
     // A new store under `fresh_path` with demcal's schema (then renamed into place by the public constructor).
     CampaignStore(const std::filesystem::path& fresh_path, const std::filesystem::path& base_dir);
     void create_schema();
+    void insert_campaign(const std::string& name, CampaignKind kind, const nlohmann::json& spec);  // (in a transaction)
+    // (in a transaction) `next_position`: the run's place in the campaign if it is new to it (then counted on)
+    void insert_run(std::int64_t campaign_id, const RunEntry& run, std::int64_t& next_position);
+    std::int64_t linked_runs(std::int64_t campaign_id);  // the runs linked to the campaign so far
     void exec(const std::string& sql);
     sqlite3* db_ = nullptr;
     std::filesystem::path path_;

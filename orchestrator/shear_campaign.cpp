@@ -519,25 +519,38 @@ ShearCampaignRunner::~ShearCampaignRunner() = default;
 
 namespace {
 
-// The runs a pass has to compute, each run folder written and each run entered in the store: the pending ones in
-// plan order, the done ones counted as reused.
+// The runs a pass has to compute (the campaign and its runs stored before): the pending ones in plan order, the done
+// ones counted as reused.
 struct PreparedRuns {
     std::deque<std::string> queue;                      // hashes to run
     std::map<std::string, const PlannedRun*> by_hash;  // every distinct run of the plan
     int reused = 0;
 };
 
-PreparedRuns prepare_runs(CampaignStore& store, std::int64_t campaign_id, const std::vector<PlannedRun>& plan,
-                          ShearEngine engine_kind, const EngineSetup& engine, bool force) {
-    PreparedRuns p;
+// Writes every planned run's folder, then stores the campaign with all its runs in one transaction: a kill leaves
+// the campaign whole in the store or not there (then the same command starts it again), never with part of its runs.
+CampaignRecord store_campaign_with_runs(CampaignStore& store, const std::string& name, const nlohmann::json& spec,
+                                        const std::vector<PlannedRun>& plan, ShearEngine engine_kind,
+                                        const EngineSetup& engine) {
+    std::vector<CampaignStore::RunEntry> entries;
+    std::set<std::string> seen;
     for (const auto& r : plan) {
-        if (p.by_hash.count(r.hash)) continue;  // the same run twice in a plan (repeated stress) runs once
-        p.by_hash[r.hash] = &r;
+        if (!seen.insert(r.hash).second) continue;  // the same run twice in a plan (repeated stress) runs once
         if (engine_kind == ShearEngine::kernel)
             write_kernel_run_directory(r, engine);
         else
             write_run_directory(r, engine.identity_text, engine.wrapper_text);
-        RunRecord rec = store.ensure_run(campaign_id, r.hash, r.params, r.dir, r.label);
+        entries.push_back({r.hash, r.params, r.dir, r.label});
+    }
+    return store.ensure_campaign(name, CampaignKind::shear, spec, entries);
+}
+
+PreparedRuns prepare_runs(CampaignStore& store, const std::vector<PlannedRun>& plan, bool force) {
+    PreparedRuns p;
+    for (const auto& r : plan) {
+        if (p.by_hash.count(r.hash)) continue;
+        p.by_hash[r.hash] = &r;
+        RunRecord rec = *store.run(r.hash);
         if (force && rec.state != RunState::pending) {
             store.reset_to_pending(r.hash, "forced recomputation");
             rec.state = RunState::pending;
@@ -760,9 +773,10 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     as_typed.normal_stresses = spec_in.normal_stresses;
     const std::string name = campaign_name(spec), legacy = legacy_campaign_name(as_typed);
     const bool typed_campaign = legacy != name && store_->find_campaign(legacy).has_value();
-    out.campaign = typed_campaign ? store_->ensure_campaign(legacy, CampaignKind::shear, as_typed.to_json())
-                                  : store_->ensure_campaign(name, CampaignKind::shear, spec.to_json());
-    PreparedRuns runs = prepare_runs(*store_, out.campaign.id, plan, spec.engine, engine, options_.force);
+    out.campaign = typed_campaign
+                       ? store_campaign_with_runs(*store_, legacy, as_typed.to_json(), plan, spec.engine, engine)
+                       : store_campaign_with_runs(*store_, name, spec.to_json(), plan, spec.engine, engine);
+    PreparedRuns runs = prepare_runs(*store_, plan, options_.force);
     out.reused = runs.reused;
     auto executor = make_executor(options_, dir_);
     CampaignExecution(*store_, options_, engine, runs, out, progress).run(*executor);

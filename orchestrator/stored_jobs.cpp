@@ -81,9 +81,15 @@ StoredJobsOutcome run_stored_jobs(CampaignStore& store, std::int64_t campaign_id
     StoredJobsOutcome out;
     std::deque<const StoredJob*> queue;
     std::map<std::string, const StoredJob*> by_hash;
-    for (const StoredJob& job : jobs) {
-        if (!by_hash.emplace(job.hash, &job).second) continue;  // the same run twice: once
-        RunRecord rec = store.ensure_run(campaign_id, job.hash, job.params, job.dir, job.label);
+    std::vector<CampaignStore::RunEntry> entries;
+    for (const StoredJob& job : jobs)
+        if (by_hash.emplace(job.hash, &job).second)  // the same run twice: once
+            entries.push_back({job.hash, job.params, job.dir, job.label});
+    // every run stored in one transaction: a kill leaves all of them or none (probe 64 D5)
+    const std::vector<RunRecord> records = store.ensure_runs(campaign_id, entries);
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        const StoredJob& job = *by_hash.at(entries[i].hash);
+        RunRecord rec = records[i];
         if (rec.state == RunState::done) {
             const std::string why = why_done_job_is_stale(job, rec);
             if (!why.empty()) {

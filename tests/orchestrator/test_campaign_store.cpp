@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <sqlite3.h>
+#include <csignal>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -257,5 +258,46 @@ TEST_CASE("a store another process began to make and never finished is removed w
     for (const auto& name : abandoned) CHECK_FALSE(fs::exists(d / name));
     for (const auto& name : kept) CHECK(fs::exists(d / name));
     CHECK(fs::exists(d / "c.sqlite"));
+    fs::remove_all(d);
+}
+
+TEST_CASE("a campaign is stored with all its runs or not at all, whenever its process is killed", "[store]") {
+    // Before (probe 64 D5): the campaign, then each run, each in its own transaction: a kill between them left a
+    // campaign with part of its runs, which `status` counted as complete with the runs it had.
+    const fs::path d = fresh_dir("store-whole-campaign");
+    constexpr int kRuns = 50000;  // enough that the kill lands while they are being stored
+    std::vector<CampaignStore::RunEntry> runs;
+    for (int i = 0; i < kRuns; ++i) {
+        const std::string hash = "h" + std::to_string(i);
+        runs.push_back({hash, {{"normal_stress", 1e4 + i}}, d / "runs" / hash, {{"replicate", i}}});
+    }
+    { CampaignStore s(d / "c.sqlite"); }  // made whole beforehand: the kill falls on the campaign's registration
+    const pid_t child = ::fork();
+    if (child == 0) {
+        CampaignStore s(d / "c.sqlite");
+        s.ensure_campaign("c1", CampaignKind::shear, {{"x", 1}}, runs);
+        ::_exit(0);
+    }
+    REQUIRE(child > 0);
+    ::usleep(100'000);
+    int status = 0;
+    const bool killed_while_storing = ::waitpid(child, &status, WNOHANG) == 0;
+    ::kill(child, SIGKILL);
+    ::waitpid(child, &status, 0);
+    CampaignStore s(d / "c.sqlite");
+    const auto campaigns = s.campaigns();
+    INFO("killed while storing: " << killed_while_storing);
+    if (campaigns.empty()) {
+        CHECK(s.runs_in_state(RunState::pending).empty());
+    } else {
+        CHECK(s.campaign_runs(campaigns.front().id).size() == static_cast<std::size_t>(kRuns));
+    }
+    // and when not killed: the campaign and every run, their records in the order given
+    const auto c = s.ensure_campaign("c1", CampaignKind::shear, {{"x", 1}}, runs);
+    CHECK(s.campaign_runs(c.id).size() == static_cast<std::size_t>(kRuns));
+    const auto records = s.ensure_runs(c.id, {runs[7], runs[3]});
+    REQUIRE(records.size() == 2);
+    CHECK(records[0].hash == "h7");
+    CHECK(records[1].hash == "h3");
     fs::remove_all(d);
 }
