@@ -3,6 +3,7 @@
 #include "analytics/number_text.hpp"
 #include "app/commands.hpp"  // UserError
 #include "app/result_files.hpp"
+#include "orchestrator/stop_signals.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -11,8 +12,11 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <fstream>
+#include <iostream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -24,8 +28,8 @@ namespace {
 
 // Whether gnuplot finished the file: a PNG ends with its IEND chunk, an SVG with its closing tag. A full disk left
 // gnuplot's output cut short while gnuplot itself exited 0.
-bool plot_is_complete(const std::filesystem::path& output) {
-    std::ifstream f(output, std::ios::binary | std::ios::ate);
+bool plot_is_complete(const std::filesystem::path& file, const std::string& extension) {
+    std::ifstream f(file, std::ios::binary | std::ios::ate);
     if (!f) return false;
     const std::streamoff size = f.tellg();
     const std::streamoff tail = std::min<std::streamoff>(size, 64);
@@ -33,7 +37,7 @@ bool plot_is_complete(const std::filesystem::path& output) {
     f.seekg(size - tail);
     f.read(end.data(), tail);
     if (!f) return false;
-    if (output.extension() == ".png") {
+    if (extension == ".png") {
         static const std::string iend("\0\0\0\0IEND\xAE\x42\x60\x82", 12);
         return end.size() >= iend.size() && end.compare(end.size() - iend.size(), iend.size(), iend) == 0;
     }
@@ -44,6 +48,40 @@ std::string single_quoted(const std::string& text) {
     std::string s = "'";
     for (char c : text) s += (c == '\'') ? std::string("''") : std::string(1, c);
     return s + "'";
+}
+
+// The stop signal that arrived while gnuplot drew (0: none). A stop signal (a second Ctrl-C during a campaign's report,
+// say) used to end demcal with gnuplot still drawing half a plot under its final name (probe 64 D2).
+volatile std::sig_atomic_t stop_signal_while_drawing = 0;
+void note_stop_signal_while_drawing(int sig) { stop_signal_while_drawing = sig; }
+
+// Waits for gnuplot. A stop signal meanwhile ends gnuplot, removes its unfinished file and the result files this
+// command had begun, and then ends demcal by the signal's own default action, as it would have ended without this.
+int wait_for_gnuplot(pid_t pid, const std::filesystem::path& unfinished, const std::filesystem::path& script,
+                     std::optional<orchestrator::StopSignalHandlers>& handlers) {
+    int status = 0;
+    for (;;) {
+        const pid_t waited = ::waitpid(pid, &status, 0);
+        const int sig = stop_signal_while_drawing;
+        if (sig != 0) {
+            if (waited < 0) {
+                ::kill(pid, SIGTERM);
+                while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+                }
+            }
+            std::error_code ec;
+            std::filesystem::remove(unfinished, ec);
+            // the report this plot belongs to is whole or absent, as after any failure (app/result_files.hpp)
+            const int removed = discard_unfinished_results();
+            std::cerr << "demcal: stopped by " << orchestrator::stop_signal_name(sig) << " while gnuplot drew "
+                      << script.string() << "; removed the " << removed << " result file" << (removed == 1 ? "" : "s")
+                      << " this command had begun" << std::endl;
+            handlers.reset();  // the previous handlers back, then the signal as if it had come to them
+            std::raise(sig);
+        }
+        if (waited >= 0) return status;
+        if (errno != EINTR) throw std::runtime_error("lost gnuplot while it rendered " + script.string());
+    }
 }
 
 }  // namespace
@@ -97,12 +135,15 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
         terminal = "svg enhanced font 'Sans,10' size " + std::to_string(width) + "," + std::to_string(height);
     else
         throw std::runtime_error("plot output must end in .png or .svg, got '" + output.string() + "'");
-    std::filesystem::path script = output, log = output;
+    std::filesystem::path script = output, log = output, unfinished = output;
     script += ".gp";
     log += ".gp.log";
+    // gnuplot draws into a file of its own, renamed over OUTPUT once complete: an existing plot is replaced whole or
+    // not at all, whatever stops the drawing (a full disk, a signal)
+    unfinished += ".part-" + std::to_string(::getpid());
     note_result_file(output);  // the two files gnuplot writes; the script is noted by write_result_file
     note_result_file(log);
-    write_result_file(script, "set terminal " + terminal + "\nset output " + gnuplot_quote(output) + "\n" + body + "\n");
+    write_result_file(script, "set terminal " + terminal + "\nset output " + gnuplot_quote(unfinished) + "\n" + body + "\n");
     // gnuplot without a shell: the script's path is one argument, whatever it holds
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -113,25 +154,26 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     std::string program = "gnuplot", script_arg = script.string();
     if (!script_arg.empty() && script_arg.front() == '-') script_arg = "./" + script_arg;
     char* argv[] = {program.data(), script_arg.data(), nullptr};
+    stop_signal_while_drawing = 0;
+    std::optional<orchestrator::StopSignalHandlers> handlers(std::in_place, note_stop_signal_while_drawing);
     pid_t pid = 0;
     const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
-    int status = 0;
     if (spawned != 0)
         throw std::runtime_error("cannot start gnuplot for " + script.string() + " (is gnuplot-nox installed?)");
-    while (::waitpid(pid, &status, 0) < 0) {
-        if (errno != EINTR) throw std::runtime_error("lost gnuplot while it rendered " + script.string());
-    }
+    const int status = wait_for_gnuplot(pid, unfinished, script, handlers);
+    handlers.reset();
     std::error_code ec;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        std::filesystem::remove(output, ec);  // whatever gnuplot began is no plot
+        std::filesystem::remove(unfinished, ec);  // whatever gnuplot began is no plot
         throw std::runtime_error("gnuplot failed on " + script.string() + " (see " + log.string() + ")");
     }
-    if (!plot_is_complete(output)) {
-        std::filesystem::remove(output, ec);
+    if (!plot_is_complete(unfinished, ext)) {
+        std::filesystem::remove(unfinished, ec);
         throw std::runtime_error("gnuplot did not finish " + output.string() +
-                                 " (the file was cut short or not written: is the disk full?); it is removed");
+                                 " (the file was cut short or not written: is the disk full?); it is not written");
     }
+    std::filesystem::rename(unfinished, output);
     // a log gnuplot left empty says nothing: one beside every plot was clutter (probe 61); a warning stays
     if (std::filesystem::is_regular_file(log, ec) && std::filesystem::file_size(log, ec) == 0 && !ec)
         std::filesystem::remove(log, ec);

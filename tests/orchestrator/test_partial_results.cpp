@@ -11,9 +11,14 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -137,4 +142,38 @@ TEST_CASE("a silo run that cannot write its results is not marked failed: the ca
     const std::string again = test::read_file(log);
     INFO(again);
     CHECK_THAT(again, Contains("2 runs finished, 0 failed"));
+}
+
+TEST_CASE("a stop signal while gnuplot draws ends both, with no half plot under the plot's name", "[cli][partial]") {
+    // Before (probe 64 D2): gnuplot wrote straight into the plot's name, and a stop signal in a report's drawing
+    // ended demcal at once: half a PNG stayed, and gnuplot went on drawing as an orphan. A slow gnuplot stands in for a
+    // large plot (the real one draws diagnose's plots in a blink): it writes half a file where it is told, then waits.
+    const fs::path dir = test::fresh_test_dir("signal-while-drawing");
+    const fs::path out = dir / "out", log = dir / "log.txt", bin = dir / "bin", pid_file = dir / "gnuplot.pid";
+    fs::create_directories(out);
+    fs::create_directories(bin);
+    std::ofstream(bin / "gnuplot") << "#!/bin/sh\necho $$ > '" << pid_file.string()
+                                   << "'\nout=$(sed -n \"s/^set output '\\(.*\\)'$/\\1/p\" \"$1\")\n"
+                                      "printf 'half a plot' > \"$out\"\nexec sleep 120\n";
+    fs::permissions(bin / "gnuplot", fs::perms::owner_all);
+    const std::string old_path = std::getenv("PATH");
+    ::setenv("PATH", (bin.string() + ":" + old_path).c_str(), 1);
+    const pid_t demcal = test::spawn_demcal({"diagnose", "--model", "oldal", "--data",
+                                            test::source_path("examples/diagnose/oldal_clean.csv").string(), "--report",
+                                            (out / "r.md").string()},
+                                           log);
+    ::setenv("PATH", old_path.c_str(), 1);
+    for (int i = 0; i < 600 && !fs::exists(pid_file); ++i) ::usleep(50'000);
+    REQUIRE(fs::exists(pid_file));
+    ::usleep(200'000);  // the stand-in has written its half file
+    const pid_t gnuplot = std::stoi(test::read_file(pid_file));
+    ::kill(demcal, SIGINT);
+    int status = 0;
+    REQUIRE(::waitpid(demcal, &status, 0) == demcal);
+    INFO(test::read_file(log));
+    CHECK(WIFSIGNALED(status));  // ended as Ctrl-C ends a program, not as a failure of its own
+    CHECK((WIFSIGNALED(status) && WTERMSIG(status) == SIGINT));
+    CHECK(::kill(gnuplot, 0) != 0);  // no gnuplot left drawing
+    CHECK_THAT(test::read_file(log), Contains("stopped by SIGINT while gnuplot drew"));
+    CHECK(names_in(out).empty());  // neither the half plot nor the report's other files it had begun
 }
