@@ -438,14 +438,14 @@ SensitivityStudy read_stored_study(const std::string& file, const nlohmann::json
                         ": its responses hold for the campaign it ran (calibrate with the same options, or run the "
                         "study for these)");
     if (const std::string why = study.campaign->packing_difference_from(here); !why.empty())
-        std::cerr << "demcal: warning: --sensitivity = '" << analytics::shortened_text(file, 200) << "': " << why
-                  << ": none of its lines is reused, and the search meets other packings' scatter\n";
+        warnings.push_back("--sensitivity = '" + analytics::shortened_text(file, 200) + "': " + why +
+                           ": none of its lines is reused, and the search meets other packings' scatter");
     else if ((!study.campaign->replicates || !study.campaign->base_seed) && here.replicates && here.base_seed)
-        std::cerr << "demcal: warning: --sensitivity = '" << analytics::shortened_text(file, 200)
-                  << "' does not record the packings its lines sheared (written before demcal recorded them): if they "
-                     "were not this calibration's ("
-                  << *here.replicates << " per stress from seed " << *here.base_seed
-                  << "), none of its lines is reused and the search meets other packings' scatter\n";
+        warnings.push_back("--sensitivity = '" + analytics::shortened_text(file, 200) +
+                           "' does not record the packings its lines sheared (written before demcal recorded them): if "
+                           "they were not this calibration's (" + std::to_string(*here.replicates) +
+                           " per stress from seed " + std::to_string(*here.base_seed) +
+                           "), none of its lines is reused and the search meets other packings' scatter");
     return study;
 }
 

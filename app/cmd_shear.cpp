@@ -348,10 +348,13 @@ void warn_of_study_commands(const std::string& dir) {
                   << "` command is run again, which reuses every finished run" << std::endl;
 }
 
+std::size_t runs_in_state(const ShearCampaignOutcome& o, orchestrator::RunState state) {
+    return std::size_t(std::count_if(o.runs.begin(), o.runs.end(),
+                                     [state](const orchestrator::RunRecord& r) { return r.state == state; }));
+}
+
 std::size_t failed_runs(const ShearCampaignOutcome& o) {
-    return std::size_t(std::count_if(o.runs.begin(), o.runs.end(), [](const orchestrator::RunRecord& r) {
-        return r.state == orchestrator::RunState::failed;
-    }));
+    return runs_in_state(o, orchestrator::RunState::failed);
 }
 
 // The stored campaign whose fresh packings replaced the failed runs of `o` (calibration::replaces_failed_runs), if
@@ -377,19 +380,25 @@ const ShearCampaignOutcome* replacing_campaign(const ShearCampaignOutcome& o,
 // resume writes again, from the store (a fit and two plots, no simulation), the report of a complete campaign it did
 // not just run that `demcal shear` made (no label: studies and crosschecks write reports of their own) or whose
 // report was begun (a file of it in the folder).
-bool report_written_again(const fs::path& dir, const ShearCampaignOutcome& o,
+// `files`: the names in the campaign folder (listed once per resume).
+bool report_written_again(const std::vector<std::string>& files, const ShearCampaignOutcome& o,
                           const std::vector<ShearCampaignOutcome>& resumed) {
     if (o.campaign.kind != CampaignKind::shear || o.campaign.status != CampaignStatus::complete) return false;
     for (const auto& r : resumed)
         if (r.campaign.name == o.campaign.name) return false;
     if (ShearCampaignSpec::from_json(o.campaign.spec).label.empty()) return true;
-    std::error_code ec;
-    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-        const std::string name = it->path().filename().string();
+    for (const std::string& name : files)
         for (const std::string& stem : {"failure_line_" + o.campaign.name, "shear_curves_" + o.campaign.name})
             if (name.rfind(stem, 0) == 0) return true;
-    }
     return false;
+}
+
+std::vector<std::string> file_names_in(const fs::path& dir) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+        names.push_back(it->path().filename().string());
+    return names;
 }
 
 void run_resume(const ShearCliOptions& opt) {
@@ -406,9 +415,7 @@ void run_resume(const ShearCliOptions& opt) {
     if (opt.yade_given) {  // void where every unfinished campaign runs on the kernel (it was silently ignored)
         bool unfinished = false, on_yade = false;
         for (const auto& o : inspect_campaigns(opt.campaign_dir)) {
-            if (std::all_of(o.runs.begin(), o.runs.end(),
-                            [](const orchestrator::RunRecord& r) { return r.state == orchestrator::RunState::done; }))
-                continue;
+            if (runs_in_state(o, orchestrator::RunState::done) == o.runs.size()) continue;
             unfinished = true;
             on_yade = on_yade || o.campaign.kind != orchestrator::CampaignKind::shear ||
                       ShearCampaignSpec::from_json(o.campaign.spec).engine == ShearEngine::yade;
@@ -437,10 +444,10 @@ void run_resume(const ShearCliOptions& opt) {
     const auto stored = inspect_campaigns(opt.campaign_dir);
     const std::size_t resumed = outs.size();
     std::size_t rewritten = 0;
+    const std::vector<std::string> files = file_names_in(runner.dir());
     for (auto o : stored)
-        if (report_written_again(runner.dir(), o, outs)) {
-            o.reused = int(std::count_if(o.runs.begin(), o.runs.end(),
-                                         [](const RunRecord& r) { return r.state == RunState::done; }));
+        if (report_written_again(files, o, outs)) {
+            o.reused = int(runs_in_state(o, RunState::done));
             outs.push_back(std::move(o));
             ++rewritten;
         }

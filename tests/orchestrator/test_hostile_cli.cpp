@@ -671,13 +671,21 @@ TEST_CASE("calibrate --sensitivity: a study of another material, or one that mov
     at_other_stresses["campaign"] = {{"engine", "kernel"}, {"normal_stresses", {2e3, 4e3, 6e3}}, {"template_sha256", ""}};
     std::ofstream(dir / "on_yade.json") << on_yade.dump();
     std::ofstream(dir / "at_other_stresses.json") << at_other_stresses.dump();
+    auto unrecorded = study;
+    unrecorded.erase("campaign");
+    std::ofstream(dir / "unrecorded.json") << unrecorded.dump();
+    auto unrecorded_then_refused = calibrate((dir / "unrecorded.json").string(), "mu_b=1.3");
+    unrecorded_then_refused.insert(unrecorded_then_refused.end(), {"--controls", "young_modulus"});
     refused({{calibrate((dir / "foreign.json").string(), "mu_b=1.3,tau_c=2e4"),
               {"its base material has density = 2000", "the start material"}},
              {residual, {"a study of the peak failure line, and --line residual"}},
              {calibrate((dir / "on_yade.json").string(), "mu_b=1.3,tau_c=2e4"),
               {"--sensitivity = '", "its lines ran on --engine yade, this calibration on kernel"}},
              {calibrate((dir / "at_other_stresses.json").string(), "mu_b=1.3,tau_c=2e4"),
-              {"its lines ran at --normal-stress 2000,4000,6000 Pa, this calibration's at 5000,10000,15000 Pa"}}},
+              {"its lines ran at --normal-stress 2000,4000,6000 Pa, this calibration's at 5000,10000,15000 Pa"}},
+             // a study that earns a warning (it records no campaign) and a refusal after it: the refusal alone, one
+             // line (the warning was printed first, before the command was refused: review of stop 64)
+             {unrecorded_then_refused, {"--controls: 'young_modulus'"}}},
             dir);
     CHECK_FALSE(fs::exists(camp));
     fs::remove_all(root);
