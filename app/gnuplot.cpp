@@ -55,6 +55,17 @@ std::string single_quoted(const std::string& text) {
 volatile std::sig_atomic_t stop_signal_while_drawing = 0;
 void note_stop_signal_while_drawing(int sig) { stop_signal_while_drawing = sig; }
 
+// Whether a stop signal would end demcal at once (its default action): only then is it caught while gnuplot draws. A
+// command that handles stop signals itself (a silo run's checkpoint) keeps its own handling, and gnuplot finishes.
+bool stop_signals_end_demcal() {
+    for (const int sig : orchestrator::kStopSignals) {
+        struct sigaction now {};
+        if (::sigaction(sig, nullptr, &now) != 0) return false;
+        if ((now.sa_flags & SA_SIGINFO) || (now.sa_handler != SIG_DFL && now.sa_handler != SIG_IGN)) return false;
+    }
+    return true;
+}
+
 // Waits for gnuplot. A stop signal meanwhile ends gnuplot, removes its unfinished file and the result files this
 // command had begun, and then ends demcal by the signal's own default action, as it would have ended without this.
 int wait_for_gnuplot(pid_t pid, const std::filesystem::path& unfinished, const std::filesystem::path& script,
@@ -76,8 +87,10 @@ int wait_for_gnuplot(pid_t pid, const std::filesystem::path& unfinished, const s
             std::cerr << "demcal: stopped by " << orchestrator::stop_signal_name(sig) << " while gnuplot drew "
                       << script.string() << "; removed the " << removed << " result file" << (removed == 1 ? "" : "s")
                       << " this command had begun" << std::endl;
-            handlers.reset();  // the previous handlers back, then the signal as if it had come to them
+            handlers.reset();  // the default action back (stop_signals_end_demcal), then the signal as if it came to it
             std::raise(sig);
+            throw std::runtime_error("stopped by " + orchestrator::stop_signal_name(sig) + " while gnuplot drew " +
+                                     script.string());  // (not reached: the default action ends the process)
         }
         if (waited >= 0) return status;
         if (errno != EINTR) throw std::runtime_error("lost gnuplot while it rendered " + script.string());
@@ -155,7 +168,8 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     if (!script_arg.empty() && script_arg.front() == '-') script_arg = "./" + script_arg;
     char* argv[] = {program.data(), script_arg.data(), nullptr};
     stop_signal_while_drawing = 0;
-    std::optional<orchestrator::StopSignalHandlers> handlers(std::in_place, note_stop_signal_while_drawing);
+    std::optional<orchestrator::StopSignalHandlers> handlers;
+    if (stop_signals_end_demcal()) handlers.emplace(note_stop_signal_while_drawing);
     pid_t pid = 0;
     const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
