@@ -46,8 +46,7 @@ $demcal calibrate "${common[@]}" --max-evaluations 7 | tee "$dir/surrogate.log" 
 # the same bounds; 5 puts the grid on the study's levels, so the study's lines are reused but still counted).
 if [[ ${GRID:-0} == 1 ]]; then
   points=${GRID_POINTS:-5}
-  $demcal calibrate "${common[@]}" --method grid --grid-points "$points" --max-evaluations $((points * points)) \
-    | tee "$dir/grid.log" || true
+  $demcal calibrate "${common[@]}" --method grid --grid-points "$points" | tee "$dir/grid.log" || true
 fi
 if [[ ${COORDINATE:-0} == 1 ]]; then
   $demcal calibrate "${common[@]}" --method coordinate --max-evaluations 40 | tee "$dir/coordinate.log" || true

@@ -15,7 +15,7 @@ import json,glob
 j=json.load(open(glob.glob('$dir/target/failure_line_*.json')[0]))['peak_failure_line']
 print('mu_b=%.6g,tau_c=%.6g' % (j['mu_b'], j['tau_c_Pa']))")
 "$demcal" calibrate --target "$target" --start "$root/examples/materials/sand-bonded.json" --strict --tol 0.05 \
-  -s $stresses -r 40 -j 2 --engine kernel --params friction_coefficient,bond_normal_strength --levels 5 \
+  -s $stresses -r 40 -j 2 --engine kernel \
   --sensitivity "$root/examples/calibration/kernel-sand-bonded-far/sensitivity.json" --campaign "$dir/loop" \
   --max-evaluations 8 | tee "$dir/loop.log"
 "$demcal" shear "$dir/loop/calibrated_material.json" -s $stresses -r 10 -j 2 -c "$dir/yade_final" | tee "$dir/yade_final.log"
