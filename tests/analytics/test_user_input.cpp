@@ -26,9 +26,11 @@ TEST_CASE("the JSON reader refuses deep nesting, duplicate keys and unusable num
     refused(R"({"a": {"b": [1, {"c": 1, "c": 1}]}})", "field 'a.b[1].c' appears twice");
     refused(R"({"timestep_fraction": 1e-320})", "field 'timestep_fraction' = 1e-320 is subnormal");
     refused(R"({"rho": [1, 2, 1e308]})", "field 'rho[2]' = 1e+308 is implausibly large");
-    refused(R"({"x": 1e400})", "is not valid JSON");
+    refused(R"({"x": 1e400})", "is not valid JSON: field 'x': number overflow");  // the field named (probe 65)
+    refused(R"({"a": {"b": [1, 0x10]}})", "is not valid JSON: in field 'a.b': ");
+    refused(R"({"a": 1 "b": 2})", "is not valid JSON: after field 'a': ");
     // the position in the file, not the JSON library's own exception tag
-    refused(R"({"x": tru})", "material = 'm.json' is not valid JSON: parse error at line 1, column 10");
+    refused(R"({"x": tru})", "material = 'm.json' is not valid JSON: field 'x': parse error at line 1, column 10");
     CHECK_THROWS_WITH(parse_json_text(R"({"x": tru})", "m"), !Contains("json.exception"));
     // the parser took a NUL for the end: a valid object, a NUL and garbage was read as the object alone
     refused(std::string("{\"x\": 1}\0GARBAGE{{{", 20), "byte 9 is a NUL byte");
