@@ -67,6 +67,12 @@ std::map<std::string, std::pair<double, double>> parse_ranges(const std::vector<
         if (!orchestrator::find_shear_param(name)) throw UserError(option + " '" + item + "': unknown parameter '" + name + "'");
         if (out.count(name))  // the last one silently won
             throw UserError(option + " '" + item + "': a range for " + name + " is given twice");
+        // the number rule of every number typed (nan:0.9 was refused as "must have low < high"), and the order
+        for (const auto& [which, value] : {std::pair<const char*, double>{"low", lo}, {"high", hi}})
+            if (const auto defect = analytics::number_defect(value))
+                throw UserError(option + " '" + analytics::shortened_text(item) + "': its " + which + " end " + *defect);
+        if (!(lo < hi))
+            throw UserError(option + " '" + analytics::shortened_text(item) + "': its low end must be below its high end");
         out[name] = {lo, hi};
     }
     return out;

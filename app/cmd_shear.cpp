@@ -11,6 +11,8 @@
 #include "analytics/user_input.hpp"
 #include "calibration/campaign_evaluator.hpp"  // replaces_failed_runs
 #include "calibration/failure_line_evaluation.hpp"
+#include "orchestrator/campaign_suspended.hpp"
+#include "orchestrator/executor.hpp"  // InterruptGuard
 #include "orchestrator/folder_lock.hpp"
 #include "orchestrator/run_identity.hpp"
 #include "orchestrator/shear_campaign.hpp"
@@ -162,6 +164,13 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
                   << stresses.size() << " normal stress" << (stresses.size() == 1 ? "" : "es")
                   << " (a line needs 3 runs on at least 2)\n";
     }
+    // A stop signal after the runs (caught by the guard the command holds from its runs on) stops the command as one during
+    // the runs does (exit 75, resume it), once the report step it came in is done, with the report's files removed.
+    // It ended demcal silently by the signal (held-back probe 65).
+    if (orchestrator::interrupted() && !outcome.interrupted)
+        throw orchestrator::CampaignSuspended("stopped by a stop signal while it wrote the report of campaign " +
+                                              outcome.campaign.name + ": its finished runs are stored; `demcal resume " +
+                                              shell_word(dir.string()) + "` writes the report again");
     keep_results();  // this campaign's report is whole: a later campaign's failure (resume) does not take it
     if (outcome.interrupted) return kExitResumeLater;
     if (!outcome.infrastructure_failure.empty()) {
@@ -199,6 +208,7 @@ void run_shear(const ShearCliOptions& opt) {
     std::cout << "campaign directory " << runner.dir().string() << ": " << spec.normal_stresses.size()
               << " normal stresses x " << spec.replicates << " replicates, " << to_string(spec.engine) << " engine, "
               << opt.exec.executor << " executor\n";
+    const orchestrator::InterruptGuard stop_guard;  // from the runs to the end of the report (report_campaign)
     const auto outcome = runner.run(spec, print_progress);
     const int code = report_campaign(runner.dir(), outcome, opt.plot_format);
     if (outcome.interrupted) std::cout << "interrupted: continue with `demcal resume " << shell_word(runner.dir().string()) << "`\n";
@@ -303,6 +313,11 @@ void check_campaign_folder_argument(const std::string& dir, const std::string& c
     if (fs::exists(d / "checkpoint.bin", ec) || fs::exists(d / "summary.json", ec))
         throw UserError(named + " is a demcal silo run's folder, not a campaign: `demcal silo --resume " +
                         shell_word(analytics::shortened_text(dir, 200)) + "` continues a suspended run");
+    // a store a command began and was stopped (kill -9) before it was renamed into place (held-back probe 65)
+    for (fs::directory_iterator it(d, ec), end; !ec && it != end; it.increment(ec))
+        if (const std::string n = it->path().filename().string(); n.rfind("campaign.sqlite.new-", 0) == 0)
+            throw UserError(named + " holds only " + analytics::shortened_text(n) + ", the store of a command stopped "
+                            "before it had stored its campaign: run that command again (it starts the campaign whole)");
     // a folder of campaigns (campaigns/, where cutoff puts its silo searches): name them
     std::vector<std::string> inside;
     for (fs::directory_iterator it(d, ec), end; !ec && it != end && inside.size() < 6; it.increment(ec))
@@ -440,6 +455,7 @@ void run_resume(const ShearCliOptions& opt) {
                         "campaign recorded in it (the command that made it stopped first): run that command again");
     find_yade(opt.exec.yade);  // before the store is opened: a bad --yade costs nothing
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
+    const orchestrator::InterruptGuard stop_guard;  // from the runs to the end of the reports (report_campaign)
     auto outs = runner.resume(print_progress);
     const auto stored = inspect_campaigns(opt.campaign_dir);
     const std::size_t resumed = outs.size();

@@ -195,7 +195,8 @@ GeometryGiven read_geometry_file(const std::string& file) {
         const bool known = std::any_of(std::begin(kGeometryKeys), std::end(kGeometryKeys),
                                        [&](const GeometryKey& k) { return key == k.file_key; });
         if (!known)
-            throw UserError(file + ": unknown key '" + key +
+            throw UserError("--geometry = '" + analytics::shortened_text(file, 200) + "': unknown key '" +
+                            analytics::shortened_text(key) +
                             "' (known: shape, theta_deg, outlet_m, D_m, body_height_m, a_m, b_m, c_m)");
         if (!value.is_number()) throw UserError(file + ": " + key + " = " + analytics::json_value_text(value) + ": must be a number");
         g.values[key] = {value.get<double>(), file + ": " + key};

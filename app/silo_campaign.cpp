@@ -263,6 +263,12 @@ void open_silo_campaign(const fs::path& dir, const json& settings, const std::st
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
+    // a shear campaign's store (or a file of its name): a sweep beside it made a folder that status and resume then
+    // refused for its store, the sweep's results unreadable by them (held-back probe 65)
+    if (std::error_code ec; fs::exists(fs::symlink_status(dir / "campaign.sqlite", ec)))
+        throw UserError("campaign = '" + analytics::shortened_text(dir.string(), 200) +
+                        "' holds campaign.sqlite (the store of shear campaigns, or a file of that name), and a " +
+                        command + " sweep keeps its own campaign.json: give another --campaign");
     if (fs::exists(settings_file)) {
         json stored = read_json_file(settings_file.string(), "campaign settings"), now = settings;
         for (const std::string& key : may_change) {

@@ -63,10 +63,14 @@ std::optional<std::filesystem::path> find_program_on_path(const std::string& nam
 // Set by SIGINT/SIGTERM while an InterruptGuard lives; executors poll it.
 bool interrupted();
 void request_interrupt();
+// Guards nest: only the outermost clears the flag, so that a signal caught by an outer guard (a command's, around its
+// campaign and report) is not lost when an executor's own guard begins.
 class InterruptGuard {
 public:
-    InterruptGuard();  // clears the flag and installs the handlers of the stop signals (stop_signals.hpp)
-    // (the previous handlers are put back when it ends)
+    InterruptGuard();  // clears the flag (outermost guard) and installs the handlers of the stop signals (stop_signals.hpp)
+    ~InterruptGuard();  // (the previous handlers are put back when it ends)
+    InterruptGuard(const InterruptGuard&) = delete;
+    InterruptGuard& operator=(const InterruptGuard&) = delete;
 
 private:
     StopSignalHandlers handlers_;

@@ -46,8 +46,13 @@ std::optional<std::filesystem::path> find_program_on_path(const std::string& nam
 bool interrupted() { return g_interrupted.load(); }
 void request_interrupt() { g_interrupted.store(true); }
 
+int g_guard_depth = 0;  // InterruptGuards alive (nested on one thread: a command's around its executor's)
+
 // (the flag cleared before the handlers are installed: a signal that comes in between is kept)
-InterruptGuard::InterruptGuard() : handlers_((g_interrupted.store(false), on_interrupt_signal)) {}
+InterruptGuard::InterruptGuard()
+    : handlers_((g_guard_depth++ == 0 ? g_interrupted.store(false) : void(), on_interrupt_signal)) {}
+
+InterruptGuard::~InterruptGuard() { --g_guard_depth; }
 
 void read_failure_from_stderr(const std::filesystem::path& stderr_log, JobOutcome& out) {
     std::ifstream f(stderr_log, std::ios::binary);

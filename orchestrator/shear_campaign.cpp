@@ -784,10 +784,23 @@ ShearCampaignOutcome ShearCampaignRunner::run(const ShearCampaignSpec& spec_in, 
     return out;
 }
 
+namespace {
+// Whether a shear campaign stored complete is: every run its spec plans is in the store, and done. A store edited or
+// damaged by hand (a run's row deleted, a run set back to pending) was shown complete and skipped by resume, whose
+// report then lost its line (held-back probe 65): its runs decide, not its stored status.
+bool complete_by_its_runs(const CampaignRecord& c, const std::vector<RunRecord>& runs) {
+    if (c.status != CampaignStatus::complete) return false;
+    const ShearCampaignSpec spec = ShearCampaignSpec::from_json(c.spec);
+    const std::set<double> stresses(spec.normal_stresses.begin(), spec.normal_stresses.end());
+    return runs.size() == stresses.size() * std::size_t(spec.replicates) &&
+           std::all_of(runs.begin(), runs.end(), [](const RunRecord& r) { return r.state == RunState::done; });
+}
+}  // namespace
+
 std::vector<ShearCampaignOutcome> ShearCampaignRunner::resume(const ProgressCallback& progress) {
     std::vector<ShearCampaignOutcome> outs;
     for (const auto& c : store_->campaigns()) {
-        if (c.kind != CampaignKind::shear || c.status == CampaignStatus::complete) continue;
+        if (c.kind != CampaignKind::shear || complete_by_its_runs(c, store_->campaign_runs(c.id))) continue;
         outs.push_back(run(ShearCampaignSpec::from_json(c.spec), progress));
         if (outs.back().interrupted) break;
     }
@@ -825,6 +838,8 @@ std::vector<ShearCampaignOutcome> inspect_campaigns(const fs::path& dir) {
         ShearCampaignOutcome o;
         o.campaign = c;
         o.runs = store.campaign_runs(c.id);
+        if (c.kind == CampaignKind::shear && c.status == CampaignStatus::complete && !complete_by_its_runs(c, o.runs))
+            o.campaign.status = CampaignStatus::open;  // (what resume makes of it)
         for (const auto& r : o.runs) {
             if (r.state == RunState::failed) ++o.failed;
             // the CPU the campaign spent: failed runs' too (a campaign of failed runs showed "CPU 0s")

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
+#include <fstream>
 #include <sys/wait.h>
 #include <thread>
 
@@ -124,5 +126,48 @@ TEST_CASE("the small hopper's cut-off search stopped by SIGTERM ends its run and
     CHECK_THAT(test::read_file(dir / "cutoff.log"),
                Catch::Matchers::Contains("interrupted after") && Catch::Matchers::Contains("run the same command again"));
     CHECK_FALSE(fs::exists(dir / "hop.json"));  // no result of a search not ended
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a shear campaign stopped while it writes its report exits 75 with no part of the report, and resume writes "
+          "it",
+          "[kernel_engine][signals]") {
+    // Before (held-back probe 65): a SIGINT just after the last run ended demcal silently by the signal, outside every
+    // handler. A slow gnuplot stands in for a report's drawing, so that the signal lands in it: it draws nothing whole.
+    const fs::path dir = test::fresh_test_dir("campaign-stop-report");
+    const fs::path camp = dir / "camp", log = dir / "stopped.log", bin = dir / "bin", drawing = dir / "drawing";
+    fs::create_directories(bin);
+    std::ofstream(bin / "gnuplot") << "#!/bin/sh\ntouch '" << drawing.string() << "'\nsleep 2\n";
+    fs::permissions(bin / "gnuplot", fs::perms::owner_all);
+    const std::vector<std::string> args{"shear", test::source_path("examples/materials/sand-tiny.json").string(),
+                                        "--normal-stress", "3e3,5e3,7e3", "--replicates", "1", "--engine", "kernel",
+                                        "--jobs", "2", "--campaign", camp.string()};
+    const std::string path = std::getenv("PATH");
+    ::setenv("PATH", (bin.string() + ":" + path).c_str(), 1);
+    const int pid = test::spawn_demcal(args, log);
+    ::setenv("PATH", path.c_str(), 1);
+    REQUIRE(pid > 0);
+    int status = 0;
+    bool ended = false;
+    for (int i = 0; i < 12000 && !ended && !fs::exists(drawing); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        ended = ::waitpid(pid, &status, WNOHANG) == pid;
+    }
+    REQUIRE_FALSE(ended);
+    REQUIRE(fs::exists(drawing));
+    ::kill(pid, SIGINT);
+    ::waitpid(pid, &status, 0);
+    const std::string text = test::read_file(log);
+    INFO(text);
+    REQUIRE(WIFEXITED(status));  // stopped, not killed by the signal
+    CHECK(WEXITSTATUS(status) == 75);
+    CHECK(text.find("writes the report again") != std::string::npos);
+    CHECK(test::find_file(camp, "failure_line_", ".json").empty());
+    CHECK(test::find_file(camp, "shear_curves_", "").empty());
+    // resume (with the real gnuplot) writes the whole report from the store, running nothing again
+    REQUIRE(test::run_demcal({"resume", camp.string()}, dir / "resume.log") == 0);
+    CHECK(!test::find_file(camp, "failure_line_", ".json").empty());
+    CHECK(!test::find_file(camp, "failure_line_", ".png").empty());
+    for (const auto& r : test::stored_runs(camp)) CHECK(r.attempts == 1);
     fs::remove_all(dir);
 }

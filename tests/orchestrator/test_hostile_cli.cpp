@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -1518,5 +1519,44 @@ TEST_CASE("probe 59: enlarge refuses a material whose calibration did not conver
             dir);
     CHECK(test::run_demcal({"enlarge", files[0], files[1], files[2], "--no-plot", "-o", out, "--allow-unconverged"},
                            root / "allowed.log") != 2);
+    fs::remove_all(root);
+}
+
+TEST_CASE("held-back probe 65: ranges, wide or non-UTF-8 tables and a sweep beside a store are refused up front",
+          "[cli]") {
+    const fs::path root = test::fresh_test_dir("hostile-probe65"), dir = root / "work";
+    fs::create_directories(dir);
+    const std::string tiny = test::source_path("examples/materials/sand-tiny.json").string();
+    const std::string camp = (dir / "camp").string();
+    // a header of many columns was refused only after comparing every name with every other (minutes for 1e6; here
+    // 300000, about 90 s before, under ctest's timeout: the case is a guard against the return of that cost)
+    std::string wide;
+    for (int c = 0; c < 300000; ++c) wide += (c ? ",c" : "c") + std::to_string(c);
+    std::ofstream(root / "wide.csv") << wide << "\n";
+    // a category that is not UTF-8 was analysed, then failed in the JSON writer with the library's text (exit 1)
+    std::string clean = test::read_file(test::source_path("examples/diagnose/oldal_clean.csv"));
+    const auto at = clean.find(",A,");
+    REQUIRE(at != std::string::npos);
+    clean.replace(at, 3, ",\xff\xfe,");
+    std::ofstream(root / "latin1.csv") << clean;
+    // a vibration sweep ran beside a store (here a text file of its name) that status and resume then refused
+    fs::create_directories(dir / "beside");
+    std::ofstream(dir / "beside" / "campaign.sqlite") << "hello\n";
+    refused({{{"sensitivity", tiny, "-s", "5e3,1e4", "--range", "friction_coefficient=nan:0.9", "--campaign", camp},
+              {"--range", "friction_coefficient", "its low end is not a number"}},
+             {{"sensitivity", tiny, "-s", "5e3,1e4", "--range", "friction_coefficient=0.9:0.1", "--campaign", camp},
+              {"--range", "its low end must be below its high end"}},
+             {{"calibrate", "--start", tiny, "--target", "mu_b=0.6", "-s", "5e3,1e4", "--bounds",
+               "friction_coefficient=0.9:0.1", "--campaign", camp},
+              {"--bounds", "its low end must be below its high end"}},
+             {{"diagnose", "--model", "oldal", "--data", (root / "wide.csv").string()},
+              {"300000 columns, more than 200"}},
+             {{"diagnose", "--model", "oldal", "--data", (root / "latin1.csv").string(), "--json",
+               (dir / "d.json").string()},
+              {"latin1.csv", "column operator", "not UTF-8 text"}},
+             {{"vibration", "--theta", "30", "--frequency", "0", "--campaign", (dir / "beside").string(), "--",
+               "--particles", "300"},
+              {"holds campaign.sqlite", "give another --campaign"}}},
+            dir);
     fs::remove_all(root);
 }
