@@ -433,6 +433,16 @@ CampaignStore::CampaignStore(const std::filesystem::path& db_path, StoreAccess a
     if (existed && std::filesystem::file_size(db_path, ec) == 0)
         throw std::invalid_argument("campaign store '" + db_path.string() +
                                     "' is empty (0 bytes), not a demcal campaign store; nothing was written to it");
+    // SQLite's side files must be files: a FIFO named -wal was opened by SQLite as "disk I/O error" (exit 1, no
+    // reason) after it had made a -shm beside it (held-back probe 65)
+    for (const char* side : {"-wal", "-shm", "-journal"}) {
+        const std::filesystem::path file = db_path.string() + side;
+        const auto side_status = std::filesystem::symlink_status(file, ec);
+        if (std::filesystem::exists(side_status) && !std::filesystem::is_regular_file(side_status))
+            throw std::invalid_argument("campaign store '" + db_path.string() + "': its side file " + file.string() +
+                                        " is not a regular file (a folder, FIFO, device or link): SQLite cannot use "
+                                        "it; nothing was written");
+    }
     check_store_path(db_path);
     if (!read_only) remove_abandoned_fresh_stores(db_path);
     if (!existed) {

@@ -205,3 +205,23 @@ TEST_CASE("a store with no campaign recorded (its command killed first) is not c
     CHECK_THAT(test::read_file(dir / "status.log"), Contains("no campaigns in") && Contains("run that command again"));
     fs::remove_all(dir);
 }
+
+TEST_CASE("a store whose -wal or -shm is not a regular file is refused, writing nothing", "[cli][store]") {
+    // a FIFO named campaign.sqlite-wal: "disk I/O error" with no reason (exit 1), and a -shm made beside it (probe 65)
+    const fs::path dir = test::fresh_test_dir("store-side-files");
+    const fs::path pristine = dir / "pristine", campaign = dir / "campaign";
+    complete_campaign(dir, pristine);
+    for (const char* side : {"campaign.sqlite-wal", "campaign.sqlite-shm"})
+        for (const std::string command : {"status", "resume"}) {
+            INFO(side << " " << command);
+            fs::remove_all(campaign);
+            fs::copy(pristine, campaign, fs::copy_options::recursive);
+            fs::remove(campaign / side);
+            REQUIRE(::mkfifo((campaign / side).c_str(), 0600) == 0);
+            const FolderState before = folder_state(campaign);
+            CHECK(test::run_demcal({command, campaign.string()}, dir / "out.log") == 2);
+            CHECK_THAT(test::read_file(dir / "out.log"), Contains(std::string(side) + " is not a regular file"));
+            CHECK(changes(before, campaign).empty());
+        }
+    fs::remove_all(dir);
+}
