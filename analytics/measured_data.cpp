@@ -353,9 +353,6 @@ MeasuredData read_measured_csv(const std::string& path, MeasuredKind kind, std::
                                             "CRLF line ends");
     std::istringstream in(text);
     auto data = parse_csv(in, path);
-    if (data.columns.size() > kMaxMeasuredColumns)
-        throw std::invalid_argument(named + ": " + std::to_string(data.columns.size()) + " columns, more than " +
-                                    std::to_string(kMaxMeasuredColumns) + " (each is a candidate effect)");
     if (data.rows() > max_rows)
         throw std::invalid_argument(named + ": " + std::to_string(data.rows()) + " rows, more than the limit of " +
                                     std::to_string(max_rows) + " (about 2 ms of diagnosis per row; raise it with "

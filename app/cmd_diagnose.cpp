@@ -380,9 +380,9 @@ void write_diagnosis_files(const DiagnoseArgs& a, const analytics::DiagnoseResul
             before_name = plots->before.filename().string();
             after_name = plots->after.filename().string();
         }
-        // the report before its plots: a run stopped while gnuplot draws (Ctrl-C) leaves the report, and the same
-        // command then replaces it and its side files (without it, they would be files it may not replace); a plot
-        // that fails takes the report with it (app/result_files.hpp)
+        // the report before its plots: a plot that fails, or a stop signal while gnuplot draws, takes the report
+        // with it (app/result_files.hpp, app/gnuplot.cpp); a kill -9 meanwhile leaves the report, which the same
+        // command then replaces with its side files (without it, they would be files it may not replace)
         write_result_file(a.report_out, markdown_report(r, a.data, before_name, after_name));
         if (plots) plot_residuals(r, data, plots->data, plots->before, plots->after);
     }
@@ -429,7 +429,8 @@ int run_diagnose(const DiagnoseArgs& a) {
     std::cout.flush();
     std::cerr << "demcal: failed: the diagnosis is not determined by these data ("
               << analytics::shortened_text(r.undetermined.front(), 300)
-              << "); its results are written (exit 1; --allow-undetermined: exit 0)" << std::endl;
+              << ")" << (a.json_out.empty() && a.report_out.empty() ? "" : "; its results are written")
+              << " (exit 1; --allow-undetermined: exit 0)" << std::endl;
     return 1;
 }
 

@@ -106,7 +106,8 @@ void write_plots(const fs::path& dir, const std::string& stem, const calibration
 }
 
 // Prints, saves and plots one campaign's failure lines; returns the process exit code.
-int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, const std::string& plot_format) {
+int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, const std::string& plot_format,
+                    bool stopped_before_reports) {
     const auto ev = calibration::failure_lines_of(outcome);
     std::cout << "\ncampaign " << outcome.campaign.name << " (" << dir.string() << "): " << outcome.runs.size()
               << " runs, " << ev.simulations_run << " computed now, " << ev.simulations_reused << " reused, "
@@ -167,7 +168,7 @@ int report_campaign(const fs::path& dir, const ShearCampaignOutcome& outcome, co
     // A stop signal after the runs (caught by the guard the command holds from its runs on) stops the command as one during
     // the runs does (exit 75, resume it), once the report step it came in is done, with the report's files removed.
     // It ended demcal silently by the signal (held-back probe 65).
-    if (orchestrator::interrupted() && !outcome.interrupted)
+    if (orchestrator::interrupted() && !stopped_before_reports && !outcome.interrupted)
         throw orchestrator::CampaignSuspended("stopped by a stop signal while it wrote the report of campaign " +
                                               outcome.campaign.name + ": its finished runs are stored; `demcal resume " +
                                               shell_word(dir.string()) + "` writes the report again");
@@ -210,7 +211,7 @@ void run_shear(const ShearCliOptions& opt) {
               << opt.exec.executor << " executor\n";
     const orchestrator::InterruptGuard stop_guard;  // from the runs to the end of the report (report_campaign)
     const auto outcome = runner.run(spec, print_progress);
-    const int code = report_campaign(runner.dir(), outcome, opt.plot_format);
+    const int code = report_campaign(runner.dir(), outcome, opt.plot_format, orchestrator::interrupted());
     if (outcome.interrupted) std::cout << "interrupted: continue with `demcal resume " << shell_word(runner.dir().string()) << "`\n";
     if (code != 0) throw CLI::RuntimeError(code);
 }
@@ -457,6 +458,7 @@ void run_resume(const ShearCliOptions& opt) {
     ShearCampaignRunner runner(opt.campaign_dir, opt.exec);
     const orchestrator::InterruptGuard stop_guard;  // from the runs to the end of the reports (report_campaign)
     auto outs = runner.resume(print_progress);
+    const bool stopped_before_reports = orchestrator::interrupted();  // (a stop in the runs is the runs' to report)
     const auto stored = inspect_campaigns(opt.campaign_dir);
     const std::size_t resumed = outs.size();
     std::size_t rewritten = 0;
@@ -482,7 +484,7 @@ void run_resume(const ShearCliOptions& opt) {
                       << " (the study fits its line over every round's runs); nothing to resume\n";
             continue;
         }
-        code = std::max(code, report_campaign(runner.dir(), o, opt.plot_format));
+        code = std::max(code, report_campaign(runner.dir(), o, opt.plot_format, stopped_before_reports));
     }
     warn_of_study_commands(opt.campaign_dir);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -156,7 +156,19 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     unfinished += ".part-" + std::to_string(::getpid());
     note_result_file(output);  // the two files gnuplot writes; the script is noted by write_result_file
     note_result_file(log);
-    write_result_file(script, "set terminal " + terminal + "\nset output " + gnuplot_quote(unfinished) + "\n" + body + "\n");
+    note_result_file(unfinished);
+    // the script kept beside the plot draws the plot (`gnuplot OUTPUT.gp` redraws it); gnuplot is run here on a copy
+    // that draws into the unfinished file, removed with it
+    const std::string head = "set terminal " + terminal + "\nset output ";
+    write_result_file(script, head + gnuplot_quote(output) + "\n" + body + "\n");
+    std::filesystem::path run_script = unfinished;
+    run_script += ".gp";
+    write_result_file(run_script, head + gnuplot_quote(unfinished) + "\n" + body + "\n");
+    const auto remove_run_files = [&] {
+        std::error_code ignored;
+        std::filesystem::remove(unfinished, ignored);
+        std::filesystem::remove(run_script, ignored);
+    };
     // gnuplot without a shell: the script's path is one argument, whatever it holds
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -164,7 +176,7 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     // a relative name starting with - ("-r.md"'s plots) is gnuplot's option, not its script (probe 62b)
-    std::string program = "gnuplot", script_arg = script.string();
+    std::string program = "gnuplot", script_arg = run_script.string();
     if (!script_arg.empty() && script_arg.front() == '-') script_arg = "./" + script_arg;
     char* argv[] = {program.data(), script_arg.data(), nullptr};
     stop_signal_while_drawing = 0;
@@ -173,20 +185,29 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
     pid_t pid = 0;
     const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
-    if (spawned != 0)
+    if (spawned != 0) {
+        remove_run_files();
         throw std::runtime_error("cannot start gnuplot for " + script.string() + " (is gnuplot-nox installed?)");
+    }
     const int status = wait_for_gnuplot(pid, unfinished, script, handlers);
     handlers.reset();
+    // a signal between wait_for_gnuplot's last look and the reset: taken as one during the drawing (review of stop 65)
+    if (const int sig = stop_signal_while_drawing; sig != 0) {
+        remove_run_files();
+        discard_unfinished_results();
+        std::raise(sig);
+    }
     std::error_code ec;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        std::filesystem::remove(unfinished, ec);  // whatever gnuplot began is no plot
+        remove_run_files();  // whatever gnuplot began is no plot
         throw std::runtime_error("gnuplot failed on " + script.string() + " (see " + log.string() + ")");
     }
     if (!plot_is_complete(unfinished, ext)) {
-        std::filesystem::remove(unfinished, ec);
+        remove_run_files();
         throw std::runtime_error("gnuplot did not finish " + output.string() +
                                  " (the file was cut short or not written: is the disk full?); it is not written");
     }
+    std::filesystem::remove(run_script, ec);
     std::filesystem::rename(unfinished, output);
     // a log gnuplot left empty says nothing: one beside every plot was clutter (probe 61); a warning stays
     if (std::filesystem::is_regular_file(log, ec) && std::filesystem::file_size(log, ec) == 0 && !ec)

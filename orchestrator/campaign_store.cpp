@@ -83,8 +83,7 @@ std::string sqlite_failure(sqlite3* db) {
         m += " (no space left on the device)";
     // what a user of an overnight campaign on a full disk needs next (probe 64 D6: the reason alone was said)
     if (code == SQLITE_FULL || sys == ENOSPC || sys == EDQUOT || sys == EFBIG)
-        m += "; the store keeps every change before this one: once there is room, the same command (or `demcal "
-             "resume` of its campaign folder) goes on from there";
+        m += "; the store keeps every change before this one: once there is room, run the command again";
     return m;
 }
 

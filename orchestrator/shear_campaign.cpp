@@ -790,10 +790,19 @@ namespace {
 // report then lost its line (held-back probe 65): its runs decide, not its stored status.
 bool complete_by_its_runs(const CampaignRecord& c, const std::vector<RunRecord>& runs) {
     if (c.status != CampaignStatus::complete) return false;
+    // every planned (stress, replicate) done; a campaign may hold more runs than planned (the same spec run again
+    // on another engine identity or script links the new runs beside the old: review of stop 65)
     const ShearCampaignSpec spec = ShearCampaignSpec::from_json(c.spec);
-    const std::set<double> stresses(spec.normal_stresses.begin(), spec.normal_stresses.end());
-    return runs.size() == stresses.size() * std::size_t(spec.replicates) &&
-           std::all_of(runs.begin(), runs.end(), [](const RunRecord& r) { return r.state == RunState::done; });
+    std::set<std::pair<double, int>> missing;
+    for (double sigma : spec.normal_stresses)
+        for (int rep = 0; rep < spec.replicates; ++rep) missing.insert({sigma, rep});
+    for (const auto& r : runs) {
+        if (r.state != RunState::done) return false;
+        if (r.label.contains("normal_stress") && r.label.contains("replicate") && r.label["normal_stress"].is_number() &&
+            r.label["replicate"].is_number_integer())
+            missing.erase({r.label["normal_stress"].get<double>(), r.label["replicate"].get<int>()});
+    }
+    return missing.empty();
 }
 }  // namespace
 
