@@ -66,31 +66,34 @@ bool stop_signals_end_demcal() {
     return true;
 }
 
-// Waits for gnuplot. A stop signal meanwhile ends gnuplot, removes its unfinished file and the result files this
-// command had begun, and then ends demcal by the signal's own default action, as it would have ended without this.
-int wait_for_gnuplot(pid_t pid, const std::filesystem::path& unfinished, const std::filesystem::path& script,
+// Ends demcal after a stop signal that came while gnuplot drew (gnuplot already ended): the unfinished plot, its run
+// script and the result files this command had begun are removed (all noted result files: the report is whole or
+// absent, app/result_files.hpp), then the signal's own default action ends demcal, as it would have without this.
+[[noreturn]] void end_by_stop_signal(int sig, const std::filesystem::path& script,
+                                     std::optional<orchestrator::StopSignalHandlers>& handlers) {
+    const int removed = discard_unfinished_results();
+    std::cerr << "demcal: stopped by " << orchestrator::stop_signal_name(sig) << " while gnuplot drew "
+              << script.string() << "; removed the " << removed << " result file" << (removed == 1 ? "" : "s")
+              << " this command had begun" << std::endl;
+    handlers.reset();  // the default action back (stop_signals_end_demcal), then the signal as if it came to it
+    std::raise(sig);
+    throw std::runtime_error("stopped by " + orchestrator::stop_signal_name(sig) + " while gnuplot drew " +
+                             script.string());  // (not reached: the default action ends the process)
+}
+
+// Waits for gnuplot; a stop signal meanwhile ends gnuplot and then demcal (end_by_stop_signal).
+int wait_for_gnuplot(pid_t pid, const std::filesystem::path& script,
                      std::optional<orchestrator::StopSignalHandlers>& handlers) {
     int status = 0;
     for (;;) {
         const pid_t waited = ::waitpid(pid, &status, 0);
-        const int sig = stop_signal_while_drawing;
-        if (sig != 0) {
+        if (const int sig = stop_signal_while_drawing; sig != 0) {
             if (waited < 0) {
                 ::kill(pid, SIGTERM);
                 while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
                 }
             }
-            std::error_code ec;
-            std::filesystem::remove(unfinished, ec);
-            // the report this plot belongs to is whole or absent, as after any failure (app/result_files.hpp)
-            const int removed = discard_unfinished_results();
-            std::cerr << "demcal: stopped by " << orchestrator::stop_signal_name(sig) << " while gnuplot drew "
-                      << script.string() << "; removed the " << removed << " result file" << (removed == 1 ? "" : "s")
-                      << " this command had begun" << std::endl;
-            handlers.reset();  // the default action back (stop_signals_end_demcal), then the signal as if it came to it
-            std::raise(sig);
-            throw std::runtime_error("stopped by " + orchestrator::stop_signal_name(sig) + " while gnuplot drew " +
-                                     script.string());  // (not reached: the default action ends the process)
+            end_by_stop_signal(sig, script, handlers);
         }
         if (waited >= 0) return status;
         if (errno != EINTR) throw std::runtime_error("lost gnuplot while it rendered " + script.string());
@@ -189,14 +192,10 @@ void render_gnuplot(const std::filesystem::path& output, const std::string& body
         remove_run_files();
         throw std::runtime_error("cannot start gnuplot for " + script.string() + " (is gnuplot-nox installed?)");
     }
-    const int status = wait_for_gnuplot(pid, unfinished, script, handlers);
-    handlers.reset();
+    const int status = wait_for_gnuplot(pid, script, handlers);
+    handlers.reset();  // (from here a stop signal takes its default action at once)
     // a signal between wait_for_gnuplot's last look and the reset: taken as one during the drawing (review of stop 65)
-    if (const int sig = stop_signal_while_drawing; sig != 0) {
-        remove_run_files();
-        discard_unfinished_results();
-        std::raise(sig);
-    }
+    if (const int sig = stop_signal_while_drawing; sig != 0) end_by_stop_signal(sig, script, handlers);
     std::error_code ec;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         remove_run_files();  // whatever gnuplot began is no plot
